@@ -1,0 +1,409 @@
+//! The adaptive explicit Runge–Kutta method of Dormand and Prince, order 8
+//! with the 5th- and 3rd-order embedded error estimate (DOP853; Hairer,
+//! Nørsett & Wanner, *Solving ODEs I*, 2nd ed., Sec. II.10).
+//!
+//! Shooting integrates the state together with its sensitivities (the
+//! variational equations) on the same steps, so the Jacobian it returns is
+//! the exact derivative of the discrete flow ("internal numerical
+//! differentiation", Bock 1981). Step size control therefore looks only at
+//! the first `controlled` components (the state), never at the
+//! sensitivities. After each accepted step an optional projection restores
+//! invariants (orthonormal directors).
+
+/// Tolerances and limits of one integration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Tolerances {
+    /// Relative tolerance per step.
+    pub rtol: f64,
+    /// Absolute tolerance per step.
+    pub atol: f64,
+    /// Maximum number of steps (accepted and rejected).
+    pub max_steps: usize,
+}
+
+impl Default for Tolerances {
+    fn default() -> Self {
+        Tolerances {
+            rtol: 1e-12,
+            atol: 1e-12,
+            max_steps: 100_000,
+        }
+    }
+}
+
+/// Work done by one integration.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct IntegrationStats {
+    /// Accepted steps.
+    pub accepted: usize,
+    /// Rejected steps.
+    pub rejected: usize,
+    /// Right-hand side evaluations.
+    pub evaluations: usize,
+}
+
+impl std::ops::AddAssign for IntegrationStats {
+    fn add_assign(&mut self, o: Self) {
+        self.accepted += o.accepted;
+        self.rejected += o.rejected;
+        self.evaluations += o.evaluations;
+    }
+}
+
+/// Why an integration stopped before its end.
+#[derive(Debug, Clone, Copy, PartialEq, thiserror::Error)]
+pub enum IntegrationError {
+    /// The solution left the finite numbers (blow-up).
+    #[error("the solution is not finite at s = {s:.6e} (blow-up)")]
+    NotFinite { s: f64 },
+    /// The step size fell below round-off of s.
+    #[error("step size underflow at s = {s:.6e} (stiff or singular equations)")]
+    StepSizeUnderflow { s: f64 },
+    /// The step budget ran out.
+    #[error("more than {steps} steps before s = {s:.6e}")]
+    TooManySteps { s: f64, steps: usize },
+}
+
+// Butcher tableau of DOP853 (Hairer's dop853.f; stages 1..12, c12 = 1).
+const C: [f64; 12] = [
+    0.0,
+    0.526001519587677318785587544488e-01,
+    0.789002279381515978178381316732e-01,
+    0.118350341907227396726757197510e+00,
+    0.281649658092772603273242802490e+00,
+    0.333333333333333333333333333333e+00,
+    0.25e+00,
+    0.307692307692307692307692307692e+00,
+    0.651282051282051282051282051282e+00,
+    0.6e+00,
+    0.857142857142857142857142857142e+00,
+    1.0,
+];
+
+#[rustfmt::skip]
+const A: [[f64; 11]; 12] = [
+    [0.0; 11],
+    [5.26001519587677318785587544488e-2, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    [1.97250569845378994544595329183e-2, 5.91751709536136983633785987549e-2, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    [2.95875854768068491816892993775e-2, 0.0, 8.87627564304205475450678981324e-2, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    [2.41365134159266685502369798665e-1, 0.0, -8.84549479328286085344864962717e-1, 9.24834003261792003115737966543e-1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    [3.7037037037037037037037037037e-2, 0.0, 0.0, 1.70828608729473871279604482173e-1, 1.25467687566822425016691814123e-1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+    [3.7109375e-2, 0.0, 0.0, 1.70252211019544039314978060272e-1, 6.02165389804559606850219397283e-2, -1.7578125e-2, 0.0, 0.0, 0.0, 0.0, 0.0],
+    [3.70920001185047927108779319836e-2, 0.0, 0.0, 1.70383925712239993810214054705e-1, 1.07262030446373284651809199168e-1, -1.53194377486244017527936158236e-2, 8.27378916381402288758473766002e-3, 0.0, 0.0, 0.0, 0.0],
+    [6.24110958716075717114429577812e-1, 0.0, 0.0, -3.36089262944694129406857109825e0, -8.68219346841726006818189891453e-1, 2.75920996994467083049415600797e1, 2.01540675504778934086186788979e1, -4.34898841810699588477366255144e1, 0.0, 0.0, 0.0],
+    [4.77662536438264365890433908527e-1, 0.0, 0.0, -2.48811461997166764192642586468e0, -5.90290826836842996371446475743e-1, 2.12300514481811942347288949897e1, 1.52792336328824235832596922938e1, -3.32882109689848629194453265587e1, -2.03312017085086261358222928593e-2, 0.0, 0.0],
+    [-9.3714243008598732571704021658e-1, 0.0, 0.0, 5.18637242884406370830023853209e0, 1.09143734899672957818500254654e0, -8.14978701074692612513997267357e0, -1.85200656599969598641566180701e1, 2.27394870993505042818970056734e1, 2.49360555267965238987089396762e0, -3.0467644718982195003823669022e0, 0.0],
+    [2.27331014751653820792359768449e0, 0.0, 0.0, -1.05344954667372501984066689879e1, -2.00087205822486249909675718444e0, -1.79589318631187989172765950534e1, 2.79488845294199600508499808837e1, -2.85899827713502369474065508674e0, -8.87285693353062954433549289258e0, 1.23605671757943030647266201528e1, 6.43392746015763530355970484046e-1],
+];
+
+/// 8th-order weights.
+#[rustfmt::skip]
+const B: [f64; 12] = [
+    5.42937341165687622380535766363e-2, 0.0, 0.0, 0.0, 0.0,
+    4.45031289275240888144113950566e0, 1.89151789931450038304281599044e0,
+    -5.8012039600105847814672114227e0, 3.1116436695781989440891606237e-1,
+    -1.52160949662516078556178806805e-1, 2.01365400804030348374776537501e-1,
+    4.47106157277725905176885569043e-2,
+];
+
+/// B minus the 3rd-order weights (nonzero at stages 1, 9, 12).
+const BHH: [f64; 3] = [
+    0.244094488188976377952755905512e+00,
+    0.733846688281611857341361741547e+00,
+    0.220588235294117647058823529412e-01,
+];
+
+/// The 5th-order error weights.
+#[rustfmt::skip]
+const ER: [f64; 12] = [
+    0.1312004499419488073250102996e-01, 0.0, 0.0, 0.0, 0.0,
+    -0.1225156446376204440720569753e+01, -0.4957589496572501915214079952e+00,
+    0.1664377182454986536961530415e+01, -0.3503288487499736816886487290e+00,
+    0.3341791187130174790297318841e+00, 0.8192320648511571246570742613e-01,
+    -0.2235530786388629525884427845e-01,
+];
+
+/// A DOP853 integrator with its stage storage, reusable across calls so that
+/// Newton iterations allocate nothing.
+#[derive(Debug, Clone)]
+pub struct Dop853 {
+    k: Vec<Vec<f64>>,
+    stage: Vec<f64>,
+    next: Vec<f64>,
+}
+
+impl Dop853 {
+    /// Storage for systems of dimension `n`.
+    pub fn new(n: usize) -> Self {
+        Dop853 {
+            k: vec![vec![0.0; n]; 12],
+            stage: vec![0.0; n],
+            next: vec![0.0; n],
+        }
+    }
+
+    fn resize(&mut self, n: usize) {
+        if self.stage.len() != n {
+            *self = Dop853::new(n);
+        }
+    }
+
+    /// Integrates y' = f(s, y) from `s0` to `s1` (s1 > s0) in place.
+    ///
+    /// Step size control uses the first `controlled` components. Steps land
+    /// exactly on every point of `stops` (sorted, inside [s0, s1]), where
+    /// `observe(s, y)` is called; `project` runs after every accepted step.
+    #[allow(clippy::too_many_arguments)]
+    pub fn integrate<F, O, P>(
+        &mut self,
+        mut f: F,
+        s0: f64,
+        s1: f64,
+        y: &mut [f64],
+        controlled: usize,
+        tol: &Tolerances,
+        stops: &[f64],
+        mut observe: O,
+        mut project: P,
+    ) -> Result<IntegrationStats, IntegrationError>
+    where
+        F: FnMut(f64, &[f64], &mut [f64]),
+        O: FnMut(f64, &[f64]),
+        P: FnMut(&mut [f64]),
+    {
+        let n = y.len();
+        self.resize(n);
+        let mut stats = IntegrationStats::default();
+        let mut s = s0;
+        let mut next_stop = stops.partition_point(|&t| t < s0);
+        while next_stop < stops.len() && stops[next_stop] <= s0 {
+            observe(s0, y);
+            next_stop += 1;
+        }
+        f(s, y, &mut self.k[0]);
+        stats.evaluations += 1;
+        let mut h = self.initial_step(&mut f, s, s1, y, controlled, tol);
+        stats.evaluations += 1;
+        let mut rejected_last = false;
+        while s < s1 {
+            if stats.accepted + stats.rejected >= tol.max_steps {
+                return Err(IntegrationError::TooManySteps {
+                    s,
+                    steps: tol.max_steps,
+                });
+            }
+            let target = stops.get(next_stop).copied().unwrap_or(s1).min(s1);
+            let lands = s + h >= target - 1e-14 * target.abs().max(1.0);
+            let step = if lands { target - s } else { h };
+            if step.abs() <= 10.0 * f64::EPSILON * s.abs().max(1.0) && !lands {
+                return Err(IntegrationError::StepSizeUnderflow { s });
+            }
+            self.stages(&mut f, s, step, y);
+            stats.evaluations += 11;
+            let err = self.error_norm(step, y, controlled, tol);
+            if !err.is_finite() {
+                if step < 1e-3 * (s1 - s0) * f64::EPSILON.sqrt() {
+                    return Err(IntegrationError::NotFinite { s });
+                }
+                h = step * 0.1;
+                stats.rejected += 1;
+                rejected_last = true;
+                continue;
+            }
+            let factor = (0.9 * err.powf(-1.0 / 8.0)).clamp(0.333, 6.0);
+            if err <= 1.0 {
+                stats.accepted += 1;
+                s = if lands { target } else { s + step };
+                y.copy_from_slice(&self.next);
+                project(y);
+                if y.iter().any(|v| !v.is_finite()) {
+                    return Err(IntegrationError::NotFinite { s });
+                }
+                f(s, y, &mut self.k[0]);
+                stats.evaluations += 1;
+                if lands && next_stop < stops.len() && target == stops[next_stop] {
+                    observe(s, y);
+                    next_stop += 1;
+                }
+                let grow = if rejected_last { factor.min(1.0) } else { factor };
+                // A step shortened to land on a stop says nothing against h.
+                h = if lands && step < h { h.max(step * grow) } else { step * grow };
+                rejected_last = false;
+            } else {
+                stats.rejected += 1;
+                h = step * factor.min(1.0);
+                rejected_last = true;
+            }
+        }
+        Ok(stats)
+    }
+
+    /// Hairer's starting step (II.4, "automatic selection of the initial
+    /// step size"), with k[0] = f(s, y) already evaluated.
+    fn initial_step<F: FnMut(f64, &[f64], &mut [f64])>(
+        &mut self,
+        f: &mut F,
+        s: f64,
+        s1: f64,
+        y: &[f64],
+        controlled: usize,
+        tol: &Tolerances,
+    ) -> f64 {
+        let scale = |v: f64| tol.atol + tol.rtol * v.abs();
+        let rms = |a: &dyn Fn(usize) -> f64| {
+            ((0..controlled).map(|i| a(i).powi(2)).sum::<f64>() / controlled.max(1) as f64).sqrt()
+        };
+        let d0 = rms(&|i| y[i] / scale(y[i]));
+        let d1 = rms(&|i| self.k[0][i] / scale(y[i]));
+        let span = s1 - s;
+        let h0 = if d0 < 1e-5 || d1 < 1e-5 {
+            1e-6 * span
+        } else {
+            (0.01 * d0 / d1).min(span)
+        };
+        for (i, st) in self.stage.iter_mut().enumerate() {
+            *st = y[i] + h0 * self.k[0][i];
+        }
+        let (k0, rest) = self.k.split_at_mut(1);
+        f(s + h0, &self.stage, &mut rest[0]);
+        let d2 = rms(&|i| (rest[0][i] - k0[0][i]) / scale(y[i])) / h0;
+        let h1 = if d1.max(d2) <= 1e-15 {
+            (h0 * 1e-3).max(1e-6 * span)
+        } else {
+            (0.01 / d1.max(d2)).powf(1.0 / 8.0)
+        };
+        (100.0 * h0).min(h1).min(span)
+    }
+
+    /// The 12 stages of one step of size h from (s, y); the 8th-order result
+    /// goes to `next`. Stage 1 (k[0]) is f(s, y) from the previous step.
+    fn stages<F: FnMut(f64, &[f64], &mut [f64])>(&mut self, f: &mut F, s: f64, h: f64, y: &[f64]) {
+        for j in 1..12 {
+            for i in 0..y.len() {
+                let mut acc = 0.0;
+                for (l, a) in A[j][..j].iter().enumerate() {
+                    if *a != 0.0 {
+                        acc += a * self.k[l][i];
+                    }
+                }
+                self.stage[i] = y[i] + h * acc;
+            }
+            let (_, rest) = self.k.split_at_mut(j);
+            f(s + C[j] * h, &self.stage, &mut rest[0]);
+        }
+        for i in 0..y.len() {
+            let mut acc = 0.0;
+            for (l, b) in B.iter().enumerate() {
+                if *b != 0.0 {
+                    acc += b * self.k[l][i];
+                }
+            }
+            self.next[i] = y[i] + h * acc;
+        }
+    }
+
+    /// Hairer's combined error norm of DOP853: the 5th-order estimate,
+    /// corrected by the 3rd-order one so that it behaves like an 8th-order
+    /// error (dop853.f, "error estimation").
+    fn error_norm(&self, h: f64, y: &[f64], controlled: usize, tol: &Tolerances) -> f64 {
+        let (mut err5, mut err3) = (0.0, 0.0);
+        for i in 0..controlled {
+            let sk = tol.atol + tol.rtol * y[i].abs().max(self.next[i].abs());
+            let bsum: f64 = B.iter().enumerate().map(|(l, b)| b * self.k[l][i]).sum();
+            let e3 = bsum - BHH[0] * self.k[0][i] - BHH[1] * self.k[8][i] - BHH[2] * self.k[11][i];
+            let e5: f64 = ER.iter().enumerate().map(|(l, e)| e * self.k[l][i]).sum();
+            err3 += (e3 / sk).powi(2);
+            err5 += (e5 / sk).powi(2);
+        }
+        let mut deno = err5 + 0.01 * err3;
+        if deno <= 0.0 {
+            deno = 1.0;
+        }
+        h.abs() * err5 * (1.0 / (controlled as f64 * deno)).sqrt()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// y'' = −y: y(2π) = y(0) exactly, and the error shrinks with tolerance.
+    #[test]
+    fn harmonic_oscillator_period() {
+        let mut dop = Dop853::new(2);
+        for (tol, bound) in [(1e-6, 1e-4), (1e-10, 1e-8), (1e-13, 1e-11)] {
+            let mut y = [1.0, 0.0];
+            let t = Tolerances {
+                rtol: tol,
+                atol: tol,
+                max_steps: 10_000,
+            };
+            let tau = std::f64::consts::TAU;
+            let rhs = |_: f64, y: &[f64], d: &mut [f64]| {
+                d[0] = y[1];
+                d[1] = -y[0];
+            };
+            dop.integrate(rhs, 0.0, tau, &mut y, 2, &t, &[], |_, _| {}, |_| {})
+                .unwrap();
+            let err = ((y[0] - 1.0).powi(2) + y[1].powi(2)).sqrt();
+            assert!(err < bound, "tol {tol}: error {err}");
+        }
+    }
+
+    /// A single fixed step of size h on y' = y has error O(h⁹): halving h
+    /// divides it by about 2⁹ (the method is of order 8).
+    #[test]
+    fn one_step_error_has_order_nine() {
+        let mut dop = Dop853::new(1);
+        let mut one_step = |h: f64| {
+            let mut f = |_: f64, y: &[f64], d: &mut [f64]| d[0] = y[0];
+            f(0.0, &[1.0], &mut dop.k[0]);
+            dop.stages(&mut f, 0.0, h, &[1.0]);
+            (dop.next[0] - h.exp()).abs()
+        };
+        let (e1, e2) = (one_step(0.4), one_step(0.2));
+        let order = (e1 / e2).log2();
+        assert!((order - 9.0).abs() < 0.5, "local order {order}");
+    }
+
+    #[test]
+    fn stops_are_hit_exactly() {
+        let mut dop = Dop853::new(1);
+        let mut seen = vec![];
+        let mut y = [0.0];
+        dop.integrate(
+            |_, _, d: &mut [f64]| d[0] = 1.0,
+            0.0,
+            1.0,
+            &mut y,
+            1,
+            &Tolerances::default(),
+            &[0.0, 0.25, 0.5, 1.0],
+            |s, y| seen.push((s, y[0])),
+            |_| {},
+        )
+        .unwrap();
+        assert_eq!(seen.len(), 4);
+        for (s, y) in seen {
+            assert!((s - y).abs() < 1e-14);
+        }
+    }
+
+    #[test]
+    fn blow_up_is_reported() {
+        let mut dop = Dop853::new(1);
+        let mut y = [1.0];
+        let r = dop.integrate(
+            |_, y: &[f64], d: &mut [f64]| d[0] = y[0] * y[0],
+            0.0,
+            2.0,
+            &mut y,
+            1,
+            &Tolerances::default(),
+            &[],
+            |_, _| {},
+            |_| {},
+        );
+        assert!(r.is_err(), "y' = y² blows up at s = 1: {r:?}");
+    }
+}

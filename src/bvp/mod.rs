@@ -1,0 +1,349 @@
+//! Equilibria: the boundary value problem of a clamped rod solved by single
+//! or multiple shooting with a damped Newton method, falling back to a load
+//! ramp (natural-parameter homotopy from the unloaded rod) when the loads
+//! are too large for a direct start.
+//!
+//! `solve` is the one entry point: problem (a [`Rod`] and its
+//! [`ModelChoice`]), algorithm ([`Method`] in [`SolverOptions`]), result
+//! ([`Equilibrium`]) — the problem / algorithm / solve split of
+//! DifferentialEquations.jl.
+
+pub mod integrator;
+pub mod newton;
+mod shooting;
+
+use std::time::Instant;
+
+use crate::equations::{KirchhoffEquations, PlanarEquations, RodEquations, RodSample};
+use crate::model::{ModelChoice, ModelLevel, Rod};
+use integrator::{IntegrationStats, Tolerances};
+use newton::{NewtonFailure, NewtonOptions};
+pub use shooting::ShootingSystem;
+
+
+/// How the BVP is discretized.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Method {
+    /// Single shooting on the curvature at the clamp.
+    Shooting,
+    /// Multiple shooting on `segments` equal segments.
+    MultipleShooting { segments: usize },
+}
+
+impl Method {
+    /// The name used on the command line and in output files.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Method::Shooting => "shooting",
+            Method::MultipleShooting { .. } => "multiple-shooting",
+        }
+    }
+
+    fn segments(&self) -> usize {
+        match *self {
+            Method::Shooting => 1,
+            Method::MultipleShooting { segments } => segments.max(1),
+        }
+    }
+}
+
+/// Everything that controls a solve.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SolverOptions {
+    /// The discretization.
+    pub method: Method,
+    /// Newton's tolerance and budget; the residual is scaled by the rod's
+    /// moment scale (and matching conditions by L, 1/L), so it is relative.
+    pub newton: NewtonOptions,
+    /// The integrator's tolerances.
+    pub integration: Tolerances,
+    /// Number of equally spaced output points along the rod (≥ 2).
+    pub output_points: usize,
+    /// A guess of the curvature at the clamp; the straight-rod balance when
+    /// absent.
+    pub initial_guess: Option<Vec<f64>>,
+    /// How the loads are applied.
+    pub strategy: Strategy,
+}
+
+/// How the loads are applied: all at once from the linear guess, or ramped
+/// up from the unloaded rod so that Newton follows the branch that loading
+/// the real rod follows (a direct start at a large load may converge to
+/// another, looped equilibrium).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Strategy {
+    /// Ramp when the loads' moment exceeds the stiffness moment B_min/L;
+    /// otherwise direct, ramping only if the direct solve fails.
+    Auto,
+    /// All loads at once; fail if Newton fails.
+    Direct,
+    /// Always ramp from the unloaded rod.
+    Ramp,
+}
+
+impl Strategy {
+    /// The name used in problem files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Strategy::Auto => "auto",
+            Strategy::Direct => "direct",
+            Strategy::Ramp => "ramp",
+        }
+    }
+}
+
+impl Default for SolverOptions {
+    fn default() -> Self {
+        SolverOptions {
+            method: Method::Shooting,
+            newton: NewtonOptions::default(),
+            integration: Tolerances::default(),
+            output_points: 201,
+            initial_guess: None,
+            strategy: Strategy::Auto,
+        }
+    }
+}
+
+/// A converged equilibrium.
+#[derive(Debug, Clone)]
+pub struct Equilibrium {
+    /// The model level used and why.
+    pub model: ModelChoice,
+    /// The method used.
+    pub method: Method,
+    /// The solution at the output points.
+    pub samples: Vec<RodSample>,
+    /// The free initial values at the solution (κ(0) components).
+    pub clamp_curvature: Vec<f64>,
+    /// Newton steps of the final solve.
+    pub iterations: usize,
+    /// Scaled residual (max-norm) at every Newton iterate of the final solve.
+    pub residual_history: Vec<f64>,
+    /// The final scaled residual.
+    pub residual: f64,
+    /// Load-ramp steps used (0 when the direct solve converged).
+    pub load_steps: usize,
+    /// Largest |d_i·d_j − δ_ij| over the output points.
+    pub director_drift: f64,
+    /// Integration work over all Newton iterations.
+    pub integration: IntegrationStats,
+    /// Wall time of the solve (s).
+    pub wall_time: f64,
+}
+
+impl Equilibrium {
+    /// The sample at the tip, s = L.
+    pub fn tip(&self) -> &RodSample {
+        self.samples.last().expect("an equilibrium has at least two samples")
+    }
+}
+
+/// Why no equilibrium was returned.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SolveError {
+    /// Newton did not converge.
+    #[error("{method} did not converge: {failure}; scaled residual history {history}")]
+    NoConvergence {
+        method: &'static str,
+        failure: NewtonFailure,
+        history: String,
+    },
+    /// The load ramp stalled.
+    #[error("{method} with a load ramp stalled at load factor {reached:.4} (step {step:.2e}): {last}")]
+    RampStalled {
+        method: &'static str,
+        reached: f64,
+        step: f64,
+        last: String,
+    },
+    /// The converged solution could not be re-integrated for output.
+    #[error("sampling the converged solution failed: {0}")]
+    Sampling(integrator::IntegrationError),
+    /// Options that cannot work.
+    #[error("invalid solver options: {0}")]
+    Options(String),
+}
+
+/// The equations of a rod at a model level.
+pub fn equations(rod: &Rod, level: ModelLevel) -> Box<dyn RodEquations> {
+    match level {
+        ModelLevel::Planar => Box::new(PlanarEquations::new(rod.clone())),
+        ModelLevel::Kirchhoff => Box::new(KirchhoffEquations::new(rod.clone())),
+    }
+}
+
+/// Solves for the equilibrium of `rod` with the level in `model`.
+pub fn solve(
+    rod: &Rod,
+    model: &ModelChoice,
+    opts: &SolverOptions,
+) -> Result<Equilibrium, SolveError> {
+    if opts.output_points < 2 {
+        return Err(SolveError::Options("output_points must be at least 2".into()));
+    }
+    let start = Instant::now();
+    let mut stats = IntegrationStats::default();
+    let ramp_first = match opts.strategy {
+        Strategy::Direct => false,
+        Strategy::Ramp => true,
+        Strategy::Auto => load_ratio(rod) > 1.0,
+    };
+    let (x, report, load_steps) = if ramp_first {
+        ramp(rod, model.level, opts, &mut stats, None)?
+    } else {
+        match solve_at(rod, model.level, opts, None, &mut stats) {
+            Ok((x, report)) => (x, report, 0),
+            Err(e) if opts.strategy == Strategy::Auto => {
+                ramp(rod, model.level, opts, &mut stats, Some(e))?
+            }
+            Err(e) => return Err(e),
+        }
+    };
+    let eq = equations(rod, model.level);
+    let mut sys = ShootingSystem::new(eq.as_ref(), opts.method.segments(), opts.integration);
+    let points = output_grid(rod.length, opts.output_points);
+    let (samples, drift) = sys.sample(&x, &points).map_err(SolveError::Sampling)?;
+    stats += sys.stats;
+    Ok(Equilibrium {
+        model: model.clone(),
+        method: opts.method,
+        samples,
+        clamp_curvature: sys.free_values(&x).to_vec(),
+        iterations: report.iterations,
+        residual: *report.history.last().unwrap_or(&f64::NAN),
+        residual_history: report.history,
+        load_steps,
+        director_drift: drift,
+        integration: stats,
+        wall_time: start.elapsed().as_secs_f64(),
+    })
+}
+
+/// `n` equally spaced points on [0, L], the last exactly L.
+fn output_grid(length: f64, n: usize) -> Vec<f64> {
+    (0..n)
+        .map(|i| if i + 1 == n { length } else { length * i as f64 / (n - 1) as f64 })
+        .collect()
+}
+
+/// One Newton solve from a warm start `x0` (full unknown vector) or from the
+/// guess in the options.
+fn solve_at(
+    rod: &Rod,
+    level: ModelLevel,
+    opts: &SolverOptions,
+    x0: Option<&[f64]>,
+    stats: &mut IntegrationStats,
+) -> Result<(Vec<f64>, newton::NewtonReport), SolveError> {
+    let eq = equations(rod, level);
+    let mut sys = ShootingSystem::new(eq.as_ref(), opts.method.segments(), opts.integration);
+    let x0 = match x0 {
+        Some(x) => x.to_vec(),
+        None => {
+            let u = match &opts.initial_guess {
+                Some(g) => guess_for_level(g, eq.as_ref(), level)?,
+                None => eq.initial_guess(),
+            };
+            sys.initial_unknowns(&u)
+        }
+    };
+    let outcome = newton::solve(&mut sys, &x0, &opts.newton);
+    *stats += sys.stats;
+    match outcome {
+        Ok(report) => Ok((report.x.clone(), report)),
+        Err(failure) => Err(SolveError::NoConvergence {
+            method: opts.method.name(),
+            history: format_history(failure.history()),
+            failure,
+        }),
+    }
+}
+
+/// A user's κ(0) guess (three body components) for the level's unknowns.
+fn guess_for_level(
+    g: &[f64],
+    eq: &dyn RodEquations,
+    level: ModelLevel,
+) -> Result<Vec<f64>, SolveError> {
+    if g.len() != 3 {
+        return Err(SolveError::Options("initial_curvature needs three components".into()));
+    }
+    Ok(match level {
+        ModelLevel::Planar => vec![g[1]],
+        ModelLevel::Kirchhoff => {
+            debug_assert_eq!(eq.unknowns(), 3);
+            g.to_vec()
+        }
+    })
+}
+
+/// The loads' moment over the stiffness moment B_min/L: the size of the
+/// deflection in radians that linear theory predicts.
+fn load_ratio(rod: &Rod) -> f64 {
+    let h = rod.energy.stiffness(0.0, &nalgebra::Vector3::zeros());
+    let b_min = h.symmetric_eigenvalues().min();
+    rod.loads.moment_scale(rod.length) * rod.length / b_min
+}
+
+/// Natural-parameter continuation in a load factor λ from 0 to 1, each step
+/// warm-started from the last. A step counts only when Newton converges
+/// cleanly (no damping, at most `RAMP_ITERATIONS` steps, contraction
+/// Θ ≤ 1/4 as in Deuflhard's continuation step control), so that the ramp
+/// does not jump to another branch; the step halves otherwise and grows after
+/// a success.
+fn ramp(
+    rod: &Rod,
+    level: ModelLevel,
+    opts: &SolverOptions,
+    stats: &mut IntegrationStats,
+    first_error: Option<SolveError>,
+) -> Result<(Vec<f64>, newton::NewtonReport, usize), SolveError> {
+    const RAMP_ITERATIONS: usize = 8;
+    const RAMP_CONTRACTION: f64 = 0.25;
+    let (mut lambda, mut step): (f64, f64) = (0.0, 0.25);
+    let mut x: Option<Vec<f64>> = None;
+    let mut last_error = first_error;
+    let mut steps = 0;
+    let step_opts = SolverOptions {
+        initial_guess: None,
+        newton: NewtonOptions {
+            max_iterations: opts.newton.max_iterations.min(RAMP_ITERATIONS),
+            ..opts.newton
+        },
+        ..opts.clone()
+    };
+    while step >= 1e-4 && steps < 400 {
+        let target = (lambda + step).min(1.0);
+        let scaled = rod.with_load_factor(target);
+        match solve_at(&scaled, level, &step_opts, x.as_deref(), stats) {
+            Ok((xn, report))
+                if report.damped_steps == 0 && report.contraction <= RAMP_CONTRACTION =>
+            {
+                steps += 1;
+                lambda = target;
+                x = Some(xn.clone());
+                if lambda >= 1.0 {
+                    return Ok((xn, report, steps));
+                }
+                step = (step * 1.5).min(0.5);
+            }
+            Ok(_) => step *= 0.5,
+            Err(e) => {
+                last_error = Some(e);
+                step *= 0.5;
+            }
+        }
+    }
+    Err(SolveError::RampStalled {
+        method: opts.method.name(),
+        reached: lambda,
+        step,
+        last: last_error.map_or_else(|| "step too small".to_string(), |e| e.to_string()),
+    })
+}
+
+fn format_history(h: &[f64]) -> String {
+    let items: Vec<String> = h.iter().map(|v| format!("{v:.2e}")).collect();
+    format!("[{}]", items.join(", "))
+}

@@ -1,0 +1,264 @@
+//! Shooting: single (one segment) and multiple (K segments) in one
+//! formulation.
+//!
+//! Unknowns: the free initial values u (the curvature at the clamp) and the
+//! full state y_j at the interior nodes s_j = jL/K. Residuals: the matching
+//! conditions Y_j(s_{j+1}; y_j) − y_{j+1} and the tip conditions g(Y(L)).
+//! The Jacobian comes from the variational equations integrated on the same
+//! steps as the state (exact derivative of the discrete flow), never from
+//! finite differences. With K = 1 this is single shooting; with K > 1 the
+//! products of segment sensitivities that make single shooting ill
+//! conditioned on long, soft or heavily loaded rods are never formed.
+
+use nalgebra::{DMatrix, DVector};
+
+use super::integrator::{Dop853, IntegrationError, IntegrationStats, Tolerances};
+use super::newton::NonlinearSystem;
+use crate::equations::{RodEquations, RodSample};
+
+/// The shooting formulation of a rod BVP on K segments.
+pub struct ShootingSystem<'a> {
+    eq: &'a dyn RodEquations,
+    segments: usize,
+    tol: Tolerances,
+    dop: Dop853,
+    scales: Vec<f64>,
+    moment_scale: f64,
+    /// Integration work so far.
+    pub stats: IntegrationStats,
+}
+
+impl<'a> ShootingSystem<'a> {
+    /// K ≥ 1 segments of equal length.
+    pub fn new(eq: &'a dyn RodEquations, segments: usize, tol: Tolerances) -> Self {
+        let l = eq.length();
+        let scales = eq
+            .straight_state(l)
+            .iter()
+            .enumerate()
+            .map(|(i, _)| state_scale(eq, i))
+            .collect();
+        ShootingSystem {
+            eq,
+            segments: segments.max(1),
+            tol,
+            dop: Dop853::new(eq.dim()),
+            scales,
+            moment_scale: eq.moment_scale(),
+            stats: IntegrationStats::default(),
+        }
+    }
+
+    fn node(&self, j: usize) -> f64 {
+        if j == self.segments {
+            self.eq.length()
+        } else {
+            self.eq.length() * j as f64 / self.segments as f64
+        }
+    }
+
+    /// The state at node j (j = 0 from u) taken from the unknown vector.
+    fn node_state(&self, x: &[f64], j: usize) -> Vec<f64> {
+        let (n, p) = (self.eq.dim(), self.eq.unknowns());
+        if j == 0 {
+            let mut y0 = vec![0.0; n];
+            self.eq.initial_state(&x[..p], &mut y0);
+            y0
+        } else {
+            x[p + n * (j - 1)..p + n * j].to_vec()
+        }
+    }
+
+    /// Integrates segment j from `start` with `cols` sensitivity columns
+    /// initialised to `phi0` (dim × cols); returns the end state and Φ.
+    fn segment(
+        &mut self,
+        j: usize,
+        start: &[f64],
+        phi0: &DMatrix<f64>,
+    ) -> Result<(Vec<f64>, DMatrix<f64>), IntegrationError> {
+        let n = self.eq.dim();
+        let cols = phi0.ncols();
+        let mut y = Vec::with_capacity(n * (cols + 1));
+        y.extend_from_slice(start);
+        y.extend_from_slice(phi0.as_slice());
+        let eq = self.eq;
+        let rhs = |s: f64, y: &[f64], d: &mut [f64]| {
+            let (dy, dphi) = d.split_at_mut(n);
+            eq.rhs_linearized(s, &y[..n], cols, &y[n..], dy, dphi);
+        };
+        let (a, b) = (self.node(j), self.node(j + 1));
+        let stats = self.dop.integrate(
+            rhs,
+            a,
+            b,
+            &mut y,
+            n,
+            &self.tol,
+            &[],
+            |_, _| {},
+            |y| {
+                // Interior nodes are free unknowns off the orthonormal
+                // manifold during Newton: projecting there would make Φ
+                // inconsistent with the flow. The exact flow preserves
+                // d_i·d_j, so nothing drifts that the clamp did not set.
+                if j == 0 {
+                    eq.project(&mut y[..n])
+                }
+            },
+        )?;
+        self.stats += stats;
+        let phi = DMatrix::from_column_slice(n, cols, &y[n..]);
+        y.truncate(n);
+        Ok((y, phi))
+    }
+
+    /// A starting vector of unknowns from free values u: the interior nodes
+    /// are filled by integrating from u, and by the straight rod beyond a
+    /// blow-up.
+    pub fn initial_unknowns(&mut self, u: &[f64]) -> Vec<f64> {
+        let (n, p) = (self.eq.dim(), self.eq.unknowns());
+        let mut x = u.to_vec();
+        let mut y = vec![0.0; n];
+        self.eq.initial_state(u, &mut y);
+        let mut alive = true;
+        for j in 1..self.segments {
+            if alive {
+                let eq = self.eq;
+                let out = self.dop.integrate(
+                    |s, y: &[f64], d: &mut [f64]| eq.rhs(s, y, d),
+                    self.node(j - 1),
+                    self.node(j),
+                    &mut y,
+                    n,
+                    &self.tol,
+                    &[],
+                    |_, _| {},
+                    |y| eq.project(y),
+                );
+                alive = out.is_ok();
+            }
+            if !alive {
+                y = self.eq.straight_state(self.node(j));
+            }
+            x.extend_from_slice(&y);
+        }
+        debug_assert_eq!(x.len(), p + n * (self.segments - 1));
+        x
+    }
+
+    /// The free values u in the unknown vector.
+    pub fn free_values<'x>(&self, x: &'x [f64]) -> &'x [f64] {
+        &x[..self.eq.unknowns()]
+    }
+
+    /// Samples the solution at `points` (sorted, in [0, L]) and measures the
+    /// largest departure of the directors from orthonormality.
+    pub fn sample(
+        &mut self,
+        x: &[f64],
+        points: &[f64],
+    ) -> Result<(Vec<RodSample>, f64), IntegrationError> {
+        let n = self.eq.dim();
+        let mut samples = Vec::with_capacity(points.len());
+        for j in 0..self.segments {
+            let (a, b) = (self.node(j), self.node(j + 1));
+            let last = j + 1 == self.segments;
+            let stops: Vec<f64> = points
+                .iter()
+                .copied()
+                .filter(|&s| s >= a && (s < b || (last && s <= b)))
+                .collect();
+            let mut y = self.node_state(x, j);
+            let eq = self.eq;
+            let stats = self.dop.integrate(
+                |s, y: &[f64], d: &mut [f64]| eq.rhs(s, y, d),
+                a,
+                b,
+                &mut y,
+                n,
+                &self.tol,
+                &stops,
+                |s, y| samples.push(eq.sample(s, y)),
+                |y| eq.project(y),
+            )?;
+            self.stats += stats;
+        }
+        let drift = samples.iter().map(director_drift).fold(0.0, f64::max);
+        Ok((samples, drift))
+    }
+}
+
+/// max |d_i·d_j − δ_ij| at one sample.
+fn director_drift(p: &RodSample) -> f64 {
+    let mut worst: f64 = 0.0;
+    for i in 0..3 {
+        for j in 0..3 {
+            let delta = if i == j { 1.0 } else { 0.0 };
+            worst = worst.max((p.directors[i].dot(&p.directors[j]) - delta).abs());
+        }
+    }
+    worst
+}
+
+/// A typical magnitude of state component i, to make matching residuals
+/// dimensionless: lengths by L, curvatures by 1/L, angles and directors by 1.
+fn state_scale(eq: &dyn RodEquations, i: usize) -> f64 {
+    let l = eq.length();
+    match (eq.dim(), i) {
+        (4, 0 | 1) => l,
+        (4, 3) => 1.0 / l,
+        (12, 6..=8) => 1.0 / l,
+        (12, 9..=11) => l,
+        _ => 1.0,
+    }
+}
+
+impl NonlinearSystem for ShootingSystem<'_> {
+    fn size(&self) -> usize {
+        self.eq.unknowns() + self.eq.dim() * (self.segments - 1)
+    }
+
+    fn evaluate(
+        &mut self,
+        x: &[f64],
+        r: &mut DVector<f64>,
+        jac: &mut DMatrix<f64>,
+    ) -> Result<(), IntegrationError> {
+        let (n, p, k) = (self.eq.dim(), self.eq.unknowns(), self.segments);
+        jac.fill(0.0);
+        for j in 0..k {
+            let start = self.node_state(x, j);
+            let phi0 = if j == 0 {
+                self.eq.initial_sensitivity()
+            } else {
+                DMatrix::identity(n, n)
+            };
+            let (col, cols) = if j == 0 { (0, p) } else { (p + n * (j - 1), n) };
+            let (end, phi) = self.segment(j, &start, &phi0)?;
+            if j + 1 < k {
+                let next = self.node_state(x, j + 1);
+                for i in 0..n {
+                    let w = 1.0 / self.scales[i];
+                    r[n * j + i] = (end[i] - next[i]) * w;
+                    for c in 0..cols {
+                        jac[(n * j + i, col + c)] = phi[(i, c)] * w;
+                    }
+                    jac[(n * j + i, p + n * j + i)] = -w;
+                }
+            } else {
+                let mut g = vec![0.0; p];
+                self.eq.tip_residual(&end, &mut g);
+                let gj = self.eq.tip_residual_jacobian(&end) * &phi / self.moment_scale;
+                let row = n * (k - 1);
+                for i in 0..p {
+                    r[row + i] = g[i] / self.moment_scale;
+                    for c in 0..cols {
+                        jac[(row + i, col + c)] = gj[(i, c)];
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,260 @@
+//! The spatial Kirchhoff rod: the 9-ODE system in (d1, d2, κ) of the paper
+//! ((25)–(29) for the linear energy), for any stored energy, with the
+//! position r by quadrature (r' = d3).
+//!
+//! With the Darboux vector k = κ_i d_i, d_i' = k × d_i gives
+//!
+//!   d1' = κ3 d2 − κ2 d3,   d2' = κ1 d3 − κ3 d1,   (d3 = d1 × d2)
+//!
+//! and the moment balance m' + d3 × n = 0 in body components (paper
+//! (19)–(21) with n general) reads M' = M × κ + N × e3, N_i = n·d_i. Since
+//! M' = H κ' + ∂s∇W, κ' = H⁻¹ (M × κ + N × e3 − ∂s∇W).
+//!
+//! State y = (d1, d2, κ, r), 12 numbers; three unknowns κ(0); three tip
+//! conditions M_i(L) = C·d_i(L) (paper (22) with a tip couple C).
+
+use nalgebra::{DMatrix, Matrix3, Vector3};
+
+use super::planar::straight_rod_clamp_moment;
+use super::{RodEquations, RodSample};
+use crate::model::Rod;
+
+/// The 9-ODE Kirchhoff equations (12 with the position).
+#[derive(Debug, Clone)]
+pub struct KirchhoffEquations {
+    rod: Rod,
+}
+
+/// The state unpacked.
+struct State {
+    d1: Vector3<f64>,
+    d2: Vector3<f64>,
+    d3: Vector3<f64>,
+    kappa: Vector3<f64>,
+}
+
+impl State {
+    fn read(y: &[f64]) -> State {
+        let d1 = Vector3::new(y[0], y[1], y[2]);
+        let d2 = Vector3::new(y[3], y[4], y[5]);
+        State {
+            d1,
+            d2,
+            d3: d1.cross(&d2),
+            kappa: Vector3::new(y[6], y[7], y[8]),
+        }
+    }
+}
+
+/// The pieces of κ' shared by the right-hand side and its linearization.
+struct Balance {
+    /// H⁻¹ (LU-free: H is symmetric positive definite, 3 × 3).
+    h_inv: Matrix3<f64>,
+    /// H.
+    h: Matrix3<f64>,
+    /// M = ∇W.
+    m: Vector3<f64>,
+    /// κ'.
+    rate: Vector3<f64>,
+    /// n(s), global.
+    n: Vector3<f64>,
+}
+
+impl KirchhoffEquations {
+    /// The spatial equations of a rod.
+    pub fn new(rod: Rod) -> Self {
+        KirchhoffEquations { rod }
+    }
+
+    fn balance(&self, s: f64, st: &State) -> Balance {
+        let e = &self.rod.energy;
+        let h = e.stiffness(s, &st.kappa);
+        let h_inv = h.try_inverse().unwrap_or_else(|| Matrix3::from_element(f64::NAN));
+        let m = e.moment(s, &st.kappa);
+        let n = self.rod.loads.internal_force(s, self.rod.length);
+        let body_n = Vector3::new(n.dot(&st.d1), n.dot(&st.d2), 0.0);
+        let q = m.cross(&st.kappa) + body_n.cross(&Vector3::z());
+        let rate = h_inv * (q - e.moment_rate(s, &st.kappa));
+        Balance {
+            h_inv,
+            h,
+            m,
+            rate,
+            n,
+        }
+    }
+
+    fn write_rates(st: &State, rate: &Vector3<f64>, dy: &mut [f64]) {
+        let k = st.kappa;
+        let dd1 = st.d2 * k[2] - st.d3 * k[1];
+        let dd2 = st.d3 * k[0] - st.d1 * k[2];
+        dy[0..3].copy_from_slice(dd1.as_slice());
+        dy[3..6].copy_from_slice(dd2.as_slice());
+        dy[6..9].copy_from_slice(rate.as_slice());
+        dy[9..12].copy_from_slice(st.d3.as_slice());
+    }
+}
+
+impl RodEquations for KirchhoffEquations {
+    fn dim(&self) -> usize {
+        12
+    }
+
+    fn unknowns(&self) -> usize {
+        3
+    }
+
+    fn length(&self) -> f64 {
+        self.rod.length
+    }
+
+    fn initial_state(&self, u: &[f64], y0: &mut [f64]) {
+        let c = &self.rod.clamp;
+        y0[0..3].copy_from_slice(c.director(0).as_slice());
+        y0[3..6].copy_from_slice(c.director(1).as_slice());
+        y0[6..9].copy_from_slice(u);
+        y0[9..12].copy_from_slice(c.position.as_slice());
+    }
+
+    fn initial_sensitivity(&self) -> DMatrix<f64> {
+        let mut m = DMatrix::zeros(12, 3);
+        for i in 0..3 {
+            m[(6 + i, i)] = 1.0;
+        }
+        m
+    }
+
+    fn rhs(&self, s: f64, y: &[f64], dy: &mut [f64]) {
+        let st = State::read(y);
+        let b = self.balance(s, &st);
+        Self::write_rates(&st, &b.rate, dy);
+    }
+
+    /// The linearization along (δd1, δd2, δκ, δr):
+    /// δd3 = δd1 × d2 + d1 × δd2, δd1' = δκ3 d2 + κ3 δd2 − δκ2 d3 − κ2 δd3,
+    /// δd2' = δκ1 d3 + κ1 δd3 − δκ3 d1 − κ3 δd1, δr' = δd3, and
+    /// δκ' = H⁻¹ (Hδκ × κ + M × δκ + δN × e3 − ∂sH δκ − ∂κ(Hκ')δκ),
+    /// δN_i = n·δd_i.
+    fn rhs_linearized(
+        &self,
+        s: f64,
+        y: &[f64],
+        cols: usize,
+        phi: &[f64],
+        dy: &mut [f64],
+        dphi: &mut [f64],
+    ) {
+        let st = State::read(y);
+        let b = self.balance(s, &st);
+        Self::write_rates(&st, &b.rate, dy);
+        let e = &self.rod.energy;
+        let k = st.kappa;
+        let kappa_jac = e.stiffness_rate(s, &k) + e.stiffness_derivative(s, &k, &b.rate);
+        for c in 0..cols {
+            let v = &phi[12 * c..12 * c + 12];
+            let out = &mut dphi[12 * c..12 * c + 12];
+            let dd1 = Vector3::new(v[0], v[1], v[2]);
+            let dd2 = Vector3::new(v[3], v[4], v[5]);
+            let dk = Vector3::new(v[6], v[7], v[8]);
+            let dd3 = dd1.cross(&st.d2) + st.d1.cross(&dd2);
+            let r1 = st.d2 * dk[2] + dd2 * k[2] - st.d3 * dk[1] - dd3 * k[1];
+            let r2 = st.d3 * dk[0] + dd3 * k[0] - st.d1 * dk[2] - dd1 * k[2];
+            let dn = Vector3::new(b.n.dot(&dd1), b.n.dot(&dd2), 0.0);
+            let dq = (b.h * dk).cross(&k) + b.m.cross(&dk) + dn.cross(&Vector3::z());
+            let rk = b.h_inv * (dq - kappa_jac * dk);
+            out[0..3].copy_from_slice(r1.as_slice());
+            out[3..6].copy_from_slice(r2.as_slice());
+            out[6..9].copy_from_slice(rk.as_slice());
+            out[9..12].copy_from_slice(dd3.as_slice());
+        }
+    }
+
+    fn tip_residual(&self, y: &[f64], r: &mut [f64]) {
+        let st = State::read(y);
+        let m = self.rod.energy.moment(self.rod.length, &st.kappa);
+        let c = self.rod.loads.tip_couple;
+        r[0] = m[0] - c.dot(&st.d1);
+        r[1] = m[1] - c.dot(&st.d2);
+        r[2] = m[2] - c.dot(&st.d3);
+    }
+
+    /// ∂/∂κ = H(L); ∂(C·d3)/∂d1 = d2 × C, ∂(C·d3)/∂d2 = C × d1.
+    fn tip_residual_jacobian(&self, y: &[f64]) -> DMatrix<f64> {
+        let st = State::read(y);
+        let c = self.rod.loads.tip_couple;
+        let h = self.rod.energy.stiffness(self.rod.length, &st.kappa);
+        let mut g = DMatrix::zeros(3, 12);
+        for j in 0..3 {
+            g[(0, j)] = -c[j];
+            g[(1, 3 + j)] = -c[j];
+        }
+        let (a, b) = (st.d2.cross(&c), c.cross(&st.d1));
+        for j in 0..3 {
+            g[(2, j)] = -a[j];
+            g[(2, 3 + j)] = -b[j];
+            for i in 0..3 {
+                g[(i, 6 + j)] = h[(i, j)];
+            }
+        }
+        g
+    }
+
+    /// Gram–Schmidt on (d1, d2): an O(tolerance) correction after each step
+    /// that keeps the directors orthonormal to round-off without changing
+    /// the order of the method (Hairer, Lubich & Wanner, GNI IV.4).
+    fn project(&self, y: &mut [f64]) {
+        let d1 = Vector3::new(y[0], y[1], y[2]).normalize();
+        let d2 = Vector3::new(y[3], y[4], y[5]);
+        let d2 = (d2 - d1 * d1.dot(&d2)).normalize();
+        y[0..3].copy_from_slice(d1.as_slice());
+        y[3..6].copy_from_slice(d2.as_slice());
+    }
+
+    /// M(0) balancing the loads on the straight rod, in body components at
+    /// the clamp, then κ(0) from ∇W(0, κ) = M(0) by Newton from κ = 0.
+    fn initial_guess(&self) -> Vec<f64> {
+        let m = self.rod.clamp.frame.transpose() * straight_rod_clamp_moment(&self.rod);
+        let e = &self.rod.energy;
+        let mut k = Vector3::zeros();
+        for _ in 0..50 {
+            let Some(h_inv) = e.stiffness(0.0, &k).try_inverse() else {
+                break;
+            };
+            let step = h_inv * (e.moment(0.0, &k) - m);
+            k -= step;
+            if step.norm() <= 1e-14 * k.norm().max(1.0) {
+                break;
+            }
+        }
+        k.as_slice().to_vec()
+    }
+
+    fn unknowns_of(&self, y0: &[f64]) -> Vec<f64> {
+        y0[6..9].to_vec()
+    }
+
+    fn sample(&self, s: f64, y: &[f64]) -> RodSample {
+        let st = State::read(y);
+        RodSample {
+            s,
+            position: Vector3::new(y[9], y[10], y[11]),
+            directors: [st.d1, st.d2, st.d3],
+            curvature: st.kappa,
+            moment: self.rod.energy.moment(s, &st.kappa),
+            force: self.rod.loads.internal_force(s, self.rod.length),
+        }
+    }
+
+    fn straight_state(&self, s: f64) -> Vec<f64> {
+        let c = &self.rod.clamp;
+        let mut y = vec![0.0; 12];
+        self.initial_state(&[0.0; 3], &mut y);
+        let r = c.position + c.director(2) * s;
+        y[9..12].copy_from_slice(r.as_slice());
+        y
+    }
+
+    fn moment_scale(&self) -> f64 {
+        self.rod.moment_scale()
+    }
+}

@@ -1,0 +1,79 @@
+//! Right-hand sides of the equilibrium equations and their linearizations,
+//! one implementation per model level.
+//!
+//! Every level is written as a first-order system y' = f(s, y) on [0, L]
+//! whose initial state is fixed by the clamp up to `unknowns()` free values
+//! (the curvature at the clamp) and whose tip conditions are as many
+//! residuals (the natural boundary condition M(L) = tip couple, paper (22)).
+//! Shooting and the other BVP methods see only this interface.
+
+mod kirchhoff;
+mod planar;
+
+pub use kirchhoff::KirchhoffEquations;
+pub use planar::PlanarEquations;
+
+use nalgebra::{DMatrix, Vector3};
+
+/// The rod's state at one arc length, in the quantities users read.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RodSample {
+    /// Reference arc length s.
+    pub s: f64,
+    /// Centreline position r(s), global.
+    pub position: Vector3<f64>,
+    /// Directors d1, d2, d3, global components.
+    pub directors: [Vector3<f64>; 3],
+    /// Curvature κ, body components.
+    pub curvature: Vector3<f64>,
+    /// Internal moment M = ∂W/∂κ, body components.
+    pub moment: Vector3<f64>,
+    /// Internal force n(s), global components.
+    pub force: Vector3<f64>,
+}
+
+/// A two-point boundary value problem of a clamped rod in shooting form.
+pub trait RodEquations: Send + Sync {
+    /// Dimension of the state y.
+    fn dim(&self) -> usize;
+    /// Number of free initial values, equal to the number of tip conditions.
+    fn unknowns(&self) -> usize;
+    /// The rod length L (the interval is [0, L]).
+    fn length(&self) -> f64;
+    /// y(0) for the free initial values u.
+    fn initial_state(&self, u: &[f64], y0: &mut [f64]);
+    /// ∂y(0)/∂u (dim × unknowns); y(0) is affine in u.
+    fn initial_sensitivity(&self) -> DMatrix<f64>;
+    /// y' = f(s, y).
+    fn rhs(&self, s: f64, y: &[f64], dy: &mut [f64]);
+    /// f together with its linearization applied to `cols` tangent vectors
+    /// stored column-major in `phi` (dim × cols): dphi = ∂f/∂y · phi.
+    fn rhs_linearized(
+        &self,
+        s: f64,
+        y: &[f64],
+        cols: usize,
+        phi: &[f64],
+        dy: &mut [f64],
+        dphi: &mut [f64],
+    );
+    /// The tip residuals g(y(L)).
+    fn tip_residual(&self, y: &[f64], r: &mut [f64]);
+    /// ∂g/∂y at y(L) (unknowns × dim).
+    fn tip_residual_jacobian(&self, y: &[f64]) -> DMatrix<f64>;
+    /// Restores invariants of y after an integration step (orthonormal
+    /// directors); the identity where there are none.
+    fn project(&self, y: &mut [f64]);
+    /// A starting guess of the free values: the curvature at the clamp that
+    /// balances the loads on the unloaded, straight rod.
+    fn initial_guess(&self) -> Vec<f64>;
+    /// The free values read back from a state at s = 0.
+    fn unknowns_of(&self, y0: &[f64]) -> Vec<f64>;
+    /// The state in user quantities.
+    fn sample(&self, s: f64, y: &[f64]) -> RodSample;
+    /// A state of the unloaded, straight rod at s: used where no better guess
+    /// is available (multiple-shooting nodes after a blow-up).
+    fn straight_state(&self, s: f64) -> Vec<f64>;
+    /// A moment scale (N·m) that makes residuals dimensionless.
+    fn moment_scale(&self) -> f64;
+}

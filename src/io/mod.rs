@@ -1,0 +1,8 @@
+//! Problem files in, results out: TOML problem files (serde), HDF5 results
+//! (the HDF5 C library through hdf5-metno).
+
+mod hdf5_output;
+mod problem;
+
+pub use hdf5_output::{check_target, write_equilibrium, OutputError};
+pub use problem::{Problem, ProblemError, ProblemFile, ProfileSpec};

@@ -1,0 +1,560 @@
+//! Problem files: a TOML description of a rod scene and how to solve it.
+//!
+//! Every table rejects unknown keys; syntax errors carry line and column;
+//! physical validation names the offending field. `--set key=value`
+//! overrides are applied to the parsed document before it is read, so they
+//! go through exactly the same checks. The reference of every key is in
+//! docs/problem-files.md.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use nalgebra::Vector3;
+use serde::de::{self, MapAccess, Visitor};
+use serde::{Deserialize, Deserializer, Serialize};
+
+use crate::bvp::integrator::Tolerances;
+use crate::bvp::newton::NewtonOptions;
+use crate::bvp::{Method, SolverOptions, Strategy};
+use crate::model::{
+    Clamp, DeadLoads, LinearElastic, ModelChoice, ModelLevel, Profile, QuarticStiffening, Rod,
+    StoredEnergy,
+};
+
+/// Why a problem could not be read.
+#[derive(Debug, thiserror::Error)]
+pub enum ProblemError {
+    /// The file could not be read.
+    #[error("cannot read {path}: {source}")]
+    Read {
+        path: String,
+        source: std::io::Error,
+    },
+    /// TOML syntax, an unknown or missing key, or a wrong type.
+    #[error("{0}")]
+    Parse(String),
+    /// A `--set` override that cannot be applied.
+    #[error("--set {assignment}: {message}")]
+    Override { assignment: String, message: String },
+    /// A value that is well-formed but not physical or not consistent.
+    #[error("{field}: {message}")]
+    Invalid { field: String, message: String },
+}
+
+fn invalid(field: impl Into<String>, message: impl Into<String>) -> ProblemError {
+    ProblemError::Invalid {
+        field: field.into(),
+        message: message.into(),
+    }
+}
+
+/// A problem file as written.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ProblemFile {
+    /// The rod's geometry.
+    pub rod: RodSection,
+    /// The stored energy.
+    pub energy: EnergySection,
+    /// The clamp at s = 0.
+    #[serde(default)]
+    pub clamp: ClampSection,
+    /// Dead loads.
+    #[serde(default)]
+    pub loads: LoadSection,
+    /// How to solve.
+    #[serde(default)]
+    pub solver: SolverSection,
+}
+
+/// `[rod]`.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct RodSection {
+    /// Reference length L (m).
+    pub length: f64,
+}
+
+/// `[energy]`.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct EnergySection {
+    /// "linear" or "quartic".
+    #[serde(default = "default_energy_kind")]
+    pub kind: String,
+    /// B1, B2, B3 (N·m²), each a profile.
+    pub stiffness: [ProfileSpec; 3],
+    /// κ⁰ body components (1/m), each a profile.
+    #[serde(default)]
+    pub intrinsic_curvature: [ProfileSpec; 3],
+    /// C (N·m⁴) of the quartic energy.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub quartic: Option<f64>,
+}
+
+fn default_energy_kind() -> String {
+    "linear".into()
+}
+
+/// A profile of s as written: a number, `{ polynomial = [...] }` or
+/// `{ s = [...], values = [...] }`.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+#[serde(untagged)]
+pub enum ProfileSpec {
+    /// A constant.
+    Constant(f64),
+    /// Polynomial coefficients in increasing powers of s.
+    Polynomial { polynomial: Vec<f64> },
+    /// A piecewise-linear table.
+    Table { s: Vec<f64>, values: Vec<f64> },
+}
+
+impl Default for ProfileSpec {
+    fn default() -> Self {
+        ProfileSpec::Constant(0.0)
+    }
+}
+
+impl<'de> Deserialize<'de> for ProfileSpec {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct ProfileVisitor;
+        impl<'de> Visitor<'de> for ProfileVisitor {
+            type Value = ProfileSpec;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str(
+                    "a number, { polynomial = [c0, c1, ...] } or { s = [...], values = [...] }",
+                )
+            }
+            fn visit_f64<E: de::Error>(self, v: f64) -> Result<ProfileSpec, E> {
+                Ok(ProfileSpec::Constant(v))
+            }
+            fn visit_i64<E: de::Error>(self, v: i64) -> Result<ProfileSpec, E> {
+                Ok(ProfileSpec::Constant(v as f64))
+            }
+            fn visit_u64<E: de::Error>(self, v: u64) -> Result<ProfileSpec, E> {
+                Ok(ProfileSpec::Constant(v as f64))
+            }
+            fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<ProfileSpec, A::Error> {
+                #[derive(Deserialize)]
+                #[serde(deny_unknown_fields)]
+                struct Raw {
+                    polynomial: Option<Vec<f64>>,
+                    s: Option<Vec<f64>>,
+                    values: Option<Vec<f64>>,
+                }
+                let raw = Raw::deserialize(de::value::MapAccessDeserializer::new(map))?;
+                match (raw.polynomial, raw.s, raw.values) {
+                    (Some(c), None, None) => Ok(ProfileSpec::Polynomial { polynomial: c }),
+                    (None, Some(s), Some(values)) => Ok(ProfileSpec::Table { s, values }),
+                    _ => Err(de::Error::custom(
+                        "a profile table needs either `polynomial` or both `s` and `values`",
+                    )),
+                }
+            }
+        }
+        d.deserialize_any(ProfileVisitor)
+    }
+}
+
+/// `[clamp]`.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ClampSection {
+    /// r(0) (m).
+    #[serde(default)]
+    pub position: [f64; 3],
+    /// d1(0), a unit vector.
+    #[serde(default = "unit_x")]
+    pub d1: [f64; 3],
+    /// d3(0), the tangent, a unit vector orthogonal to d1.
+    #[serde(default = "unit_z")]
+    pub d3: [f64; 3],
+}
+
+fn unit_x() -> [f64; 3] {
+    [1.0, 0.0, 0.0]
+}
+
+fn unit_z() -> [f64; 3] {
+    [0.0, 0.0, 1.0]
+}
+
+impl Default for ClampSection {
+    fn default() -> Self {
+        ClampSection {
+            position: [0.0; 3],
+            d1: unit_x(),
+            d3: unit_z(),
+        }
+    }
+}
+
+/// `[loads]`, global components.
+#[derive(Debug, Clone, Default, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct LoadSection {
+    /// Tip force (N).
+    #[serde(default)]
+    pub tip_force: [f64; 3],
+    /// Tip couple (N·m).
+    #[serde(default)]
+    pub tip_couple: [f64; 3],
+    /// Uniform force per unit length (N/m), e.g. self-weight ρAg.
+    #[serde(default)]
+    pub distributed_force: [f64; 3],
+}
+
+/// `[solver]`.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct SolverSection {
+    /// "shooting" or "multiple-shooting".
+    #[serde(default = "default_method")]
+    pub method: String,
+    /// Segments of multiple shooting.
+    #[serde(default = "default_segments")]
+    pub segments: usize,
+    /// "auto", "planar" or "kirchhoff".
+    #[serde(default = "default_auto")]
+    pub model: String,
+    /// "auto", "direct" or "ramp".
+    #[serde(default = "default_auto")]
+    pub strategy: String,
+    /// Newton tolerance on the scaled residual.
+    #[serde(default = "default_tolerance")]
+    pub tolerance: f64,
+    /// Newton iteration budget.
+    #[serde(default = "default_max_iterations")]
+    pub max_iterations: usize,
+    /// Relative and absolute tolerance of the integrator.
+    #[serde(default = "default_integration_tolerance")]
+    pub integration_tolerance: f64,
+    /// Step budget of one integration.
+    #[serde(default = "default_max_steps")]
+    pub max_steps: usize,
+    /// Output points along the rod.
+    #[serde(default = "default_output_points")]
+    pub output_points: usize,
+    /// Guess of κ(0), body components (1/m).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial_curvature: Option<[f64; 3]>,
+}
+
+fn default_method() -> String {
+    "shooting".into()
+}
+fn default_segments() -> usize {
+    8
+}
+fn default_auto() -> String {
+    "auto".into()
+}
+fn default_tolerance() -> f64 {
+    1e-10
+}
+fn default_max_iterations() -> usize {
+    50
+}
+fn default_integration_tolerance() -> f64 {
+    1e-12
+}
+fn default_max_steps() -> usize {
+    100_000
+}
+fn default_output_points() -> usize {
+    201
+}
+
+impl Default for SolverSection {
+    fn default() -> Self {
+        toml::from_str("").expect("every solver key has a default")
+    }
+}
+
+/// A problem ready to solve.
+#[derive(Debug, Clone)]
+pub struct Problem {
+    /// The rod.
+    pub rod: Rod,
+    /// The model level and why.
+    pub model: ModelChoice,
+    /// The solver settings.
+    pub options: SolverOptions,
+    /// The effective problem text (with overrides applied), stored with
+    /// results.
+    pub text: String,
+}
+
+impl Problem {
+    /// Reads a problem file and applies `key=value` overrides.
+    pub fn from_path(path: &Path, overrides: &[String]) -> Result<Problem, ProblemError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ProblemError::Read {
+            path: path.display().to_string(),
+            source,
+        })?;
+        Problem::from_str_with(&text, overrides)
+    }
+
+    /// Reads a problem from TOML text and applies `key=value` overrides.
+    pub fn from_str_with(text: &str, overrides: &[String]) -> Result<Problem, ProblemError> {
+        let text = apply_overrides(text, overrides)?;
+        let file: ProblemFile =
+            toml::from_str(&text).map_err(|e| ProblemError::Parse(e.to_string()))?;
+        let rod = build_rod(&file)?;
+        let model = choose_model(&rod, &file.solver.model)?;
+        let options = build_options(&file.solver)?;
+        Ok(Problem {
+            rod,
+            model,
+            options,
+            text,
+        })
+    }
+}
+
+/// The text with every `a.b.c=value` applied; the value is read as a TOML
+/// value (number, boolean, array, inline table, quoted string), else as a
+/// bare string.
+fn apply_overrides(text: &str, overrides: &[String]) -> Result<String, ProblemError> {
+    if overrides.is_empty() {
+        return Ok(text.to_string());
+    }
+    let mut doc: toml::Table = text.parse().map_err(|e: toml::de::Error| ProblemError::Parse(e.to_string()))?;
+    for assignment in overrides {
+        let fail = |message: &str| ProblemError::Override {
+            assignment: assignment.clone(),
+            message: message.into(),
+        };
+        let (key, raw) = assignment
+            .split_once('=')
+            .ok_or_else(|| fail("expected key=value"))?;
+        let path: Vec<&str> = key.trim().split('.').map(str::trim).collect();
+        if path.iter().any(|p| p.is_empty()) {
+            return Err(fail("empty key"));
+        }
+        let value = parse_value(raw.trim());
+        let (last, parents) = path.split_last().expect("non-empty path");
+        let mut table = &mut doc;
+        for part in parents {
+            let entry = table
+                .entry(part.to_string())
+                .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+            table = entry
+                .as_table_mut()
+                .ok_or_else(|| fail(&format!("`{part}` is not a table")))?;
+        }
+        table.insert(last.to_string(), value);
+    }
+    toml::to_string(&doc).map_err(|e| ProblemError::Parse(e.to_string()))
+}
+
+fn parse_value(raw: &str) -> toml::Value {
+    format!("v = {raw}")
+        .parse::<toml::Table>()
+        .ok()
+        .and_then(|mut t| t.remove("v"))
+        .unwrap_or_else(|| toml::Value::String(raw.to_string()))
+}
+
+fn finite(field: &str, v: f64) -> Result<f64, ProblemError> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(invalid(field, format!("must be a finite number, got {v}")))
+    }
+}
+
+fn vector(field: &str, v: [f64; 3]) -> Result<Vector3<f64>, ProblemError> {
+    for (i, x) in v.iter().enumerate() {
+        finite(&format!("{field}[{i}]"), *x)?;
+    }
+    Ok(Vector3::from(v))
+}
+
+fn profile(field: &str, spec: &ProfileSpec) -> Result<Profile, ProblemError> {
+    let p = match spec {
+        ProfileSpec::Constant(c) => Profile::Constant(*c),
+        ProfileSpec::Polynomial { polynomial } => {
+            if polynomial.is_empty() {
+                return Err(invalid(field, "a polynomial needs at least one coefficient"));
+            }
+            Profile::Polynomial(polynomial.clone())
+        }
+        ProfileSpec::Table { s, values } => {
+            if s.len() < 2 || s.len() != values.len() {
+                return Err(invalid(
+                    field,
+                    format!(
+                        "a table needs at least two points and as many values as s ({} s, {} values)",
+                        s.len(),
+                        values.len()
+                    ),
+                ));
+            }
+            if s.windows(2).any(|w| !(w[1] > w[0])) {
+                return Err(invalid(format!("{field}.s"), "must be strictly increasing"));
+            }
+            Profile::Table {
+                s: s.clone(),
+                values: values.clone(),
+            }
+        }
+    };
+    if !p.is_finite() {
+        return Err(invalid(field, "must contain finite numbers only"));
+    }
+    Ok(p)
+}
+
+fn build_rod(file: &ProblemFile) -> Result<Rod, ProblemError> {
+    let length = finite("rod.length", file.rod.length)?;
+    if length <= 0.0 {
+        return Err(invalid("rod.length", format!("must be positive, got {length}")));
+    }
+    Ok(Rod {
+        length,
+        energy: build_energy(&file.energy, length)?,
+        clamp: build_clamp(&file.clamp)?,
+        loads: DeadLoads {
+            tip_force: vector("loads.tip_force", file.loads.tip_force)?,
+            tip_couple: vector("loads.tip_couple", file.loads.tip_couple)?,
+            distributed_force: vector("loads.distributed_force", file.loads.distributed_force)?,
+        },
+    })
+}
+
+fn build_energy(e: &EnergySection, length: f64) -> Result<Arc<dyn StoredEnergy>, ProblemError> {
+    let mut stiffness: [Profile; 3] = Default::default();
+    let mut kappa0: [Profile; 3] = Default::default();
+    for i in 0..3 {
+        let field = format!("energy.stiffness[{i}]");
+        stiffness[i] = profile(&field, &e.stiffness[i])?;
+        let min = stiffness[i].minimum_on(length);
+        if !(min > 0.0) {
+            return Err(invalid(field, format!("must be positive on [0, L], minimum {min}")));
+        }
+        kappa0[i] = profile(&format!("energy.intrinsic_curvature[{i}]"), &e.intrinsic_curvature[i])?;
+    }
+    let linear = LinearElastic {
+        stiffness,
+        intrinsic_curvature: kappa0,
+    };
+    match (e.kind.as_str(), e.quartic) {
+        ("linear", None) => Ok(Arc::new(linear)),
+        ("linear", Some(_)) => Err(invalid("energy.quartic", "only for kind = \"quartic\"")),
+        ("quartic", Some(c)) => {
+            let c = finite("energy.quartic", c)?;
+            if c < 0.0 {
+                return Err(invalid("energy.quartic", format!("must be ≥ 0, got {c}")));
+            }
+            Ok(Arc::new(QuarticStiffening { linear, quartic: c }))
+        }
+        ("quartic", None) => Err(invalid("energy.quartic", "required for kind = \"quartic\"")),
+        (other, _) => Err(invalid(
+            "energy.kind",
+            format!("unknown energy `{other}`; expected \"linear\" or \"quartic\""),
+        )),
+    }
+}
+
+/// Orthonormality tolerance of the clamp frame.
+const FRAME_TOLERANCE: f64 = 1e-9;
+
+fn build_clamp(c: &ClampSection) -> Result<Clamp, ProblemError> {
+    let position = vector("clamp.position", c.position)?;
+    let d1 = vector("clamp.d1", c.d1)?;
+    let d3 = vector("clamp.d3", c.d3)?;
+    for (name, d) in [("clamp.d1", d1), ("clamp.d3", d3)] {
+        if (d.norm() - 1.0).abs() > FRAME_TOLERANCE {
+            return Err(invalid(name, format!("must be a unit vector, |{name}| = {}", d.norm())));
+        }
+    }
+    if d1.dot(&d3).abs() > FRAME_TOLERANCE {
+        return Err(invalid(
+            "clamp.d3",
+            format!("must be orthogonal to clamp.d1, d1·d3 = {}", d1.dot(&d3)),
+        ));
+    }
+    Ok(Clamp::new(position, d1, d3))
+}
+
+fn choose_model(rod: &Rod, model: &str) -> Result<ModelChoice, ProblemError> {
+    let level = match model {
+        "auto" => return Ok(ModelChoice::for_rod(rod)),
+        "planar" => ModelLevel::Planar,
+        "kirchhoff" | "spatial" => ModelLevel::Kirchhoff,
+        other => {
+            return Err(invalid(
+                "solver.model",
+                format!("unknown model `{other}`; expected \"auto\", \"planar\" or \"kirchhoff\""),
+            ))
+        }
+    };
+    ModelChoice::forced(rod, level).map_err(|m| invalid("solver.model", m))
+}
+
+fn positive(field: &str, v: f64) -> Result<f64, ProblemError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(invalid(field, format!("must be a positive finite number, got {v}")))
+    }
+}
+
+fn build_options(s: &SolverSection) -> Result<SolverOptions, ProblemError> {
+    let method = match s.method.as_str() {
+        "shooting" => Method::Shooting,
+        "multiple-shooting" => {
+            if s.segments < 1 {
+                return Err(invalid("solver.segments", "must be at least 1"));
+            }
+            Method::MultipleShooting {
+                segments: s.segments,
+            }
+        }
+        other => {
+            return Err(invalid(
+                "solver.method",
+                format!("unknown method `{other}`; expected \"shooting\" or \"multiple-shooting\""),
+            ))
+        }
+    };
+    let strategy = match s.strategy.as_str() {
+        "auto" => Strategy::Auto,
+        "direct" => Strategy::Direct,
+        "ramp" => Strategy::Ramp,
+        other => {
+            return Err(invalid(
+                "solver.strategy",
+                format!("unknown strategy `{other}`; expected \"auto\", \"direct\" or \"ramp\""),
+            ))
+        }
+    };
+    let tol = positive("solver.integration_tolerance", s.integration_tolerance)?;
+    if s.output_points < 2 {
+        return Err(invalid("solver.output_points", "must be at least 2"));
+    }
+    if s.max_iterations < 1 {
+        return Err(invalid("solver.max_iterations", "must be at least 1"));
+    }
+    let initial_guess = match s.initial_curvature {
+        Some(k) => Some(vector("solver.initial_curvature", k)?.as_slice().to_vec()),
+        None => None,
+    };
+    Ok(SolverOptions {
+        method,
+        newton: NewtonOptions {
+            tolerance: positive("solver.tolerance", s.tolerance)?,
+            max_iterations: s.max_iterations,
+            ..Default::default()
+        },
+        integration: Tolerances {
+            rtol: tol,
+            atol: tol,
+            max_steps: s.max_steps.max(1),
+        },
+        output_points: s.output_points,
+        initial_guess,
+        strategy,
+    })
+}

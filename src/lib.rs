@@ -1,0 +1,12 @@
+//! cosserat: statics and stability of slender elastic rods.
+//!
+//! Data flows one way through the stages (docs/ARCHITECTURE.md):
+//! problem file ([`io`]) → rod ([`model`]) → equations ([`equations`]) →
+//! equilibrium ([`bvp`]) → output ([`io`]). A Rust user can skip the problem
+//! file: build a [`model::Rod`] (with any [`model::StoredEnergy`]), pick a
+//! [`model::ModelChoice`], and call [`bvp::solve`].
+
+pub mod bvp;
+pub mod equations;
+pub mod io;
+pub mod model;

@@ -1,0 +1,108 @@
+//! The `cosserat` command.
+//!
+//! Exit codes: 0 success, 2 bad input or a solver that did not converge
+//! (nothing is written then), 1 an unexpected failure writing output.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+use cosserat::bvp::{solve, Equilibrium};
+use cosserat::io::{check_target, write_equilibrium, Problem};
+
+#[derive(Parser)]
+#[command(name = "cosserat", version, about = "Statics and stability of slender elastic rods")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Solve for the equilibrium of a rod problem.
+    Solve {
+        /// The problem file (TOML).
+        problem: PathBuf,
+        /// Write the solution to this HDF5 file.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// Override the solver method ("shooting", "multiple-shooting").
+        #[arg(long)]
+        method: Option<String>,
+        /// Override any key of the problem file, e.g. --set loads.tip_force=[5,0,0].
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// Overwrite an existing output file.
+        #[arg(long)]
+        force: bool,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Solve {
+            problem,
+            output,
+            method,
+            mut set,
+            force,
+        } => {
+            if let Some(m) = method {
+                set.push(format!("solver.method=\"{m}\""));
+            }
+            run_solve(problem, output, &set, force)
+        }
+    }
+}
+
+fn fail(code: u8, message: impl std::fmt::Display) -> ExitCode {
+    eprintln!("error: {message}");
+    ExitCode::from(code)
+}
+
+fn run_solve(path: PathBuf, output: Option<PathBuf>, set: &[String], force: bool) -> ExitCode {
+    let problem = match Problem::from_path(&path, set) {
+        Ok(p) => p,
+        Err(e) => return fail(2, format!("{}: {e}", path.display())),
+    };
+    if let Some(out) = &output {
+        if let Err(e) = check_target(out, force) {
+            return fail(2, e);
+        }
+    }
+    println!("problem   {}", path.display());
+    println!("model     {} ({})", problem.model.level.name(), problem.model.reason);
+    println!("energy    {}", problem.rod.energy.name());
+    let eq = match solve(&problem.rod, &problem.model, &problem.options) {
+        Ok(eq) => eq,
+        Err(e) => return fail(2, e),
+    };
+    report(&eq);
+    if let Some(out) = output {
+        if let Err(e) = write_equilibrium(&out, &eq, &problem.text, force) {
+            return fail(1, e);
+        }
+        println!("written   {}", out.display());
+    }
+    ExitCode::SUCCESS
+}
+
+fn report(eq: &Equilibrium) {
+    let tip = eq.tip();
+    let v = |x: nalgebra::Vector3<f64>| format!("[{:+.12e}, {:+.12e}, {:+.12e}]", x[0], x[1], x[2]);
+    println!("method    {}", eq.method.name());
+    if eq.load_steps > 0 {
+        println!("load ramp {} steps", eq.load_steps);
+    }
+    println!("newton    {} iterations", eq.iterations);
+    println!("residual  {:.3e} (scaled max-norm)", eq.residual);
+    println!("tip       position {}", v(tip.position));
+    println!("          tangent  {}", v(tip.directors[2]));
+    println!("drift     {:.1e} (max |d_i·d_j − δ_ij|)", eq.director_drift);
+    println!(
+        "work      {} steps, {} rejected, {} evaluations",
+        eq.integration.accepted, eq.integration.rejected, eq.integration.evaluations
+    );
+    println!("time      {:.3} ms", eq.wall_time * 1e3);
+}

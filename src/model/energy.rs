@@ -1,0 +1,265 @@
+//! Stored energy densities W(s, κ) of a hyperelastic Kirchhoff rod.
+//!
+//! The body moment is M = ∂W/∂κ and the bending/torsion stiffness is the
+//! Hessian H = ∂²W/∂κ² (DESIGN.md, "The mathematics"). The equilibrium
+//! equations need κ', which follows from M' = H κ' + ∂s∇W; their variational
+//! equations (the shooting Jacobian) need the derivative of H κ' in κ, a
+//! third derivative of W. Every energy supplies all of these, so that any
+//! hyperelastic material plugs into the same equations.
+
+use nalgebra::{Matrix3, Vector3};
+
+use super::profile::Profile;
+
+/// A stored energy density per unit reference length, W(s, κ) ≥ 0, C² in κ
+/// with positive definite Hessian.
+pub trait StoredEnergy: std::fmt::Debug + Send + Sync {
+    /// W(s, κ).
+    fn density(&self, s: f64, kappa: &Vector3<f64>) -> f64;
+    /// The body moment M = ∂W/∂κ (body components).
+    fn moment(&self, s: f64, kappa: &Vector3<f64>) -> Vector3<f64>;
+    /// The stiffness H = ∂²W/∂κ² (symmetric, positive definite).
+    fn stiffness(&self, s: f64, kappa: &Vector3<f64>) -> Matrix3<f64>;
+    /// ∂M/∂s at fixed κ: the explicit s-dependence of the moment
+    /// (tapered rods, varying intrinsic curvature).
+    fn moment_rate(&self, s: f64, kappa: &Vector3<f64>) -> Vector3<f64>;
+    /// ∂H/∂s at fixed κ.
+    fn stiffness_rate(&self, s: f64, kappa: &Vector3<f64>) -> Matrix3<f64>;
+    /// ∂(H(κ) v)/∂κ for a fixed vector v: the third derivative of W
+    /// contracted with v (zero for quadratic energies).
+    fn stiffness_derivative(
+        &self,
+        s: f64,
+        kappa: &Vector3<f64>,
+        v: &Vector3<f64>,
+    ) -> Matrix3<f64>;
+    /// True when M1 = M3 = 0 whenever κ1 = κ3 = 0, for every κ2 and s: the
+    /// energy then admits planar equilibria bent about d2 (planar model).
+    fn admits_planar_bending(&self) -> bool;
+    /// A short name for reports ("linear", "quartic", ...).
+    fn name(&self) -> &str;
+}
+
+/// The linear-elastic energy with intrinsic curvature,
+/// W = ½ Σ B_i(s) (κ_i − κ⁰_i(s))² (paper eq. (17) with B_i varying in s).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LinearElastic {
+    /// Bending stiffnesses B1, B2 and torsional stiffness B3 (N·m²).
+    pub stiffness: [Profile; 3],
+    /// Intrinsic curvature κ⁰ in body components (1/m).
+    pub intrinsic_curvature: [Profile; 3],
+}
+
+impl LinearElastic {
+    /// A prismatic rod with constant stiffness and intrinsic curvature.
+    pub fn uniform(b: [f64; 3], kappa0: [f64; 3]) -> Self {
+        LinearElastic {
+            stiffness: b.map(Profile::Constant),
+            intrinsic_curvature: kappa0.map(Profile::Constant),
+        }
+    }
+
+    fn b(&self, s: f64) -> Vector3<f64> {
+        Vector3::from_fn(|i, _| self.stiffness[i].value(s))
+    }
+
+    fn b_rate(&self, s: f64) -> Vector3<f64> {
+        Vector3::from_fn(|i, _| self.stiffness[i].derivative(s))
+    }
+
+    /// κ⁰(s).
+    pub fn kappa0(&self, s: f64) -> Vector3<f64> {
+        Vector3::from_fn(|i, _| self.intrinsic_curvature[i].value(s))
+    }
+
+    fn kappa0_rate(&self, s: f64) -> Vector3<f64> {
+        Vector3::from_fn(|i, _| self.intrinsic_curvature[i].derivative(s))
+    }
+}
+
+impl StoredEnergy for LinearElastic {
+    fn density(&self, s: f64, kappa: &Vector3<f64>) -> f64 {
+        let e = kappa - self.kappa0(s);
+        0.5 * self.b(s).component_mul(&e).dot(&e)
+    }
+
+    fn moment(&self, s: f64, kappa: &Vector3<f64>) -> Vector3<f64> {
+        self.b(s).component_mul(&(kappa - self.kappa0(s)))
+    }
+
+    fn stiffness(&self, s: f64, _kappa: &Vector3<f64>) -> Matrix3<f64> {
+        Matrix3::from_diagonal(&self.b(s))
+    }
+
+    fn moment_rate(&self, s: f64, kappa: &Vector3<f64>) -> Vector3<f64> {
+        self.b_rate(s).component_mul(&(kappa - self.kappa0(s)))
+            - self.b(s).component_mul(&self.kappa0_rate(s))
+    }
+
+    fn stiffness_rate(&self, s: f64, _kappa: &Vector3<f64>) -> Matrix3<f64> {
+        Matrix3::from_diagonal(&self.b_rate(s))
+    }
+
+    fn stiffness_derivative(&self, _: f64, _: &Vector3<f64>, _: &Vector3<f64>) -> Matrix3<f64> {
+        Matrix3::zeros()
+    }
+
+    fn admits_planar_bending(&self) -> bool {
+        self.intrinsic_curvature[0].is_zero() && self.intrinsic_curvature[2].is_zero()
+    }
+
+    fn name(&self) -> &str {
+        "linear"
+    }
+}
+
+/// A material that stiffens with curvature: the linear energy plus a quartic
+/// term in the magnitude of the curvature change,
+/// W = ½ Σ B_i (κ_i − κ⁰_i)² + ¼ C |κ − κ⁰|⁴.
+///
+/// The quartic term couples the three components (H is not diagonal) and has
+/// a non-zero third derivative, so the equations exercise every method of
+/// [`StoredEnergy`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct QuarticStiffening {
+    /// The quadratic part.
+    pub linear: LinearElastic,
+    /// The stiffening coefficient C (N·m⁴), C ≥ 0.
+    pub quartic: f64,
+}
+
+impl QuarticStiffening {
+    /// With u = κ − κ⁰ and S = |u|²: ∇ = C S u, H = C (S I + 2 u uᵀ).
+    fn quartic_parts(&self, u: &Vector3<f64>) -> (Vector3<f64>, Matrix3<f64>) {
+        let c = self.quartic;
+        let sq = u.norm_squared();
+        (
+            c * sq * u,
+            c * (Matrix3::identity() * sq + 2.0 * u * u.transpose()),
+        )
+    }
+}
+
+impl StoredEnergy for QuarticStiffening {
+    fn density(&self, s: f64, kappa: &Vector3<f64>) -> f64 {
+        let u = kappa - self.linear.kappa0(s);
+        self.linear.density(s, kappa) + 0.25 * self.quartic * u.norm_squared().powi(2)
+    }
+
+    fn moment(&self, s: f64, kappa: &Vector3<f64>) -> Vector3<f64> {
+        let u = kappa - self.linear.kappa0(s);
+        self.linear.moment(s, kappa) + self.quartic_parts(&u).0
+    }
+
+    fn stiffness(&self, s: f64, kappa: &Vector3<f64>) -> Matrix3<f64> {
+        let u = kappa - self.linear.kappa0(s);
+        self.linear.stiffness(s, kappa) + self.quartic_parts(&u).1
+    }
+
+    /// κ⁰(s) enters through u = κ − κ⁰(s): ∂s∇W₄ = −H₄ κ⁰'.
+    fn moment_rate(&self, s: f64, kappa: &Vector3<f64>) -> Vector3<f64> {
+        let u = kappa - self.linear.kappa0(s);
+        self.linear.moment_rate(s, kappa) - self.quartic_parts(&u).1 * self.linear.kappa0_rate(s)
+    }
+
+    /// ∂sH₄ = −T(κ⁰') with T the third derivative below.
+    fn stiffness_rate(&self, s: f64, kappa: &Vector3<f64>) -> Matrix3<f64> {
+        let rate = self.linear.kappa0_rate(s);
+        self.linear.stiffness_rate(s, kappa) - self.stiffness_derivative(s, kappa, &rate)
+    }
+
+    /// H₄ v = C (S v + 2 u (u·v)), so ∂(H₄ v)/∂u = 2C (v uᵀ + (u·v) I + u vᵀ).
+    fn stiffness_derivative(
+        &self,
+        s: f64,
+        kappa: &Vector3<f64>,
+        v: &Vector3<f64>,
+    ) -> Matrix3<f64> {
+        let u = kappa - self.linear.kappa0(s);
+        2.0 * self.quartic
+            * (v * u.transpose() + Matrix3::identity() * u.dot(v) + u * v.transpose())
+    }
+
+    fn admits_planar_bending(&self) -> bool {
+        self.linear.admits_planar_bending()
+    }
+
+    fn name(&self) -> &str {
+        "quartic"
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn energies() -> Vec<Box<dyn StoredEnergy>> {
+        let tapered = LinearElastic {
+            stiffness: [
+                Profile::Polynomial(vec![2.0, -0.5]),
+                Profile::Polynomial(vec![1.0, 0.3, 0.2]),
+                Profile::Constant(1.5),
+            ],
+            intrinsic_curvature: [
+                Profile::Polynomial(vec![0.1, 0.4]),
+                Profile::Polynomial(vec![-0.3, 0.0, 1.0]),
+                Profile::Constant(0.7),
+            ],
+        };
+        vec![
+            Box::new(tapered.clone()),
+            Box::new(QuarticStiffening {
+                linear: tapered,
+                quartic: 0.8,
+            }),
+        ]
+    }
+
+    const H: f64 = 1e-6;
+
+    fn fd_vec(f: impl Fn(f64) -> Vector3<f64>) -> Vector3<f64> {
+        (f(H) - f(-H)) / (2.0 * H)
+    }
+
+    fn fd_mat(f: impl Fn(f64) -> Matrix3<f64>) -> Matrix3<f64> {
+        (f(H) - f(-H)) / (2.0 * H)
+    }
+
+    #[test]
+    fn derivatives_match_central_differences() {
+        let s = 0.37;
+        let kappa = Vector3::new(0.4, -1.2, 0.9);
+        let v = Vector3::new(-0.3, 0.8, 0.5);
+        for e in energies() {
+            let grad = e.moment(s, &kappa);
+            let hess = e.stiffness(s, &kappa);
+            for i in 0..3 {
+                let ei = Vector3::ith(i, 1.0);
+                let dw = (e.density(s, &(kappa + H * ei)) - e.density(s, &(kappa - H * ei)))
+                    / (2.0 * H);
+                assert!((dw - grad[i]).abs() < 1e-8, "{}: ∂W/∂κ{i}", e.name());
+                let dm = fd_vec(|h| e.moment(s, &(kappa + h * ei)));
+                assert!((dm - hess.column(i)).norm() < 1e-8, "{}: H col {i}", e.name());
+            }
+            let dms = fd_vec(|h| e.moment(s + h, &kappa));
+            assert!((dms - e.moment_rate(s, &kappa)).norm() < 1e-8, "{}", e.name());
+            let dhs = fd_mat(|h| e.stiffness(s + h, &kappa));
+            assert!((dhs - e.stiffness_rate(s, &kappa)).norm() < 1e-7, "{}", e.name());
+            let t = e.stiffness_derivative(s, &kappa, &v);
+            for i in 0..3 {
+                let ei = Vector3::ith(i, 1.0);
+                let dhv = fd_vec(|h| e.stiffness(s, &(kappa + h * ei)) * v);
+                assert!((dhv - t.column(i)).norm() < 1e-7, "{}: T col {i}", e.name());
+            }
+        }
+    }
+
+    #[test]
+    fn hessian_is_symmetric_positive_definite() {
+        for e in energies() {
+            let h = e.stiffness(0.2, &Vector3::new(1.0, 2.0, -0.5));
+            assert!((h - h.transpose()).norm() < 1e-14);
+            assert!(h.cholesky().is_some());
+        }
+    }
+}

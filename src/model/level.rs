@@ -1,0 +1,92 @@
+//! The model level a scene needs: "model no more than a scene needs"
+//! (DESIGN.md). A planar scene runs the 4-ODE planar model, a spatial one the
+//! 9-ODE Kirchhoff model; the choice comes with its reason.
+
+use super::Rod;
+
+/// How much model the equations carry.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ModelLevel {
+    /// Bending in the plane of d1(0), d3(0): x, z, φ, κ2 (4 ODEs).
+    Planar,
+    /// The spatial Kirchhoff rod: d1, d2, κ (9 ODEs) plus r by quadrature.
+    Kirchhoff,
+}
+
+impl ModelLevel {
+    /// The name used in problem files, reports and HDF5 attributes.
+    pub fn name(self) -> &'static str {
+        match self {
+            ModelLevel::Planar => "planar",
+            ModelLevel::Kirchhoff => "kirchhoff",
+        }
+    }
+}
+
+/// The level chosen for a scene and why.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ModelChoice {
+    /// The level used.
+    pub level: ModelLevel,
+    /// A sentence saying why.
+    pub reason: String,
+}
+
+/// Relative size below which a load component counts as zero.
+const PLANE_TOLERANCE: f64 = 1e-12;
+
+impl ModelChoice {
+    /// The least level that represents the scene exactly: planar when the
+    /// energy admits planar bending about d2(0) and every load keeps the rod
+    /// in the plane of d1(0), d3(0); Kirchhoff otherwise.
+    pub fn for_rod(rod: &Rod) -> ModelChoice {
+        match planar_obstruction(rod) {
+            None => ModelChoice {
+                level: ModelLevel::Planar,
+                reason: "planar: intrinsic curvature, forces and couple keep the rod \
+                         in the plane of d1(0), d3(0)"
+                    .into(),
+            },
+            Some(why) => ModelChoice {
+                level: ModelLevel::Kirchhoff,
+                reason: format!("kirchhoff: {why}"),
+            },
+        }
+    }
+
+    /// A level forced by the user; forcing planar on a spatial scene is an
+    /// error naming the obstruction.
+    pub fn forced(rod: &Rod, level: ModelLevel) -> Result<ModelChoice, String> {
+        match (level, planar_obstruction(rod)) {
+            (ModelLevel::Planar, Some(why)) => {
+                Err(format!("the planar model cannot represent this scene: {why}"))
+            }
+            _ => Ok(ModelChoice {
+                level,
+                reason: format!("{}: forced by the user", level.name()),
+            }),
+        }
+    }
+}
+
+/// Why the scene is not planar, or None when it is.
+fn planar_obstruction(rod: &Rod) -> Option<String> {
+    if !rod.energy.admits_planar_bending() {
+        return Some("the intrinsic curvature has κ⁰1 or κ⁰3 components".into());
+    }
+    let normal = rod.clamp.director(1);
+    let scale = rod.loads.moment_scale(rod.length).max(f64::MIN_POSITIVE);
+    let loads = &rod.loads;
+    if (loads.tip_force.dot(&normal) * rod.length).abs() > PLANE_TOLERANCE * scale {
+        return Some("the tip force has a component along d2(0)".into());
+    }
+    let f = loads.distributed_force.dot(&normal) * rod.length * rod.length;
+    if f.abs() > PLANE_TOLERANCE * scale {
+        return Some("the distributed force has a component along d2(0)".into());
+    }
+    let c = loads.tip_couple - normal * loads.tip_couple.dot(&normal);
+    if c.norm() > PLANE_TOLERANCE * scale {
+        return Some("the tip couple is not along d2(0)".into());
+    }
+    None
+}

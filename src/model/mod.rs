@@ -1,0 +1,16 @@
+//! What a rod is: its stored energy, its clamp, the dead loads on it, and the
+//! least model level (planar or spatial) that the scene needs.
+//!
+//! This stage knows nothing of how equilibria are computed.
+
+mod energy;
+mod level;
+mod loads;
+mod profile;
+mod rod;
+
+pub use energy::{LinearElastic, QuarticStiffening, StoredEnergy};
+pub use level::{ModelChoice, ModelLevel};
+pub use loads::DeadLoads;
+pub use profile::Profile;
+pub use rod::{Clamp, Rod};

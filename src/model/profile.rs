@@ -1,0 +1,137 @@
+//! Functions of the reference arc length s: stiffness and intrinsic-curvature
+//! profiles of non-prismatic or pre-curved rods.
+//!
+//! A profile is a constant, a polynomial in s (coefficients in increasing
+//! powers, s in the same length unit as the rod), or a piecewise-linear table.
+//! Energies need the value and its s-derivative (the explicit s-dependence of
+//! the body moment, DESIGN.md "κ' from M' = Hκ' + ∂s∇W").
+
+/// A scalar function of the arc length s.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Profile {
+    /// The same value everywhere.
+    Constant(f64),
+    /// Σ c_k s^k, coefficients in increasing powers.
+    Polynomial(Vec<f64>),
+    /// Piecewise-linear interpolation of (s_k, v_k), s strictly increasing;
+    /// held constant outside the table.
+    Table { s: Vec<f64>, values: Vec<f64> },
+}
+
+impl Default for Profile {
+    fn default() -> Self {
+        Profile::Constant(0.0)
+    }
+}
+
+impl Profile {
+    /// The value at s.
+    pub fn value(&self, s: f64) -> f64 {
+        match self {
+            Profile::Constant(c) => *c,
+            Profile::Polynomial(c) => c.iter().rev().fold(0.0, |acc, &ck| acc * s + ck),
+            Profile::Table { s: knots, values } => {
+                let (k, t) = locate(knots, s);
+                values[k] + t * (values[k + 1] - values[k])
+            }
+        }
+    }
+
+    /// The derivative d/ds at s (one-sided at table knots: the right segment).
+    pub fn derivative(&self, s: f64) -> f64 {
+        match self {
+            Profile::Constant(_) => 0.0,
+            Profile::Polynomial(c) => c
+                .iter()
+                .enumerate()
+                .skip(1)
+                .rev()
+                .fold(0.0, |acc, (k, &ck)| acc * s + k as f64 * ck),
+            Profile::Table { s: knots, values } => {
+                if s < knots[0] || s > knots[knots.len() - 1] {
+                    return 0.0;
+                }
+                let (k, _) = locate(knots, s);
+                (values[k + 1] - values[k]) / (knots[k + 1] - knots[k])
+            }
+        }
+    }
+
+    /// True when the profile is identically zero.
+    pub fn is_zero(&self) -> bool {
+        match self {
+            Profile::Constant(c) => *c == 0.0,
+            Profile::Polynomial(c) => c.iter().all(|&x| x == 0.0),
+            Profile::Table { values, .. } => values.iter().all(|&x| x == 0.0),
+        }
+    }
+
+    /// The smallest value on [0, length]: exact for constants and tables
+    /// (extremes sit at knots), sampled densely plus the end points for
+    /// polynomials. Used to reject non-positive stiffness.
+    pub fn minimum_on(&self, length: f64) -> f64 {
+        match self {
+            Profile::Constant(c) => *c,
+            Profile::Table { s, values } => {
+                let mut m = self.value(0.0).min(self.value(length));
+                for (sk, vk) in s.iter().zip(values) {
+                    if (0.0..=length).contains(sk) {
+                        m = m.min(*vk);
+                    }
+                }
+                m
+            }
+            Profile::Polynomial(_) => (0..=1000)
+                .map(|i| self.value(length * i as f64 / 1000.0))
+                .fold(f64::INFINITY, f64::min),
+        }
+    }
+
+    /// Every number in the profile is finite.
+    pub fn is_finite(&self) -> bool {
+        match self {
+            Profile::Constant(c) => c.is_finite(),
+            Profile::Polynomial(c) => c.iter().all(|x| x.is_finite()),
+            Profile::Table { s, values } => s.iter().chain(values).all(|x| x.is_finite()),
+        }
+    }
+}
+
+/// The table segment k holding s and the fraction t ∈ [0, 1] along it
+/// (clamped to the ends outside the table).
+fn locate(knots: &[f64], s: f64) -> (usize, f64) {
+    let n = knots.len();
+    if s <= knots[0] {
+        return (0, 0.0);
+    }
+    if s >= knots[n - 1] {
+        return (n - 2, 1.0);
+    }
+    let k = knots.partition_point(|&x| x <= s).saturating_sub(1).min(n - 2);
+    (k, (s - knots[k]) / (knots[k + 1] - knots[k]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn polynomial_value_and_derivative() {
+        let p = Profile::Polynomial(vec![1.0, -2.0, 3.0]);
+        assert_eq!(p.value(2.0), 1.0 - 4.0 + 12.0);
+        assert_eq!(p.derivative(2.0), -2.0 + 12.0);
+    }
+
+    #[test]
+    fn table_interpolates_and_clamps() {
+        let p = Profile::Table {
+            s: vec![0.0, 1.0, 3.0],
+            values: vec![1.0, 3.0, 2.0],
+        };
+        assert_eq!(p.value(0.5), 2.0);
+        assert_eq!(p.value(2.0), 2.5);
+        assert_eq!(p.value(5.0), 2.0);
+        assert_eq!(p.derivative(2.0), -0.5);
+        assert_eq!(p.minimum_on(3.0), 1.0);
+    }
+}

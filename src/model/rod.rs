@@ -1,0 +1,71 @@
+//! The rod: length, stored energy, clamp at s = 0 and dead loads.
+
+use std::sync::Arc;
+
+use nalgebra::{Matrix3, Vector3};
+
+use super::{DeadLoads, StoredEnergy};
+
+/// The clamp at s = 0: position and the directors d1(0), d2(0), d3(0).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Clamp {
+    /// r(0) (m).
+    pub position: Vector3<f64>,
+    /// The director frame [d1 d2 d3] at s = 0, as columns (orthonormal,
+    /// right-handed).
+    pub frame: Matrix3<f64>,
+}
+
+impl Clamp {
+    /// A clamp from d1(0) and d3(0); d2 = d3 × d1 completes a right-handed
+    /// frame. Orthonormality is the caller's to check (problem files do).
+    pub fn new(position: Vector3<f64>, d1: Vector3<f64>, d3: Vector3<f64>) -> Self {
+        let d2 = d3.cross(&d1);
+        Clamp {
+            position,
+            frame: Matrix3::from_columns(&[d1, d2, d3]),
+        }
+    }
+
+    /// The paper's clamp: origin, d1 = e1 (vertical, down), d3 = e3.
+    pub fn paper() -> Self {
+        Clamp::new(Vector3::zeros(), Vector3::x(), Vector3::z())
+    }
+
+    /// d_i(0), i = 0, 1, 2.
+    pub fn director(&self, i: usize) -> Vector3<f64> {
+        self.frame.column(i).into_owned()
+    }
+}
+
+/// A Kirchhoff rod clamped at s = 0 and free at s = L under dead loads.
+#[derive(Debug, Clone)]
+pub struct Rod {
+    /// Reference length L (m).
+    pub length: f64,
+    /// The stored energy density W(s, κ).
+    pub energy: Arc<dyn StoredEnergy>,
+    /// The clamp at s = 0.
+    pub clamp: Clamp,
+    /// Dead loads.
+    pub loads: DeadLoads,
+}
+
+impl Rod {
+    /// A characteristic moment (N·m) for scaling residuals: the larger of the
+    /// bending moment B/L that curves the rod by one radian and the moments
+    /// of the loads.
+    pub fn moment_scale(&self) -> f64 {
+        let b = self.energy.stiffness(0.0, &Vector3::zeros());
+        let stiff = b.diagonal().max() / self.length;
+        stiff.max(self.loads.moment_scale(self.length))
+    }
+
+    /// The same rod under loads scaled by `factor`.
+    pub fn with_load_factor(&self, factor: f64) -> Rod {
+        Rod {
+            loads: self.loads.scaled(factor),
+            ..self.clone()
+        }
+    }
+}

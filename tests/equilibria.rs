@@ -1,0 +1,166 @@
+//! Equilibria against closed forms: the elastica cantilever (elliptic
+//! integrals), the roll-up under an end couple, the unloaded helix, and the
+//! agreement of models and methods where they overlap.
+mod support;
+
+use std::f64::consts::TAU;
+use std::sync::Arc;
+
+use cosserat::bvp::{solve, Equilibrium, Method, SolverOptions};
+use cosserat::model::{
+    Clamp, DeadLoads, LinearElastic, ModelChoice, ModelLevel, QuarticStiffening, Rod,
+};
+use nalgebra::{Matrix3, Vector3};
+use support::references::cantilever_tip;
+
+/// The paper's cantilever: L = 1, B = (10, 1, 10), clamp d1 = e1 (down),
+/// d3 = e3, tip force k e1.
+fn cantilever(k: f64) -> Rod {
+    Rod {
+        length: 1.0,
+        energy: Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
+        clamp: Clamp::paper(),
+        loads: DeadLoads {
+            tip_force: Vector3::new(k, 0.0, 0.0),
+            ..Default::default()
+        },
+    }
+}
+
+fn solve_with(rod: &Rod, level: ModelLevel, method: Method) -> Equilibrium {
+    let choice = ModelChoice::forced(rod, level).unwrap();
+    let opts = SolverOptions {
+        method,
+        ..Default::default()
+    };
+    solve(rod, &choice, &opts).unwrap_or_else(|e| panic!("{level:?} {method:?}: {e}"))
+}
+
+const METHODS: [Method; 2] = [Method::Shooting, Method::MultipleShooting { segments: 8 }];
+const LEVELS: [ModelLevel; 2] = [ModelLevel::Planar, ModelLevel::Kirchhoff];
+
+#[test]
+fn cantilever_tip_matches_elliptic_integrals() {
+    for k in [0.5, 1.0, 3.0, 10.0] {
+        let reference = cantilever_tip(k);
+        let rod = cantilever(k);
+        assert_eq!(ModelChoice::for_rod(&rod).level, ModelLevel::Planar);
+        for level in LEVELS {
+            for method in METHODS {
+                let eq = solve_with(&rod, level, method);
+                let tip = eq.tip();
+                let d3 = tip.directors[2];
+                let angle = d3[0].atan2(d3[2]);
+                let errors = [
+                    (tip.position[0] - reference.x).abs(),
+                    (tip.position[2] - reference.z).abs(),
+                    tip.position[1].abs(),
+                    (angle - reference.angle).abs(),
+                ];
+                let worst = errors.iter().cloned().fold(0.0, f64::max);
+                assert!(
+                    worst <= 1e-9,
+                    "k = {k}, {level:?}, {method:?}: errors {errors:?}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn planar_and_spatial_models_agree_on_planar_scenes() {
+    for k in [0.5, 3.0, 10.0] {
+        let rod = cantilever(k);
+        let planar = solve_with(&rod, ModelLevel::Planar, Method::Shooting);
+        let spatial = solve_with(&rod, ModelLevel::Kirchhoff, Method::Shooting);
+        for (a, b) in planar.samples.iter().zip(&spatial.samples) {
+            assert!((a.position - b.position).norm() <= 1e-10, "k = {k}, s = {}", a.s);
+            assert!((a.curvature - b.curvature).norm() <= 1e-10, "k = {k}, s = {}", a.s);
+        }
+    }
+}
+
+#[test]
+fn end_couple_rolls_the_rod_into_a_circle() {
+    let b2 = 1.0;
+    let mut rod = cantilever(0.0);
+    rod.loads.tip_couple = Vector3::new(0.0, TAU * b2 / rod.length, 0.0);
+    for level in LEVELS {
+        for method in METHODS {
+            let eq = solve_with(&rod, level, method);
+            let tip = eq.tip();
+            assert!(tip.position.norm() <= 1e-9, "{level:?} {method:?}: tip {}", tip.position);
+            assert!((tip.directors[2] - Vector3::z()).norm() <= 1e-9);
+            // A circle of radius L/2π through the clamp, centre at x = L/2π.
+            let r = rod.length / TAU;
+            for p in &eq.samples {
+                let c = Vector3::new(r, 0.0, 0.0);
+                assert!(((p.position - c).norm() - r).abs() <= 1e-9, "s = {}", p.s);
+            }
+        }
+    }
+}
+
+/// r(s) = R0 [s I + (1 − cos ωs)/ω² K + (ωs − sin ωs)/ω³ K²] e3 with
+/// K = [κ⁰]× and ω = |κ⁰|: the frame is R0 exp(sK) for a constant body
+/// Darboux vector.
+fn helix_position(kappa0: Vector3<f64>, s: f64) -> Vector3<f64> {
+    let w = kappa0.norm();
+    let k = kappa0.cross_matrix();
+    let m = Matrix3::identity() * s
+        + k * ((1.0 - (w * s).cos()) / (w * w))
+        + k * k * ((w * s - (w * s).sin()) / (w * w * w));
+    m * Vector3::z()
+}
+
+#[test]
+fn unloaded_rod_with_constant_intrinsic_curvature_is_a_helix() {
+    let kappa0 = Vector3::new(1.3, -0.7, 2.1);
+    let rod = Rod {
+        length: 3.0,
+        energy: Arc::new(LinearElastic::uniform([1.0, 2.0, 0.8], kappa0.into())),
+        clamp: Clamp::new(Vector3::zeros(), Vector3::x(), Vector3::z()),
+        loads: DeadLoads::default(),
+    };
+    let choice = ModelChoice::for_rod(&rod);
+    assert_eq!(choice.level, ModelLevel::Kirchhoff, "{}", choice.reason);
+    for method in METHODS {
+        let eq = solve_with(&rod, ModelLevel::Kirchhoff, method);
+        for p in &eq.samples {
+            let exact = helix_position(kappa0, p.s);
+            assert!((p.position - exact).norm() <= 1e-9, "{method:?} s = {}", p.s);
+        }
+        assert!(eq.director_drift <= 1e-12, "drift {}", eq.director_drift);
+    }
+}
+
+/// A spatial scene (helix under a tip load, quartic energy): single and
+/// multiple shooting find the same equilibrium.
+#[test]
+fn single_and_multiple_shooting_agree() {
+    let linear = LinearElastic::uniform([1.0, 1.5, 0.7], [0.8, 0.3, 1.2]);
+    let energies: Vec<Arc<dyn cosserat::model::StoredEnergy>> = vec![
+        Arc::new(linear.clone()),
+        Arc::new(QuarticStiffening {
+            linear,
+            quartic: 0.5,
+        }),
+    ];
+    for energy in energies {
+        let rod = Rod {
+            length: 2.0,
+            energy,
+            clamp: Clamp::paper(),
+            loads: DeadLoads {
+                tip_force: Vector3::new(0.6, 0.2, -0.1),
+                tip_couple: Vector3::new(0.0, 0.1, 0.2),
+                distributed_force: Vector3::new(0.3, 0.0, 0.0),
+            },
+        };
+        let single = solve_with(&rod, ModelLevel::Kirchhoff, Method::Shooting);
+        let multi = solve_with(&rod, ModelLevel::Kirchhoff, METHODS[1]);
+        for (a, b) in single.samples.iter().zip(&multi.samples) {
+            assert!((a.position - b.position).norm() <= 1e-9, "s = {}", a.s);
+        }
+    }
+}

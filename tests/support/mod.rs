@@ -1,0 +1,6 @@
+//! Independent references for the tests: closed forms evaluated here, never
+//! the solver's own output.
+#![allow(dead_code)]
+
+pub mod elliptic;
+pub mod references;

@@ -1,0 +1,31 @@
+//! The references themselves against published values and limits.
+mod support;
+use support::elliptic::{ellip_e, ellip_f};
+use support::references::cantilever_tip;
+
+#[test]
+fn complete_integrals_match_tabulated_values() {
+    // K(k = sin 45°) and E(k = sin 45°), Abramowitz & Stegun Table 17.1.
+    let k = std::f64::consts::FRAC_1_SQRT_2;
+    let half_pi = std::f64::consts::FRAC_PI_2;
+    assert!((ellip_f(half_pi, k) - 1.854_074_677_301_372).abs() < 1e-14);
+    assert!((ellip_e(half_pi, k) - 1.350_643_881_047_675).abs() < 1e-14);
+}
+
+#[test]
+fn cantilever_reference_small_load_limit() {
+    // Linear beam theory: deflection kL/3 for k → 0.
+    let t = cantilever_tip(1e-4);
+    assert!((t.x / 1e-4 - 1.0 / 3.0).abs() < 1e-4);
+    assert!((t.z - 1.0).abs() < 1e-7);
+}
+
+#[test]
+fn cantilever_reference_matches_mattiasson_table() {
+    // Mattiasson (1981), Table 1: k = 1: tip deflection 0.30172, horizontal
+    // displacement 0.05643 (so z = 0.94357), tip rotation 0.46135.
+    let t = cantilever_tip(1.0);
+    assert!((t.x - 0.30172).abs() < 1e-5, "x {}", t.x);
+    assert!((1.0 - t.z - 0.05643).abs() < 1e-5, "z {}", t.z);
+    assert!((t.angle - 0.46135).abs() < 1e-5, "angle {}", t.angle);
+}
