@@ -11,7 +11,11 @@ use cosserat::bvp::{solve, Equilibrium};
 use cosserat::io::{check_target, write_equilibrium, Problem};
 
 #[derive(Parser)]
-#[command(name = "cosserat", version, about = "Statics and stability of slender elastic rods")]
+#[command(
+    name = "cosserat",
+    version,
+    about = "Statics and stability of slender elastic rods"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -72,7 +76,11 @@ fn run_solve(path: PathBuf, output: Option<PathBuf>, set: &[String], force: bool
         }
     }
     println!("problem   {}", path.display());
-    println!("model     {} ({})", problem.model.level.name(), problem.model.reason);
+    println!(
+        "model     {} ({})",
+        problem.model.level.name(),
+        problem.model.reason
+    );
     println!("energy    {}", problem.rod.energy.name());
     let eq = match solve(&problem.rod, &problem.model, &problem.options) {
         Ok(eq) => eq,

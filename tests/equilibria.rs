@@ -74,8 +74,16 @@ fn planar_and_spatial_models_agree_on_planar_scenes() {
         let planar = solve_with(&rod, ModelLevel::Planar, Method::Shooting);
         let spatial = solve_with(&rod, ModelLevel::Kirchhoff, Method::Shooting);
         for (a, b) in planar.samples.iter().zip(&spatial.samples) {
-            assert!((a.position - b.position).norm() <= 1e-10, "k = {k}, s = {}", a.s);
-            assert!((a.curvature - b.curvature).norm() <= 1e-10, "k = {k}, s = {}", a.s);
+            assert!(
+                (a.position - b.position).norm() <= 1e-10,
+                "k = {k}, s = {}",
+                a.s
+            );
+            assert!(
+                (a.curvature - b.curvature).norm() <= 1e-10,
+                "k = {k}, s = {}",
+                a.s
+            );
         }
     }
 }
@@ -89,7 +97,11 @@ fn end_couple_rolls_the_rod_into_a_circle() {
         for method in METHODS {
             let eq = solve_with(&rod, level, method);
             let tip = eq.tip();
-            assert!(tip.position.norm() <= 1e-9, "{level:?} {method:?}: tip {}", tip.position);
+            assert!(
+                tip.position.norm() <= 1e-9,
+                "{level:?} {method:?}: tip {}",
+                tip.position
+            );
             assert!((tip.directors[2] - Vector3::z()).norm() <= 1e-9);
             // A circle of radius L/2π through the clamp, centre at x = L/2π.
             let r = rod.length / TAU;
@@ -128,7 +140,11 @@ fn unloaded_rod_with_constant_intrinsic_curvature_is_a_helix() {
         let eq = solve_with(&rod, ModelLevel::Kirchhoff, method);
         for p in &eq.samples {
             let exact = helix_position(kappa0, p.s);
-            assert!((p.position - exact).norm() <= 1e-9, "{method:?} s = {}", p.s);
+            assert!(
+                (p.position - exact).norm() <= 1e-9,
+                "{method:?} s = {}",
+                p.s
+            );
         }
         assert!(eq.director_drift <= 1e-12, "drift {}", eq.director_drift);
     }
@@ -163,4 +179,48 @@ fn single_and_multiple_shooting_agree() {
             assert!((a.position - b.position).norm() <= 1e-9, "s = {}", a.s);
         }
     }
+}
+
+/// Large loads: the ramp from the unloaded rod follows the loading branch
+/// (a direct start at k = 30 can converge to a looped equilibrium).
+#[test]
+fn large_load_follows_the_loading_branch() {
+    let k = 30.0;
+    let reference = cantilever_tip(k);
+    for method in METHODS {
+        let eq = solve_with(&cantilever(k), ModelLevel::Planar, method);
+        assert!(eq.load_steps > 0, "{method:?} should ramp at k = {k}");
+        let tip = eq.tip().position;
+        assert!(
+            (tip[0] - reference.x).abs() <= 1e-9,
+            "{method:?}: x {}",
+            tip[0]
+        );
+        assert!(
+            (tip[2] - reference.z).abs() <= 1e-9,
+            "{method:?}: z {}",
+            tip[2]
+        );
+    }
+}
+
+/// At k = 100 the shooting sensitivities grow like exp(√k s) ≈ e¹⁰: single
+/// shooting must fail with a clear error, multiple shooting must succeed.
+#[test]
+fn single_shooting_fails_clearly_where_multiple_shooting_recovers() {
+    let k = 100.0;
+    let rod = cantilever(k);
+    let choice = ModelChoice::forced(&rod, ModelLevel::Planar).unwrap();
+    let err = solve(&rod, &choice, &SolverOptions::default()).unwrap_err();
+    let message = err.to_string();
+    assert!(message.contains("shooting"), "{message}");
+    assert!(
+        message.contains("stalled") || message.contains("did not converge"),
+        "{message}"
+    );
+    let reference = cantilever_tip(k);
+    let eq = solve_with(&rod, ModelLevel::Planar, METHODS[1]);
+    let tip = eq.tip().position;
+    assert!((tip[0] - reference.x).abs() <= 1e-9, "x {}", tip[0]);
+    assert!((tip[2] - reference.z).abs() <= 1e-9, "z {}", tip[2]);
 }

@@ -10,6 +10,9 @@
 //! sensitivities. After each accepted step an optional projection restores
 //! invariants (orthonormal directors).
 
+// The tableau is kept digit for digit as published (dop853.f).
+#![allow(clippy::excessive_precision)]
+
 /// Tolerances and limits of one integration.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Tolerances {
@@ -225,9 +228,17 @@ impl Dop853 {
                     observe(s, y);
                     next_stop += 1;
                 }
-                let grow = if rejected_last { factor.min(1.0) } else { factor };
+                let grow = if rejected_last {
+                    factor.min(1.0)
+                } else {
+                    factor
+                };
                 // A step shortened to land on a stop says nothing against h.
-                h = if lands && step < h { h.max(step * grow) } else { step * grow };
+                h = if lands && step < h {
+                    h.max(step * grow)
+                } else {
+                    step * grow
+                };
                 rejected_last = false;
             } else {
                 stats.rejected += 1;
@@ -279,32 +290,27 @@ impl Dop853 {
     /// goes to `next`. Stage 1 (k[0]) is f(s, y) from the previous step.
     fn stages<F: FnMut(f64, &[f64], &mut [f64])>(&mut self, f: &mut F, s: f64, h: f64, y: &[f64]) {
         for j in 1..12 {
-            for i in 0..y.len() {
-                let mut acc = 0.0;
-                for (l, a) in A[j][..j].iter().enumerate() {
-                    if *a != 0.0 {
-                        acc += a * self.k[l][i];
-                    }
+            self.stage.copy_from_slice(y);
+            for (l, &a) in A[j][..j].iter().enumerate() {
+                if a != 0.0 {
+                    axpy(&mut self.stage, h * a, &self.k[l]);
                 }
-                self.stage[i] = y[i] + h * acc;
             }
             let (_, rest) = self.k.split_at_mut(j);
             f(s + C[j] * h, &self.stage, &mut rest[0]);
         }
-        for i in 0..y.len() {
-            let mut acc = 0.0;
-            for (l, b) in B.iter().enumerate() {
-                if *b != 0.0 {
-                    acc += b * self.k[l][i];
-                }
+        self.next.copy_from_slice(y);
+        for (l, &b) in B.iter().enumerate() {
+            if b != 0.0 {
+                axpy(&mut self.next, h * b, &self.k[l]);
             }
-            self.next[i] = y[i] + h * acc;
         }
     }
 
     /// Hairer's combined error norm of DOP853: the 5th-order estimate,
     /// corrected by the 3rd-order one so that it behaves like an 8th-order
     /// error (dop853.f, "error estimation").
+    #[allow(clippy::needless_range_loop)] // i indexes y, next and 12 stages
     fn error_norm(&self, h: f64, y: &[f64], controlled: usize, tol: &Tolerances) -> f64 {
         let (mut err5, mut err3) = (0.0, 0.0);
         for i in 0..controlled {
@@ -320,6 +326,13 @@ impl Dop853 {
             deno = 1.0;
         }
         h.abs() * err5 * (1.0 / (controlled as f64 * deno)).sqrt()
+    }
+}
+
+/// y += a x.
+fn axpy(y: &mut [f64], a: f64, x: &[f64]) {
+    for (yi, xi) in y.iter_mut().zip(x) {
+        *yi += a * xi;
     }
 }
 

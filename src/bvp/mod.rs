@@ -20,7 +20,6 @@ use integrator::{IntegrationStats, Tolerances};
 use newton::{NewtonFailure, NewtonOptions};
 pub use shooting::ShootingSystem;
 
-
 /// How the BVP is discretized.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Method {
@@ -135,7 +134,9 @@ pub struct Equilibrium {
 impl Equilibrium {
     /// The sample at the tip, s = L.
     pub fn tip(&self) -> &RodSample {
-        self.samples.last().expect("an equilibrium has at least two samples")
+        self.samples
+            .last()
+            .expect("an equilibrium has at least two samples")
     }
 }
 
@@ -150,7 +151,9 @@ pub enum SolveError {
         history: String,
     },
     /// The load ramp stalled.
-    #[error("{method} with a load ramp stalled at load factor {reached:.4} (step {step:.2e}): {last}")]
+    #[error(
+        "{method} with a load ramp stalled at load factor {reached:.4} (step {step:.2e}): {last}"
+    )]
     RampStalled {
         method: &'static str,
         reached: f64,
@@ -180,7 +183,9 @@ pub fn solve(
     opts: &SolverOptions,
 ) -> Result<Equilibrium, SolveError> {
     if opts.output_points < 2 {
-        return Err(SolveError::Options("output_points must be at least 2".into()));
+        return Err(SolveError::Options(
+            "output_points must be at least 2".into(),
+        ));
     }
     let start = Instant::now();
     let mut stats = IntegrationStats::default();
@@ -223,7 +228,13 @@ pub fn solve(
 /// `n` equally spaced points on [0, L], the last exactly L.
 fn output_grid(length: f64, n: usize) -> Vec<f64> {
     (0..n)
-        .map(|i| if i + 1 == n { length } else { length * i as f64 / (n - 1) as f64 })
+        .map(|i| {
+            if i + 1 == n {
+                length
+            } else {
+                length * i as f64 / (n - 1) as f64
+            }
+        })
         .collect()
 }
 
@@ -267,7 +278,9 @@ fn guess_for_level(
     level: ModelLevel,
 ) -> Result<Vec<f64>, SolveError> {
     if g.len() != 3 {
-        return Err(SolveError::Options("initial_curvature needs three components".into()));
+        return Err(SolveError::Options(
+            "initial_curvature needs three components".into(),
+        ));
     }
     Ok(match level {
         ModelLevel::Planar => vec![g[1]],

@@ -67,7 +67,9 @@ pub enum NewtonFailure {
     #[error("the initial guess is inadmissible: {0}")]
     BadStart(IntegrationError),
     /// The Jacobian could not be factored.
-    #[error("singular Jacobian at iteration {iteration} (a fold or bifurcation, or a degenerate guess)")]
+    #[error(
+        "singular Jacobian at iteration {iteration} (a fold or bifurcation, or a degenerate guess)"
+    )]
     SingularJacobian { iteration: usize, history: Vec<f64> },
     /// No damped step reduced the residual.
     #[error("no damped step (down to λ = {min_damping}) passed the natural monotonicity test at iteration {iteration}; last trial: {last_trial}")]
@@ -79,7 +81,10 @@ pub enum NewtonFailure {
     },
     /// The iteration budget ran out.
     #[error("{iterations} iterations without reaching the tolerance")]
-    IterationLimit { iterations: usize, history: Vec<f64> },
+    IterationLimit {
+        iterations: usize,
+        history: Vec<f64>,
+    },
 }
 
 impl NewtonFailure {
@@ -95,7 +100,10 @@ impl NewtonFailure {
 }
 
 fn max_norm(r: &DVector<f64>) -> f64 {
-    r.iter().fold(0.0, |m, v| if v.is_nan() { f64::NAN } else { m.max(v.abs()) })
+    r.iter().fold(
+        0.0,
+        |m, v| if v.is_nan() { f64::NAN } else { m.max(v.abs()) },
+    )
 }
 
 /// Solves F(x) = 0 from `x0` by damped Newton.
@@ -107,7 +115,9 @@ pub fn solve<S: NonlinearSystem>(
     let n = system.size();
     let mut x = x0.to_vec();
     let (mut r, mut jac) = (DVector::zeros(n), DMatrix::zeros(n, n));
-    system.evaluate(&x, &mut r, &mut jac).map_err(NewtonFailure::BadStart)?;
+    system
+        .evaluate(&x, &mut r, &mut jac)
+        .map_err(NewtonFailure::BadStart)?;
     let (mut r_try, mut jac_try) = (DVector::zeros(n), DMatrix::zeros(n, n));
     let mut history = vec![max_norm(&r)];
     let mut damped_steps = 0;
@@ -147,7 +157,11 @@ pub fn solve<S: NonlinearSystem>(
         last_step_norm = step_norm;
         let mut lambda = 1.0;
         loop {
-            let trial: Vec<f64> = x.iter().zip(step.iter()).map(|(a, b)| a + lambda * b).collect();
+            let trial: Vec<f64> = x
+                .iter()
+                .zip(step.iter())
+                .map(|(a, b)| a + lambda * b)
+                .collect();
             let outcome = system.evaluate(&trial, &mut r_try, &mut jac_try);
             let accepted = match &outcome {
                 Ok(()) => lu
@@ -221,7 +235,10 @@ mod tests {
     #[test]
     fn singular_jacobian_is_reported() {
         let err = solve(&mut Sqrt2, &[0.0], &NewtonOptions::default()).unwrap_err();
-        assert!(matches!(err, NewtonFailure::SingularJacobian { .. }), "{err}");
+        assert!(
+            matches!(err, NewtonFailure::SingularJacobian { .. }),
+            "{err}"
+        );
     }
 
     #[test]

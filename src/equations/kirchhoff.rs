@@ -69,7 +69,9 @@ impl KirchhoffEquations {
     fn balance(&self, s: f64, st: &State) -> Balance {
         let e = &self.rod.energy;
         let h = e.stiffness(s, &st.kappa);
-        let h_inv = h.try_inverse().unwrap_or_else(|| Matrix3::from_element(f64::NAN));
+        let h_inv = h
+            .try_inverse()
+            .unwrap_or_else(|| Matrix3::from_element(f64::NAN));
         let m = e.moment(s, &st.kappa);
         let n = self.rod.loads.internal_force(s, self.rod.length);
         let body_n = Vector3::new(n.dot(&st.d1), n.dot(&st.d2), 0.0);

@@ -34,7 +34,10 @@ impl PlanarEquations {
     /// (n_x, n_z): the internal force in the clamp frame's plane.
     fn force_in_plane(&self, s: f64) -> (f64, f64) {
         let n = self.rod.loads.internal_force(s, self.rod.length);
-        (n.dot(&self.rod.clamp.director(0)), n.dot(&self.rod.clamp.director(2)))
+        (
+            n.dot(&self.rod.clamp.director(0)),
+            n.dot(&self.rod.clamp.director(2)),
+        )
     }
 
     /// (κ2', ∂κ2'/∂φ, ∂κ2'/∂κ2) at (s, φ, κ2).
@@ -110,7 +113,10 @@ impl RodEquations for PlanarEquations {
     }
 
     fn tip_residual_jacobian(&self, y: &[f64]) -> DMatrix<f64> {
-        let h22 = self.rod.energy.stiffness(self.rod.length, &Self::kappa(y[3]))[(1, 1)];
+        let h22 = self
+            .rod
+            .energy
+            .stiffness(self.rod.length, &Self::kappa(y[3]))[(1, 1)];
         DMatrix::from_row_slice(1, 4, &[0.0, 0.0, 0.0, h22])
     }
 

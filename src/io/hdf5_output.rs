@@ -68,16 +68,22 @@ pub fn write_equilibrium(
 }
 
 fn temporary_path(path: &Path) -> PathBuf {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
     path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
 }
 
 fn text(s: &str) -> hdf5::Result<VarLenUnicode> {
-    s.parse::<VarLenUnicode>().map_err(|e| hdf5::Error::from(e.to_string().as_str()))
+    s.parse::<VarLenUnicode>()
+        .map_err(|e| hdf5::Error::from(e.to_string().as_str()))
 }
 
 fn string_attr(loc: &hdf5::Location, name: &str, value: &str) -> hdf5::Result<()> {
-    loc.new_attr::<VarLenUnicode>().create(name)?.write_scalar(&text(value)?)
+    loc.new_attr::<VarLenUnicode>()
+        .create(name)?
+        .write_scalar(&text(value)?)
 }
 
 fn f64_attr(loc: &hdf5::Location, name: &str, value: f64) -> hdf5::Result<()> {
@@ -85,7 +91,9 @@ fn f64_attr(loc: &hdf5::Location, name: &str, value: f64) -> hdf5::Result<()> {
 }
 
 fn usize_attr(loc: &hdf5::Location, name: &str, value: usize) -> hdf5::Result<()> {
-    loc.new_attr::<u64>().create(name)?.write_scalar(&(value as u64))
+    loc.new_attr::<u64>()
+        .create(name)?
+        .write_scalar(&(value as u64))
 }
 
 fn vectors(
@@ -94,7 +102,10 @@ fn vectors(
     samples: &[RodSample],
     f: impl Fn(&RodSample) -> nalgebra::Vector3<f64>,
 ) -> hdf5::Result<()> {
-    let data: Vec<f64> = samples.iter().flat_map(|p| f(p).as_slice().to_vec()).collect();
+    let data: Vec<f64> = samples
+        .iter()
+        .flat_map(|p| f(p).as_slice().to_vec())
+        .collect();
     group
         .new_dataset::<f64>()
         .shape([samples.len(), 3])
@@ -105,10 +116,17 @@ fn vectors(
 fn write_file(path: &Path, eq: &Equilibrium, problem: &str) -> hdf5::Result<()> {
     let file = hdf5::File::create(path)?;
     string_attr(&file, "problem", problem)?;
-    string_attr(&file, "generator", concat!("cosserat ", env!("CARGO_PKG_VERSION")))?;
+    string_attr(
+        &file,
+        "generator",
+        concat!("cosserat ", env!("CARGO_PKG_VERSION")),
+    )?;
     let g = file.create_group("solution")?;
     let s: Vec<f64> = eq.samples.iter().map(|p| p.s).collect();
-    g.new_dataset::<f64>().shape([s.len()]).create("s")?.write_raw(&s)?;
+    g.new_dataset::<f64>()
+        .shape([s.len()])
+        .create("s")?
+        .write_raw(&s)?;
     vectors(&g, "position", &eq.samples, |p| p.position)?;
     for (i, name) in ["d1", "d2", "d3"].iter().enumerate() {
         vectors(&g, name, &eq.samples, |p| p.directors[i])?;

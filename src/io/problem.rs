@@ -319,7 +319,9 @@ fn apply_overrides(text: &str, overrides: &[String]) -> Result<String, ProblemEr
     if overrides.is_empty() {
         return Ok(text.to_string());
     }
-    let mut doc: toml::Table = text.parse().map_err(|e: toml::de::Error| ProblemError::Parse(e.to_string()))?;
+    let mut doc: toml::Table = text
+        .parse()
+        .map_err(|e: toml::de::Error| ProblemError::Parse(e.to_string()))?;
     for assignment in overrides {
         let fail = |message: &str| ProblemError::Override {
             assignment: assignment.clone(),
@@ -376,7 +378,10 @@ fn profile(field: &str, spec: &ProfileSpec) -> Result<Profile, ProblemError> {
         ProfileSpec::Constant(c) => Profile::Constant(*c),
         ProfileSpec::Polynomial { polynomial } => {
             if polynomial.is_empty() {
-                return Err(invalid(field, "a polynomial needs at least one coefficient"));
+                return Err(invalid(
+                    field,
+                    "a polynomial needs at least one coefficient",
+                ));
             }
             Profile::Polynomial(polynomial.clone())
         }
@@ -391,7 +396,7 @@ fn profile(field: &str, spec: &ProfileSpec) -> Result<Profile, ProblemError> {
                     ),
                 ));
             }
-            if s.windows(2).any(|w| !(w[1] > w[0])) {
+            if !s.windows(2).all(|w| w[1] > w[0]) {
                 return Err(invalid(format!("{field}.s"), "must be strictly increasing"));
             }
             Profile::Table {
@@ -409,7 +414,10 @@ fn profile(field: &str, spec: &ProfileSpec) -> Result<Profile, ProblemError> {
 fn build_rod(file: &ProblemFile) -> Result<Rod, ProblemError> {
     let length = finite("rod.length", file.rod.length)?;
     if length <= 0.0 {
-        return Err(invalid("rod.length", format!("must be positive, got {length}")));
+        return Err(invalid(
+            "rod.length",
+            format!("must be positive, got {length}"),
+        ));
     }
     Ok(Rod {
         length,
@@ -430,10 +438,16 @@ fn build_energy(e: &EnergySection, length: f64) -> Result<Arc<dyn StoredEnergy>,
         let field = format!("energy.stiffness[{i}]");
         stiffness[i] = profile(&field, &e.stiffness[i])?;
         let min = stiffness[i].minimum_on(length);
-        if !(min > 0.0) {
-            return Err(invalid(field, format!("must be positive on [0, L], minimum {min}")));
+        if min.is_nan() || min <= 0.0 {
+            return Err(invalid(
+                field,
+                format!("must be positive on [0, L], minimum {min}"),
+            ));
         }
-        kappa0[i] = profile(&format!("energy.intrinsic_curvature[{i}]"), &e.intrinsic_curvature[i])?;
+        kappa0[i] = profile(
+            &format!("energy.intrinsic_curvature[{i}]"),
+            &e.intrinsic_curvature[i],
+        )?;
     }
     let linear = LinearElastic {
         stiffness,
@@ -466,7 +480,10 @@ fn build_clamp(c: &ClampSection) -> Result<Clamp, ProblemError> {
     let d3 = vector("clamp.d3", c.d3)?;
     for (name, d) in [("clamp.d1", d1), ("clamp.d3", d3)] {
         if (d.norm() - 1.0).abs() > FRAME_TOLERANCE {
-            return Err(invalid(name, format!("must be a unit vector, |{name}| = {}", d.norm())));
+            return Err(invalid(
+                name,
+                format!("must be a unit vector, |{name}| = {}", d.norm()),
+            ));
         }
     }
     if d1.dot(&d3).abs() > FRAME_TOLERANCE {
@@ -497,7 +514,10 @@ fn positive(field: &str, v: f64) -> Result<f64, ProblemError> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
     } else {
-        Err(invalid(field, format!("must be a positive finite number, got {v}")))
+        Err(invalid(
+            field,
+            format!("must be a positive finite number, got {v}"),
+        ))
     }
 }
 

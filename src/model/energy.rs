@@ -27,12 +27,7 @@ pub trait StoredEnergy: std::fmt::Debug + Send + Sync {
     fn stiffness_rate(&self, s: f64, kappa: &Vector3<f64>) -> Matrix3<f64>;
     /// ∂(H(κ) v)/∂κ for a fixed vector v: the third derivative of W
     /// contracted with v (zero for quadratic energies).
-    fn stiffness_derivative(
-        &self,
-        s: f64,
-        kappa: &Vector3<f64>,
-        v: &Vector3<f64>,
-    ) -> Matrix3<f64>;
+    fn stiffness_derivative(&self, s: f64, kappa: &Vector3<f64>, v: &Vector3<f64>) -> Matrix3<f64>;
     /// True when M1 = M3 = 0 whenever κ1 = κ3 = 0, for every κ2 and s: the
     /// energy then admits planar equilibria bent about d2 (planar model).
     fn admits_planar_bending(&self) -> bool;
@@ -169,12 +164,7 @@ impl StoredEnergy for QuarticStiffening {
     }
 
     /// H₄ v = C (S v + 2 u (u·v)), so ∂(H₄ v)/∂u = 2C (v uᵀ + (u·v) I + u vᵀ).
-    fn stiffness_derivative(
-        &self,
-        s: f64,
-        kappa: &Vector3<f64>,
-        v: &Vector3<f64>,
-    ) -> Matrix3<f64> {
+    fn stiffness_derivative(&self, s: f64, kappa: &Vector3<f64>, v: &Vector3<f64>) -> Matrix3<f64> {
         let u = kappa - self.linear.kappa0(s);
         2.0 * self.quartic
             * (v * u.transpose() + Matrix3::identity() * u.dot(v) + u * v.transpose())
@@ -235,16 +225,28 @@ mod tests {
             let hess = e.stiffness(s, &kappa);
             for i in 0..3 {
                 let ei = Vector3::ith(i, 1.0);
-                let dw = (e.density(s, &(kappa + H * ei)) - e.density(s, &(kappa - H * ei)))
-                    / (2.0 * H);
+                let dw =
+                    (e.density(s, &(kappa + H * ei)) - e.density(s, &(kappa - H * ei))) / (2.0 * H);
                 assert!((dw - grad[i]).abs() < 1e-8, "{}: ∂W/∂κ{i}", e.name());
                 let dm = fd_vec(|h| e.moment(s, &(kappa + h * ei)));
-                assert!((dm - hess.column(i)).norm() < 1e-8, "{}: H col {i}", e.name());
+                assert!(
+                    (dm - hess.column(i)).norm() < 1e-8,
+                    "{}: H col {i}",
+                    e.name()
+                );
             }
             let dms = fd_vec(|h| e.moment(s + h, &kappa));
-            assert!((dms - e.moment_rate(s, &kappa)).norm() < 1e-8, "{}", e.name());
+            assert!(
+                (dms - e.moment_rate(s, &kappa)).norm() < 1e-8,
+                "{}",
+                e.name()
+            );
             let dhs = fd_mat(|h| e.stiffness(s + h, &kappa));
-            assert!((dhs - e.stiffness_rate(s, &kappa)).norm() < 1e-7, "{}", e.name());
+            assert!(
+                (dhs - e.stiffness_rate(s, &kappa)).norm() < 1e-7,
+                "{}",
+                e.name()
+            );
             let t = e.stiffness_derivative(s, &kappa, &v);
             for i in 0..3 {
                 let ei = Vector3::ith(i, 1.0);

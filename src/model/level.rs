@@ -58,9 +58,9 @@ impl ModelChoice {
     /// error naming the obstruction.
     pub fn forced(rod: &Rod, level: ModelLevel) -> Result<ModelChoice, String> {
         match (level, planar_obstruction(rod)) {
-            (ModelLevel::Planar, Some(why)) => {
-                Err(format!("the planar model cannot represent this scene: {why}"))
-            }
+            (ModelLevel::Planar, Some(why)) => Err(format!(
+                "the planar model cannot represent this scene: {why}"
+            )),
             _ => Ok(ModelChoice {
                 level,
                 reason: format!("{}: forced by the user", level.name()),

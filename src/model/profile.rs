@@ -107,7 +107,10 @@ fn locate(knots: &[f64], s: f64) -> (usize, f64) {
     if s >= knots[n - 1] {
         return (n - 2, 1.0);
     }
-    let k = knots.partition_point(|&x| x <= s).saturating_sub(1).min(n - 2);
+    let k = knots
+        .partition_point(|&x| x <= s)
+        .saturating_sub(1)
+        .min(n - 2);
     (k, (s - knots[k]) / (knots[k + 1] - knots[k]))
 }
 
