@@ -64,7 +64,9 @@ fn main() {
                     }
                     let eq = last.unwrap();
                     let tip = eq.tip().position;
-                    let err = (tip[0] - reference.x).abs().max((tip[2] - reference.z).abs());
+                    let err = (tip[0] - reference.x)
+                        .abs()
+                        .max((tip[2] - reference.z).abs());
                     println!(
                         "{:>5} {:>10} {:>18} {:>8.0e} {:>10.1e} {:>12.1} {:>6}",
                         k,

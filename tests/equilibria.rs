@@ -224,3 +224,91 @@ fn single_shooting_fails_clearly_where_multiple_shooting_recovers() {
     assert!((tip[0] - reference.x).abs() <= 1e-9, "x {}", tip[0]);
     assert!((tip[2] - reference.z).abs() <= 1e-9, "z {}", tip[2]);
 }
+
+/// A tapered cantilever, B2(s) = 2 − s (polynomial profile), under a small
+/// tip force: linear beam theory (unit-load method) gives the deflection
+/// δ = F ∫₀¹ (1 − s)²/(2 − s) ds = F (ln 2 − ½); the nonlinear correction
+/// is O(F²) relative.
+#[test]
+fn tapered_cantilever_matches_linear_beam_theory() {
+    use cosserat::model::Profile;
+    let force = 1e-4;
+    let energy = LinearElastic {
+        stiffness: [
+            Profile::Constant(10.0),
+            Profile::Polynomial(vec![2.0, -1.0]),
+            Profile::Constant(10.0),
+        ],
+        intrinsic_curvature: Default::default(),
+    };
+    let mut rod = cantilever(force);
+    rod.energy = Arc::new(energy);
+    let mut opts = SolverOptions::default();
+    opts.newton.tolerance = 1e-14;
+    let eq = solve(&rod, &ModelChoice::for_rod(&rod), &opts).unwrap();
+    let exact = force * (2f64.ln() - 0.5);
+    let rel = (eq.tip().position[0] - exact).abs() / exact;
+    assert!(rel <= 1e-6, "relative error {rel}");
+}
+
+/// An unloaded rod whose intrinsic curvature κ⁰2 is a piecewise-linear
+/// table takes its intrinsic shape: φ = ∫κ⁰2 (piecewise quadratic, exact),
+/// tip = ∫ (sin φ, cos φ) by composite Simpson with the knot as a panel
+/// boundary.
+#[test]
+fn tabulated_intrinsic_curvature_gives_its_intrinsic_shape() {
+    use cosserat::model::Profile;
+    let (knots, values) = ([0.0, 0.4, 1.0], [0.0, 3.0, -1.0]);
+    let energy = LinearElastic {
+        stiffness: [1.0, 1.0, 1.0].map(Profile::Constant),
+        intrinsic_curvature: [
+            Profile::Constant(0.0),
+            Profile::Table {
+                s: knots.to_vec(),
+                values: values.to_vec(),
+            },
+            Profile::Constant(0.0),
+        ],
+    };
+    let mut rod = cantilever(0.0);
+    rod.energy = Arc::new(energy);
+    // φ(s) exactly: integral of the linear interpolant.
+    let phi = |s: f64| {
+        let mut acc = 0.0;
+        for i in 0..2 {
+            let (a, b) = (knots[i], knots[i + 1]);
+            let t = s.clamp(a, b) - a;
+            let slope = (values[i + 1] - values[i]) / (b - a);
+            acc += values[i] * t + 0.5 * slope * t * t;
+        }
+        acc
+    };
+    let simpson = |f: &dyn Fn(f64) -> f64, a: f64, b: f64| {
+        let n = 2000;
+        let h = (b - a) / n as f64;
+        (0..=n)
+            .map(|i| {
+                let w = if i == 0 || i == n {
+                    1.0
+                } else if i % 2 == 1 {
+                    4.0
+                } else {
+                    2.0
+                };
+                w * f(a + h * i as f64)
+            })
+            .sum::<f64>()
+            * h
+            / 3.0
+    };
+    let x = simpson(&|s| phi(s).sin(), 0.0, 0.4) + simpson(&|s| phi(s).sin(), 0.4, 1.0);
+    let z = simpson(&|s| phi(s).cos(), 0.0, 0.4) + simpson(&|s| phi(s).cos(), 0.4, 1.0);
+    for level in LEVELS {
+        let eq = solve_with(&rod, level, Method::Shooting);
+        let tip = eq.tip().position;
+        assert!(
+            (tip[0] - x).abs() <= 1e-9 && (tip[2] - z).abs() <= 1e-9,
+            "{level:?}: {tip}"
+        );
+    }
+}
