@@ -87,6 +87,18 @@ fn run_solve(path: PathBuf, output: Option<PathBuf>, set: &[String], force: bool
         Err(e) => return fail(2, e),
     };
     report(&eq);
+    let tolerance = problem.options.newton.tolerance;
+    if eq.residual.is_nan() || eq.residual > tolerance {
+        // Belt and braces: solve() returns only converged results, but a
+        // result whose residual exceeds the tolerance is never written.
+        return fail(
+            2,
+            format!(
+                "residual {:.3e} exceeds the tolerance {tolerance:.1e}",
+                eq.residual
+            ),
+        );
+    }
     if let Some(out) = output {
         if let Err(e) = write_equilibrium(&out, &eq, &problem.text, force) {
             return fail(1, e);

@@ -247,3 +247,13 @@ fn solution_file_follows_the_contract() {
     assert!(m.iter().zip(&k).all(|(m, k)| (m - k).abs() < 1e-15));
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+#[test]
+fn impossible_tolerance_is_an_error_not_a_result() {
+    rejects(
+        "impossible-tolerance",
+        CANTILEVER,
+        &["--set", "solver.tolerance=1e-30"],
+        &["did not converge"],
+    );
+}

@@ -312,3 +312,52 @@ fn tabulated_intrinsic_curvature_gives_its_intrinsic_shape() {
         );
     }
 }
+
+/// A singular energy Hessian (zero torsional stiffness, built in code where
+/// the problem-file checks do not apply) is a typed error naming the cause.
+#[test]
+fn singular_energy_hessian_is_a_typed_error() {
+    let mut rod = cantilever(1.0);
+    rod.energy = Arc::new(LinearElastic::uniform([1.0, 1.0, 0.0], [0.0; 3]));
+    let err = solve(&rod, &ModelChoice::for_rod(&rod), &SolverOptions::default()).unwrap_err();
+    assert!(matches!(err, cosserat::bvp::SolveError::Model(_)), "{err}");
+    assert!(err.to_string().contains("not positive definite"), "{err}");
+}
+
+/// Loads so large that no method converges within its budget: a typed
+/// error, never a result.
+#[test]
+fn hopeless_load_is_an_error() {
+    let rod = cantilever(1e5);
+    let opts = SolverOptions {
+        method: Method::MultipleShooting { segments: 4 },
+        integration: cosserat::bvp::integrator::Tolerances {
+            max_steps: 2000,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let err = solve(&rod, &ModelChoice::for_rod(&rod), &opts).unwrap_err();
+    assert!(
+        matches!(err, cosserat::bvp::SolveError::RampStalled { .. }),
+        "{err}"
+    );
+}
+
+/// The same input gives bit-identical output.
+#[test]
+fn solves_are_bit_reproducible() {
+    let rod = cantilever(3.0);
+    let run = || {
+        solve_with(
+            &rod,
+            ModelLevel::Kirchhoff,
+            Method::MultipleShooting { segments: 8 },
+        )
+    };
+    let (a, b) = (run(), run());
+    for (p, q) in a.samples.iter().zip(&b.samples) {
+        assert_eq!(p, q);
+    }
+    assert_eq!(a.residual_history, b.residual_history);
+}
