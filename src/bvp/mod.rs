@@ -8,14 +8,20 @@
 //! ([`Equilibrium`]) — the problem / algorithm / solve split of
 //! DifferentialEquations.jl.
 
+mod collocation;
 pub mod integrator;
 pub mod newton;
 mod shooting;
 
 use std::time::Instant;
 
+use nalgebra::DMatrix;
+
 use crate::equations::{KirchhoffEquations, PlanarEquations, RodEquations, RodSample};
 use crate::model::{ModelChoice, ModelLevel, Rod};
+pub use collocation::{
+    solve_collocation, CollocationError, CollocationOptions, CollocationSolution,
+};
 use integrator::{IntegrationStats, Tolerances};
 use newton::{NewtonFailure, NewtonOptions};
 pub use shooting::ShootingSystem;
@@ -115,6 +121,12 @@ pub struct Equilibrium {
     pub samples: Vec<RodSample>,
     /// The free initial values at the solution (κ(0) components).
     pub clamp_curvature: Vec<f64>,
+    /// The full vector of shooting unknowns (κ(0) and the interior node
+    /// states of multiple shooting): enough to re-integrate the solution.
+    pub unknowns: Vec<f64>,
+    /// The scaled shooting Jacobian at the solution; singular exactly where
+    /// the linearized BVP is (folds and branch points).
+    pub jacobian: DMatrix<f64>,
     /// Newton steps of the final solve.
     pub iterations: usize,
     /// Scaled residual (max-norm) at every Newton iterate of the final solve.
@@ -137,6 +149,23 @@ impl Equilibrium {
         self.samples
             .last()
             .expect("an equilibrium has at least two samples")
+    }
+
+    /// The solution at other points (sorted, in [0, L]), re-integrated from
+    /// the converged unknowns with the tolerances in `opts`; used by the
+    /// stability analysis at its quadrature points.
+    pub fn resample(
+        &self,
+        rod: &Rod,
+        opts: &SolverOptions,
+        points: &[f64],
+    ) -> Result<Vec<RodSample>, SolveError> {
+        let eq = equations(rod, self.model.level);
+        let mut sys = ShootingSystem::new(eq.as_ref(), self.method.segments(), opts.integration);
+        let (samples, _) = sys
+            .sample(&self.unknowns, points)
+            .map_err(SolveError::Sampling)?;
+        Ok(samples)
     }
 }
 
@@ -219,6 +248,8 @@ pub fn solve(
         method: opts.method,
         samples,
         clamp_curvature: sys.free_values(&x).to_vec(),
+        unknowns: x.clone(),
+        jacobian: report.jacobian.clone(),
         iterations: report.iterations,
         residual: *report.history.last().unwrap_or(&f64::NAN),
         residual_history: report.history,

@@ -31,13 +31,7 @@ pub struct ShootingSystem<'a> {
 impl<'a> ShootingSystem<'a> {
     /// K ≥ 1 segments of equal length.
     pub fn new(eq: &'a dyn RodEquations, segments: usize, tol: Tolerances) -> Self {
-        let l = eq.length();
-        let scales = eq
-            .straight_state(l)
-            .iter()
-            .enumerate()
-            .map(|(i, _)| state_scale(eq, i))
-            .collect();
+        let scales = eq.state_scales();
         ShootingSystem {
             eq,
             segments: segments.max(1),
@@ -184,33 +178,11 @@ impl<'a> ShootingSystem<'a> {
             )?;
             self.stats += stats;
         }
-        let drift = samples.iter().map(director_drift).fold(0.0, f64::max);
+        let drift = samples
+            .iter()
+            .map(RodSample::director_drift)
+            .fold(0.0, f64::max);
         Ok((samples, drift))
-    }
-}
-
-/// max |d_i·d_j − δ_ij| at one sample.
-fn director_drift(p: &RodSample) -> f64 {
-    let mut worst: f64 = 0.0;
-    for i in 0..3 {
-        for j in 0..3 {
-            let delta = if i == j { 1.0 } else { 0.0 };
-            worst = worst.max((p.directors[i].dot(&p.directors[j]) - delta).abs());
-        }
-    }
-    worst
-}
-
-/// A typical magnitude of state component i, to make matching residuals
-/// dimensionless: lengths by L, curvatures by 1/L, angles and directors by 1.
-fn state_scale(eq: &dyn RodEquations, i: usize) -> f64 {
-    let l = eq.length();
-    match (eq.dim(), i) {
-        (4, 0 | 1) => l,
-        (4, 3) => 1.0 / l,
-        (12, 6..=8) => 1.0 / l,
-        (12, 9..=11) => l,
-        _ => 1.0,
     }
 }
 

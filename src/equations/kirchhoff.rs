@@ -259,4 +259,12 @@ impl RodEquations for KirchhoffEquations {
     fn moment_scale(&self) -> f64 {
         self.rod.moment_scale()
     }
+
+    fn state_scales(&self) -> Vec<f64> {
+        let l = self.rod.length;
+        let mut scales = vec![1.0; 12];
+        scales[6..9].fill(1.0 / l);
+        scales[9..12].fill(l);
+        scales
+    }
 }

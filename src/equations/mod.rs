@@ -76,4 +76,22 @@ pub trait RodEquations: Send + Sync {
     fn straight_state(&self, s: f64) -> Vec<f64>;
     /// A moment scale (N·m) that makes residuals dimensionless.
     fn moment_scale(&self) -> f64;
+    /// A typical magnitude of each state component, to make matching and
+    /// collocation residuals dimensionless: lengths L, curvatures 1/L,
+    /// angles and directors 1.
+    fn state_scales(&self) -> Vec<f64>;
+}
+
+impl RodSample {
+    /// max |d_i·d_j − δ_ij|: how far the directors are from orthonormal.
+    pub fn director_drift(&self) -> f64 {
+        let mut worst: f64 = 0.0;
+        for i in 0..3 {
+            for j in 0..3 {
+                let delta = if i == j { 1.0 } else { 0.0 };
+                worst = worst.max((self.directors[i].dot(&self.directors[j]) - delta).abs());
+            }
+        }
+        worst
+    }
 }

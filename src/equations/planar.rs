@@ -167,6 +167,11 @@ impl RodEquations for PlanarEquations {
     fn moment_scale(&self) -> f64 {
         self.rod.moment_scale()
     }
+
+    fn state_scales(&self) -> Vec<f64> {
+        let l = self.rod.length;
+        vec![l, l, 1.0, 1.0 / l]
+    }
 }
 
 /// The moment at the clamp, m(0) = C + (r(L) − r(0)) × P + ∫ (r − r(0)) × f,
