@@ -10,3 +10,4 @@ pub mod bvp;
 pub mod equations;
 pub mod io;
 pub mod model;
+pub mod stability;

@@ -13,8 +13,11 @@ use std::path::{Path, PathBuf};
 
 use hdf5::types::VarLenUnicode;
 
+use nalgebra::Vector3;
+
 use crate::bvp::Equilibrium;
 use crate::equations::RodSample;
+use crate::stability::{Block, CriticalLoad, Stability};
 
 /// Why a result could not be written.
 #[derive(Debug, thiserror::Error)]
@@ -48,12 +51,59 @@ pub fn write_equilibrium(
     problem: &str,
     force: bool,
 ) -> Result<(), OutputError> {
+    write_atomically(path, force, |file| {
+        root_attributes(file, problem)?;
+        write_solution(file, eq)
+    })
+}
+
+/// Writes a stability analysis (with its equilibrium, or the critical load
+/// of a fixed shape) to `path` atomically.
+pub fn write_stability(
+    path: &Path,
+    problem: &str,
+    result: &StabilityResult,
+    force: bool,
+) -> Result<(), OutputError> {
+    write_atomically(path, force, |file| {
+        root_attributes(file, problem)?;
+        match result {
+            StabilityResult::Equilibrium(eq, stability) => {
+                write_solution(file, eq)?;
+                write_spectrum(file, stability)
+            }
+            StabilityResult::FixedShape(critical) => write_critical_load(file, critical),
+        }
+    })
+}
+
+/// What `cosserat stability` computed.
+#[derive(Debug, Clone)]
+pub enum StabilityResult {
+    /// An equilibrium and its spectrum.
+    Equilibrium(Box<Equilibrium>, Stability),
+    /// The critical load of a fixed loaded shape.
+    FixedShape(CriticalLoad),
+}
+
+/// Runs `write` on a temporary file next to `path` and renames it into
+/// place; removes the temporary on any failure.
+fn write_atomically(
+    path: &Path,
+    force: bool,
+    write: impl FnOnce(&hdf5::File) -> hdf5::Result<()>,
+) -> Result<(), OutputError> {
     check_target(path, force)?;
     let tmp = temporary_path(path);
-    let result = write_file(&tmp, eq, problem).map_err(|e| OutputError::Hdf5 {
-        path: path.display().to_string(),
-        message: e.to_string(),
-    });
+    let result = hdf5::File::create(&tmp)
+        .and_then(|file| {
+            write(&file)?;
+            file.flush()
+        })
+        .map_err(|e| OutputError::Hdf5 {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        });
     if let Err(e) = result {
         let _ = std::fs::remove_file(&tmp);
         return Err(e);
@@ -113,20 +163,27 @@ fn vectors(
         .write_raw(&data)
 }
 
-fn write_file(path: &Path, eq: &Equilibrium, problem: &str) -> hdf5::Result<()> {
-    let file = hdf5::File::create(path)?;
-    string_attr(&file, "problem", problem)?;
+fn root_attributes(file: &hdf5::File, problem: &str) -> hdf5::Result<()> {
+    string_attr(file, "problem", problem)?;
     string_attr(
-        &file,
+        file,
         "generator",
         concat!("cosserat ", env!("CARGO_PKG_VERSION")),
-    )?;
+    )
+}
+
+fn array(group: &hdf5::Group, name: &str, shape: &[usize], data: &[f64]) -> hdf5::Result<()> {
+    group
+        .new_dataset::<f64>()
+        .shape(shape)
+        .create(name)?
+        .write_raw(data)
+}
+
+fn write_solution(file: &hdf5::File, eq: &Equilibrium) -> hdf5::Result<()> {
     let g = file.create_group("solution")?;
     let s: Vec<f64> = eq.samples.iter().map(|p| p.s).collect();
-    g.new_dataset::<f64>()
-        .shape([s.len()])
-        .create("s")?
-        .write_raw(&s)?;
+    array(&g, "s", &[s.len()], &s)?;
     vectors(&g, "position", &eq.samples, |p| p.position)?;
     for (i, name) in ["d1", "d2", "d3"].iter().enumerate() {
         vectors(&g, name, &eq.samples, |p| p.directors[i])?;
@@ -135,10 +192,7 @@ fn write_file(path: &Path, eq: &Equilibrium, problem: &str) -> hdf5::Result<()> 
     vectors(&g, "moment", &eq.samples, |p| p.moment)?;
     vectors(&g, "force", &eq.samples, |p| p.force)?;
     let h = &eq.residual_history;
-    g.new_dataset::<f64>()
-        .shape([h.len()])
-        .create("residual_history")?
-        .write_raw(h)?;
+    array(&g, "residual_history", &[h.len()], h)?;
     string_attr(&g, "model", eq.model.level.name())?;
     string_attr(&g, "model_reason", &eq.model.reason)?;
     string_attr(&g, "method", eq.method.name())?;
@@ -148,7 +202,76 @@ fn write_file(path: &Path, eq: &Equilibrium, problem: &str) -> hdf5::Result<()> 
     usize_attr(&g, "load_steps", eq.load_steps)?;
     f64_attr(&g, "director_drift", eq.director_drift)?;
     f64_attr(&g, "wall_time", eq.wall_time)?;
-    usize_attr(&g, "integration_steps", eq.integration.accepted)?;
-    file.flush()?;
+    usize_attr(&g, "integration_steps", eq.integration.accepted)
+}
+
+/// Modes as (count × nodes × 3).
+fn modes(
+    group: &hdf5::Group,
+    name: &str,
+    modes: &[&Vec<Vector3<f64>>],
+    nodes: usize,
+) -> hdf5::Result<()> {
+    let data: Vec<f64> = modes
+        .iter()
+        .flat_map(|m| m.iter().flat_map(|w| w.as_slice().to_vec()))
+        .collect();
+    array(group, name, &[modes.len(), nodes, 3], &data)
+}
+
+fn write_spectrum(file: &hdf5::File, st: &Stability) -> hdf5::Result<()> {
+    let g = file.create_group("stability")?;
+    let n = st.nodes.len();
+    array(&g, "nodes", &[n], &st.nodes)?;
+    let mut all: Vec<(f64, &Vec<Vector3<f64>>)> = st
+        .blocks
+        .iter()
+        .flat_map(|b| b.eigenvalues.iter().copied().zip(b.modes.iter()))
+        .collect();
+    all.sort_by(|a, b| a.0.total_cmp(&b.0));
+    all.truncate(st.blocks.first().map_or(0, |b| b.eigenvalues.len()));
+    let values: Vec<f64> = all.iter().map(|a| a.0).collect();
+    array(&g, "eigenvalues", &[values.len()], &values)?;
+    modes(
+        &g,
+        "eigenvectors",
+        &all.iter().map(|a| a.1).collect::<Vec<_>>(),
+        n,
+    )?;
+    usize_attr(&g, "morse_index", st.morse_index)?;
+    g.new_dataset::<u64>()
+        .create("morse_index")?
+        .write_scalar(&(st.morse_index as u64))?;
+    string_attr(&g, "verdict", if st.stable { "stable" } else { "unstable" })?;
+    for b in st.blocks.iter().filter(|b| b.block != Block::Full) {
+        let sub = g.create_group(b.block.name())?;
+        array(&sub, "eigenvalues", &[b.eigenvalues.len()], &b.eigenvalues)?;
+        modes(&sub, "eigenvectors", &b.modes.iter().collect::<Vec<_>>(), n)?;
+        sub.new_dataset::<u64>()
+            .create("morse_index")?
+            .write_scalar(&(b.morse_index as u64))?;
+    }
+    Ok(())
+}
+
+fn write_critical_load(file: &hdf5::File, c: &CriticalLoad) -> hdf5::Result<()> {
+    let g = file.create_group("stability")?;
+    let n = c.nodes.len();
+    array(&g, "nodes", &[n], &c.nodes)?;
+    g.new_dataset::<f64>()
+        .create("critical_load")?
+        .write_scalar(&c.gamma.unwrap_or(f64::INFINITY))?;
+    g.new_dataset::<f64>()
+        .create("load_factor")?
+        .write_scalar(&c.load_factor.unwrap_or(f64::INFINITY))?;
+    for (block, factor, mode) in &c.blocks {
+        let sub = g.create_group(block.name())?;
+        sub.new_dataset::<f64>()
+            .create("load_factor")?
+            .write_scalar(&factor.unwrap_or(f64::INFINITY))?;
+        if !mode.is_empty() {
+            modes(&sub, "null_vector", &[mode], n)?;
+        }
+    }
     Ok(())
 }

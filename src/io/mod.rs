@@ -4,5 +4,7 @@
 mod hdf5_output;
 mod problem;
 
-pub use hdf5_output::{check_target, write_equilibrium, OutputError};
+pub use hdf5_output::{
+    check_target, write_equilibrium, write_stability, OutputError, StabilityResult,
+};
 pub use problem::{Problem, ProblemError, ProblemFile, ProfileSpec};

@@ -20,6 +20,7 @@ use crate::model::{
     Clamp, DeadLoads, LinearElastic, ModelChoice, ModelLevel, Profile, QuarticStiffening, Rod,
     StoredEnergy,
 };
+use crate::stability::{FixedShape, StabilityOptions};
 
 /// Why a problem could not be read.
 #[derive(Debug, thiserror::Error)]
@@ -65,6 +66,52 @@ pub struct ProblemFile {
     /// How to solve.
     #[serde(default)]
     pub solver: SolverSection,
+    /// A loaded shape held fixed (paper Sec. 3): κ⁰ then follows from the
+    /// load.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shape: Option<ShapeSection>,
+    /// How the second variation is discretized.
+    #[serde(default)]
+    pub stability: StabilitySection,
+}
+
+/// `[shape]`.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ShapeSection {
+    /// φ(s) (rad), from d3(0) towards d1(0), in the plane of d1(0), d3(0).
+    pub turning_angle: ProfileSpec,
+}
+
+/// `[stability]`.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct StabilitySection {
+    /// Finite elements.
+    #[serde(default = "default_elements")]
+    pub elements: usize,
+    /// Lagrange order (1 to 3).
+    #[serde(default = "default_order")]
+    pub order: usize,
+    /// Lowest eigenvalues reported per block.
+    #[serde(default = "default_eigenvalues")]
+    pub eigenvalues: usize,
+}
+
+fn default_elements() -> usize {
+    100
+}
+fn default_order() -> usize {
+    2
+}
+fn default_eigenvalues() -> usize {
+    4
+}
+
+impl Default for StabilitySection {
+    fn default() -> Self {
+        toml::from_str("").expect("every stability key has a default")
+    }
 }
 
 /// `[rod]`.
@@ -283,6 +330,10 @@ pub struct Problem {
     /// The effective problem text (with overrides applied), stored with
     /// results.
     pub text: String,
+    /// The fixed loaded shape of a fixed-shape scene.
+    pub shape: Option<FixedShape>,
+    /// The discretization of the second variation.
+    pub stability: StabilityOptions,
 }
 
 impl Problem {
@@ -303,11 +354,15 @@ impl Problem {
         let rod = build_rod(&file)?;
         let model = choose_model(&rod, &file.solver.model)?;
         let options = build_options(&file.solver)?;
+        let shape = build_shape(&file)?;
+        let stability = build_stability(&file.stability)?;
         Ok(Problem {
             rod,
             model,
             options,
             text,
+            shape,
+            stability,
         })
     }
 }
@@ -508,6 +563,57 @@ fn choose_model(rod: &Rod, model: &str) -> Result<ModelChoice, ProblemError> {
         }
     };
     ModelChoice::forced(rod, level).map_err(|m| invalid("solver.model", m))
+}
+
+fn build_shape(file: &ProblemFile) -> Result<Option<FixedShape>, ProblemError> {
+    let Some(shape) = &file.shape else {
+        return Ok(None);
+    };
+    let turning_angle = profile("shape.turning_angle", &shape.turning_angle)?;
+    if file.energy.kind != "linear" {
+        return Err(invalid(
+            "shape",
+            "a fixed-shape scene needs energy.kind = \"linear\" (K is then linear in the load)",
+        ));
+    }
+    if file
+        .energy
+        .intrinsic_curvature
+        .iter()
+        .any(|p| *p != ProfileSpec::Constant(0.0))
+    {
+        return Err(invalid(
+            "energy.intrinsic_curvature",
+            "a fixed-shape scene derives κ⁰ from the shape and the load (paper (43)); remove it",
+        ));
+    }
+    if file.loads.tip_couple != [0.0; 3] {
+        return Err(invalid(
+            "loads.tip_couple",
+            "a fixed-shape scene takes forces only",
+        ));
+    }
+    Ok(Some(FixedShape { turning_angle }))
+}
+
+fn build_stability(s: &StabilitySection) -> Result<StabilityOptions, ProblemError> {
+    if s.elements < 1 {
+        return Err(invalid("stability.elements", "must be at least 1"));
+    }
+    if !(1..=3).contains(&s.order) {
+        return Err(invalid(
+            "stability.order",
+            format!("must be 1, 2 or 3, got {}", s.order),
+        ));
+    }
+    if s.eigenvalues < 1 {
+        return Err(invalid("stability.eigenvalues", "must be at least 1"));
+    }
+    Ok(StabilityOptions {
+        elements: s.elements,
+        order: s.order,
+        eigenvalues: s.eigenvalues,
+    })
 }
 
 fn positive(field: &str, v: f64) -> Result<f64, ProblemError> {

@@ -33,6 +33,12 @@ pub trait StoredEnergy: std::fmt::Debug + Send + Sync {
     fn admits_planar_bending(&self) -> bool;
     /// A short name for reports ("linear", "quartic", ...).
     fn name(&self) -> &str;
+    /// True when H does not depend on κ or on κ⁰ (a quadratic energy in
+    /// κ − κ⁰): the second variation of a fixed shape is then linear in
+    /// the load (paper Sec. 2.5).
+    fn is_quadratic(&self) -> bool {
+        false
+    }
 }
 
 /// The linear-elastic energy with intrinsic curvature,
@@ -105,6 +111,10 @@ impl StoredEnergy for LinearElastic {
 
     fn name(&self) -> &str {
         "linear"
+    }
+
+    fn is_quadratic(&self) -> bool {
+        true
     }
 }
 

@@ -1,0 +1,163 @@
+//! Stability: the second variation of the potential energy at an
+//! equilibrium (paper Sec. 2.1, 2.5, eqs. (23), (45), (50), (51)),
+//! discretized by finite elements as a banded matrix K; its lowest
+//! eigenvalues, its inertia (Morse index) and a verdict; and the critical
+//! load of a fixed loaded shape, where K(λ) = K0 + λK1 is linear in the load
+//! factor and λ_crit is a generalized eigenvalue (no root finder).
+
+pub mod banded;
+pub mod eigen;
+mod fixed_shape;
+mod second_variation;
+
+pub use fixed_shape::{critical_load, CriticalLoad, FixedShape};
+pub use second_variation::{Block, FiniteElements, FormCoefficients};
+
+use nalgebra::Vector3;
+
+use crate::bvp::{Equilibrium, SolveError, SolverOptions};
+use crate::equations::RodSample;
+use crate::model::{ModelLevel, Rod};
+use eigen::{count_below, lowest_eigenpairs, EigenError};
+
+/// How the second variation is discretized and how much of its spectrum is
+/// computed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StabilityOptions {
+    /// Number of finite elements.
+    pub elements: usize,
+    /// Lagrange order of the elements (1 to 3); eigenvalues converge at
+    /// order 2p.
+    pub order: usize,
+    /// Number of lowest eigenvalues reported per block.
+    pub eigenvalues: usize,
+}
+
+impl Default for StabilityOptions {
+    fn default() -> Self {
+        StabilityOptions {
+            elements: 100,
+            order: 2,
+            eigenvalues: 4,
+        }
+    }
+}
+
+/// Why a stability analysis failed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum StabilityError {
+    /// The loads have no potential (a dead tip couple in space).
+    #[error("not conservative: {0}")]
+    NonConservative(String),
+    /// The equilibrium could not be resampled.
+    #[error(transparent)]
+    Solve(#[from] SolveError),
+    /// The eigensolver failed.
+    #[error(transparent)]
+    Eigen(#[from] EigenError),
+    /// A fixed-shape scene the method does not cover.
+    #[error("fixed shape: {0}")]
+    FixedShape(String),
+}
+
+/// The spectrum of one block of K.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BlockSpectrum {
+    /// Which components of ω.
+    pub block: Block,
+    /// The lowest eigenvalues of K v = λ G v (G the L² Gram matrix).
+    pub eigenvalues: Vec<f64>,
+    /// The eigenvectors as nodal rotations ω(s_i) (body components).
+    pub modes: Vec<Vec<Vector3<f64>>>,
+    /// The number of negative eigenvalues of K (its inertia).
+    pub morse_index: usize,
+}
+
+/// The stability of an equilibrium.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Stability {
+    /// One block (spatial scenes) or the in-plane and out-of-plane blocks
+    /// (planar scenes, paper (50)/(51)).
+    pub blocks: Vec<BlockSpectrum>,
+    /// The Morse index of K (sum over blocks).
+    pub morse_index: usize,
+    /// K positive definite.
+    pub stable: bool,
+    /// The finite-element nodes.
+    pub nodes: Vec<f64>,
+}
+
+/// The quadratic-form coefficients at equilibrium samples.
+pub fn coefficients(rod: &Rod, samples: &[RodSample]) -> Vec<FormCoefficients> {
+    samples
+        .iter()
+        .map(|p| {
+            let frame = nalgebra::Matrix3::from_columns(&p.directors);
+            let body_force = frame.transpose() * p.force;
+            let h = rod.energy.stiffness(p.s, &p.curvature);
+            FormCoefficients::at(&h, &p.curvature, &p.moment, &body_force)
+        })
+        .collect()
+}
+
+/// The spectrum and inertia of K for one block.
+pub fn block_spectrum(
+    fe: &FiniteElements,
+    coeffs: &[FormCoefficients],
+    block: Block,
+    count: usize,
+) -> Result<BlockSpectrum, StabilityError> {
+    let k = fe.stiffness(coeffs, block);
+    let g = fe.mass(block);
+    let pairs = lowest_eigenpairs(&k, &g, count)?;
+    Ok(BlockSpectrum {
+        block,
+        eigenvalues: pairs.values,
+        modes: pairs
+            .vectors
+            .iter()
+            .map(|v| fe.nodal_rotations(block, v))
+            .collect(),
+        morse_index: count_below(&k, &g, 0.0),
+    })
+}
+
+/// Rejects loads without a potential: a dead couple on a spatial rod.
+fn check_conservative(rod: &Rod) -> Result<(), StabilityError> {
+    if rod.loads.tip_couple.norm() > 0.0 {
+        return Err(StabilityError::NonConservative(
+            "a dead tip couple has no potential for spatial rotations, so the second \
+             variation does not decide stability; remove loads.tip_couple"
+                .into(),
+        ));
+    }
+    Ok(())
+}
+
+/// The stability of an equilibrium of `rod` (from [`crate::bvp::solve`]).
+pub fn analyze(
+    rod: &Rod,
+    eq: &Equilibrium,
+    solver: &SolverOptions,
+    opts: &StabilityOptions,
+) -> Result<Stability, StabilityError> {
+    check_conservative(rod)?;
+    let fe = FiniteElements::new(rod.length, opts.elements, opts.order);
+    let samples = eq.resample(rod, solver, &fe.quadrature_points())?;
+    let coeffs = coefficients(rod, &samples);
+    let blocks = match eq.model.level {
+        ModelLevel::Planar => vec![Block::InPlane, Block::OutOfPlane],
+        ModelLevel::Kirchhoff => vec![Block::Full],
+    };
+    let blocks = blocks
+        .into_iter()
+        .map(|b| block_spectrum(&fe, &coeffs, b, opts.eigenvalues))
+        .collect::<Result<Vec<_>, _>>()?;
+    let morse_index = blocks.iter().map(|b| b.morse_index).sum();
+    Ok(Stability {
+        blocks,
+        morse_index,
+        stable: morse_index == 0,
+        nodes: fe.nodes(),
+    })
+}

@@ -1,0 +1,296 @@
+//! The second variation of the potential energy of a Kirchhoff rod under
+//! dead forces, for any stored energy, and its finite-element
+//! discretization.
+//!
+//! # Derivation
+//!
+//! Perturb the frame by a rotation field in body components,
+//! R_ε = R exp(ε ω̂), ω(0) = 0 at the clamp. With the Lie-group expansions
+//! exp(−εω̂) κ̂ exp(εω̂) = (κ − ε ω×κ + ½ε² ω×(ω×κ))^ and
+//! exp(−εω̂)(exp εω̂)' = (εω' − ½ε² ω×ω')^ + O(ε³), the curvature of R_ε is
+//!
+//!   κ_ε = κ + ε (ω' + κ×ω) + ε² (½ ω×(ω×κ) − ½ ω×ω') + O(ε³),
+//!
+//! and the tangent is d3_ε = R (e3 + ε ω×e3 + ½ε² ω×(ω×e3)) + O(ε³).
+//! The potential energy with dead forces is
+//! V = ∫ W(s, κ) ds − ∫ n·r' ds + const (n = P + ∫_s^L f, integration by
+//! parts), so with N = Rᵀn the body force,
+//!
+//!   δ²V = ∫ (ω' + κ×ω)ᵀ H (ω' + κ×ω) + M·(ω×(ω×κ)) − M·(ω×ω')
+//!           − N·(ω×(ω×e3)) ds,
+//!
+//! H = ∂²W/∂κ², M = ∂W/∂κ. At an equilibrium this does not depend on how
+//! the second-order part of the perturbation is chosen.
+//!
+//! For the linear energy at a planar equilibrium (κ = κ2 e2, M = M2 e2,
+//! N = (F cos φ, 0, F sin φ)) and ω = (ψ, ζ, χ) this is the paper's (45):
+//! B1(ψ' + κ2χ)² + B2ζ'² + B3(χ' − κ2ψ)² + F(−ψχ cos φ + (ζ² + ψ²) sin φ)
+//! plus M2(ψχ' − χψ' − κ2ψ² − κ2χ²). The printed (45) has +χ²κ2 in the
+//! last term; the term M·(ω×(ω×κ)) = −M2κ2(ψ² + χ²) is symmetric in ψ and
+//! χ, and tests/stability.rs shows that only the symmetric form is singular
+//! where the shooting Jacobian is. The in-plane part (ζ) and the
+//! out-of-plane part (ψ, χ) decouple: the paper's (50) and (51).
+//!
+//! # Discretization
+//!
+//! Lagrange finite elements of order p (1 to 3) on a uniform mesh, Gauss
+//! quadrature with p + 1 points, nodal unknowns ω at every node but the
+//! clamp. q = ω'ᵀAω' + 2ω'ᵀBω + ωᵀCω gives K; the L² Gram matrix G makes
+//! the eigenvalues of K v = λ G v converge to those of the continuous form
+//! (at order 2p).
+
+use nalgebra::{Matrix3, Vector3};
+
+use super::banded::SymmetricBanded;
+
+/// The coefficients of the quadratic form at one point:
+/// q(ω, ω') = ω'ᵀAω' + 2ω'ᵀBω + ωᵀCω.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FormCoefficients {
+    /// A = H.
+    pub a: Matrix3<f64>,
+    /// B = H[κ]× − ½[M]×.
+    pub b: Matrix3<f64>,
+    /// C = [κ]×ᵀH[κ]× + sym(Mκᵀ) − (M·κ)I − sym(Ne3ᵀ) + N3 I.
+    pub c: Matrix3<f64>,
+}
+
+fn sym(m: Matrix3<f64>) -> Matrix3<f64> {
+    (m + m.transpose()) * 0.5
+}
+
+impl FormCoefficients {
+    /// From the stiffness H, curvature κ, moment M and internal force N
+    /// (all body components) at a point.
+    pub fn at(
+        h: &Matrix3<f64>,
+        kappa: &Vector3<f64>,
+        moment: &Vector3<f64>,
+        force: &Vector3<f64>,
+    ) -> Self {
+        let k = kappa.cross_matrix();
+        let e3 = Vector3::z();
+        let id = Matrix3::identity();
+        FormCoefficients {
+            a: *h,
+            b: h * k - moment.cross_matrix() * 0.5,
+            c: sym(k.transpose() * h * k) + sym(moment * kappa.transpose())
+                - id * moment.dot(kappa)
+                - sym(force * e3.transpose())
+                + id * force[2],
+        }
+    }
+
+    /// The quadratic form at (ω, ω').
+    pub fn evaluate(&self, w: &Vector3<f64>, dw: &Vector3<f64>) -> f64 {
+        dw.dot(&(self.a * dw)) + 2.0 * dw.dot(&(self.b * w)) + w.dot(&(self.c * w))
+    }
+}
+
+/// Which components of ω a matrix acts on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Block {
+    /// All three: ω = (ω1, ω2, ω3).
+    Full,
+    /// Bending in the plane (about d2): ω2 = ζ, paper (50).
+    InPlane,
+    /// Out of the plane: ω1 = ψ (about d1) and ω3 = χ (twist), paper (51).
+    OutOfPlane,
+}
+
+impl Block {
+    /// The components of ω in the block.
+    pub fn components(self) -> &'static [usize] {
+        match self {
+            Block::Full => &[0, 1, 2],
+            Block::InPlane => &[1],
+            Block::OutOfPlane => &[0, 2],
+        }
+    }
+
+    /// The name used in reports and HDF5 groups.
+    pub fn name(self) -> &'static str {
+        match self {
+            Block::Full => "full",
+            Block::InPlane => "in_plane",
+            Block::OutOfPlane => "out_of_plane",
+        }
+    }
+}
+
+/// Lagrange elements of order p on a uniform mesh of [0, L].
+#[derive(Debug, Clone, PartialEq)]
+pub struct FiniteElements {
+    length: f64,
+    elements: usize,
+    order: usize,
+}
+
+/// Gauss–Legendre nodes and weights on [0, 1] with `m` points (m = 2..4).
+fn gauss(m: usize) -> (Vec<f64>, Vec<f64>) {
+    let (x, w): (Vec<f64>, Vec<f64>) = match m {
+        2 => {
+            let a = 1.0 / 3f64.sqrt();
+            (vec![-a, a], vec![1.0, 1.0])
+        }
+        3 => {
+            let a = (0.6f64).sqrt();
+            (vec![-a, 0.0, a], vec![5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0])
+        }
+        _ => {
+            let r = (6.0f64 / 5.0).sqrt();
+            let (a, b) = (
+                ((3.0 - 2.0 * r) / 7.0).sqrt(),
+                ((3.0 + 2.0 * r) / 7.0).sqrt(),
+            );
+            let (wa, wb) = ((18.0 + 30f64.sqrt()) / 36.0, (18.0 - 30f64.sqrt()) / 36.0);
+            (vec![-b, -a, a, b], vec![wb, wa, wa, wb])
+        }
+    };
+    (
+        x.iter().map(|v| 0.5 * (v + 1.0)).collect(),
+        w.iter().map(|v| 0.5 * v).collect(),
+    )
+}
+
+impl FiniteElements {
+    /// `elements` elements of order `order` (1 to 3) on [0, length].
+    pub fn new(length: f64, elements: usize, order: usize) -> Self {
+        FiniteElements {
+            length,
+            elements: elements.max(1),
+            order: order.clamp(1, 3),
+        }
+    }
+
+    /// Element size.
+    pub fn h(&self) -> f64 {
+        self.length / self.elements as f64
+    }
+
+    /// All nodes s_0 = 0, …, s_{pE} = L.
+    pub fn nodes(&self) -> Vec<f64> {
+        let n = self.elements * self.order;
+        (0..=n).map(|i| self.length * i as f64 / n as f64).collect()
+    }
+
+    /// The quadrature points in increasing order (where the equilibrium
+    /// must be sampled).
+    pub fn quadrature_points(&self) -> Vec<f64> {
+        let (x, _) = gauss(self.order + 1);
+        let h = self.h();
+        (0..self.elements)
+            .flat_map(|e| {
+                x.iter()
+                    .map(move |xi| (e as f64 + xi) * h)
+                    .collect::<Vec<_>>()
+            })
+            .collect()
+    }
+
+    /// Lagrange shape functions and their ξ-derivatives at ξ ∈ [0, 1].
+    fn shape(&self, xi: f64) -> (Vec<f64>, Vec<f64>) {
+        let p = self.order;
+        let nodes: Vec<f64> = (0..=p).map(|a| a as f64 / p as f64).collect();
+        let mut value = vec![1.0; p + 1];
+        let mut deriv = vec![0.0; p + 1];
+        for a in 0..=p {
+            for b in (0..=p).filter(|&b| b != a) {
+                let denom = nodes[a] - nodes[b];
+                let mut term = 1.0 / denom;
+                for c in (0..=p).filter(|&c| c != a && c != b) {
+                    term *= (xi - nodes[c]) / (nodes[a] - nodes[c]);
+                }
+                deriv[a] += term;
+                value[a] *= (xi - nodes[b]) / denom;
+            }
+        }
+        (value, deriv)
+    }
+
+    /// Number of unknowns of a block (the clamp node is fixed).
+    pub fn size(&self, block: Block) -> usize {
+        block.components().len() * self.elements * self.order
+    }
+
+    /// K for the coefficients at the quadrature points (in the order of
+    /// [`Self::quadrature_points`]).
+    pub fn stiffness(&self, coeffs: &[FormCoefficients], block: Block) -> SymmetricBanded {
+        assert_eq!(
+            coeffs.len(),
+            self.elements * (self.order + 1),
+            "one set per quadrature point"
+        );
+        self.assemble(block, |q, a, da, b, db, ci, cj| {
+            let c = &coeffs[q];
+            da * db * c.a[(ci, cj)]
+                + da * b * c.b[(ci, cj)]
+                + a * db * c.b[(cj, ci)]
+                + a * b * c.c[(ci, cj)]
+        })
+    }
+
+    /// The L² Gram matrix G (ω·ω integrated).
+    pub fn mass(&self, block: Block) -> SymmetricBanded {
+        self.assemble(
+            block,
+            |_, a, _, b, _, ci, cj| if ci == cj { a * b } else { 0.0 },
+        )
+    }
+
+    /// Element-by-element assembly of ∫ term(φ_a, φ_a', φ_b, φ_b') over
+    /// the selected components; `term` gets the quadrature index.
+    #[allow(clippy::type_complexity)]
+    fn assemble(
+        &self,
+        block: Block,
+        term: impl Fn(usize, f64, f64, f64, f64, usize, usize) -> f64,
+    ) -> SymmetricBanded {
+        let comps = block.components();
+        let nc = comps.len();
+        let p = self.order;
+        let mut k = SymmetricBanded::zeros(self.size(block), nc * (p + 1) - 1);
+        let (xs, ws) = gauss(p + 1);
+        let h = self.h();
+        let shapes: Vec<_> = xs.iter().map(|&x| self.shape(x)).collect();
+        for e in 0..self.elements {
+            for (g, ((val, der), w)) in shapes.iter().zip(&ws).enumerate() {
+                let q = e * (p + 1) + g;
+                for a in 0..=p {
+                    let Some(ia) = (e * p + a).checked_sub(1) else {
+                        continue;
+                    };
+                    for b in 0..=p {
+                        let Some(ib) = (e * p + b).checked_sub(1) else {
+                            continue;
+                        };
+                        for (x, &ci) in comps.iter().enumerate() {
+                            for (y, &cj) in comps.iter().enumerate() {
+                                let (i, j) = (ia * nc + x, ib * nc + y);
+                                if i < j {
+                                    continue;
+                                }
+                                let v = term(q, val[a], der[a] / h, val[b], der[b] / h, ci, cj);
+                                k.add(i, j, w * h * v);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        k
+    }
+
+    /// Nodal values of ω (3 components, zero at the clamp) from a vector of
+    /// block unknowns.
+    pub fn nodal_rotations(&self, block: Block, v: &[f64]) -> Vec<Vector3<f64>> {
+        let comps = block.components();
+        let mut out = vec![Vector3::zeros(); self.elements * self.order + 1];
+        for (node, w) in out.iter_mut().enumerate().skip(1) {
+            for (x, &c) in comps.iter().enumerate() {
+                w[c] = v[(node - 1) * comps.len() + x];
+            }
+        }
+        out
+    }
+}
