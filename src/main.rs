@@ -8,7 +8,8 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use cosserat::bvp::{solve, Equilibrium};
-use cosserat::io::{check_target, write_equilibrium, Problem};
+use cosserat::io::{check_target, write_equilibrium, write_stability, Problem, StabilityResult};
+use cosserat::stability::{analyze, critical_load, CriticalLoad, Stability};
 
 #[derive(Parser)]
 #[command(
@@ -40,6 +41,21 @@ enum Command {
         #[arg(long)]
         force: bool,
     },
+    /// Decide the stability of an equilibrium (lowest Hessian eigenvalues,
+    /// Morse index), or the critical load of a fixed loaded shape.
+    Stability {
+        /// The problem file (TOML).
+        problem: PathBuf,
+        /// Write the analysis to this HDF5 file.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// Override any key of the problem file, e.g. --set stability.elements=400.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// Overwrite an existing output file.
+        #[arg(long)]
+        force: bool,
+    },
 }
 
 fn main() -> ExitCode {
@@ -57,6 +73,107 @@ fn main() -> ExitCode {
             }
             run_solve(problem, output, &set, force)
         }
+        Command::Stability {
+            problem,
+            output,
+            set,
+            force,
+        } => run_stability(problem, output, &set, force),
+    }
+}
+
+/// Reads the problem and checks the output target before any work.
+fn prepare(
+    path: &PathBuf,
+    output: &Option<PathBuf>,
+    set: &[String],
+    force: bool,
+) -> Result<Problem, ExitCode> {
+    let problem =
+        Problem::from_path(path, set).map_err(|e| fail(2, format!("{}: {e}", path.display())))?;
+    if let Some(out) = output {
+        check_target(out, force).map_err(|e| fail(2, e))?;
+    }
+    println!("problem   {}", path.display());
+    Ok(problem)
+}
+
+fn run_stability(path: PathBuf, output: Option<PathBuf>, set: &[String], force: bool) -> ExitCode {
+    let problem = match prepare(&path, &output, set, force) {
+        Ok(p) => p,
+        Err(code) => return code,
+    };
+    let opts = &problem.stability;
+    println!(
+        "mesh      {} elements of order {}",
+        opts.elements, opts.order
+    );
+    let result = match &problem.shape {
+        Some(shape) => match critical_load(&problem.rod, shape, opts) {
+            Ok(c) => {
+                report_critical(&c);
+                StabilityResult::FixedShape(c)
+            }
+            Err(e) => return fail(2, e),
+        },
+        None => {
+            println!(
+                "model     {} ({})",
+                problem.model.level.name(),
+                problem.model.reason
+            );
+            let eq = match solve(&problem.rod, &problem.model, &problem.options) {
+                Ok(eq) => eq,
+                Err(e) => return fail(2, e),
+            };
+            match analyze(&problem.rod, &eq, &problem.options, opts) {
+                Ok(st) => {
+                    report_spectrum(&st);
+                    StabilityResult::Equilibrium(Box::new(eq), st)
+                }
+                Err(e) => return fail(2, e),
+            }
+        }
+    };
+    if let Some(out) = output {
+        if let Err(e) = write_stability(&out, &problem.text, &result, force) {
+            return fail(1, e);
+        }
+        println!("written   {}", out.display());
+    }
+    ExitCode::SUCCESS
+}
+
+fn report_spectrum(st: &Stability) {
+    for b in &st.blocks {
+        let values: Vec<String> = b.eigenvalues.iter().map(|v| format!("{v:+.6e}")).collect();
+        println!(
+            "{:<13} lowest eigenvalues [{}], Morse index {}",
+            b.block.name(),
+            values.join(", "),
+            b.morse_index
+        );
+    }
+    println!("morse     {}", st.morse_index);
+    println!(
+        "verdict   {}",
+        if st.stable { "stable" } else { "unstable" }
+    );
+}
+
+fn report_critical(c: &CriticalLoad) {
+    for (block, factor, _) in &c.blocks {
+        match factor {
+            Some(f) => println!("{:<13} critical load factor {f:.10e}", block.name()),
+            None => println!("{:<13} no positive critical load", block.name()),
+        }
+    }
+    match (c.load_factor, c.gamma) {
+        (Some(f), Some(g)) => {
+            println!("critical  load factor {f:.10e}");
+            println!("          γ_crit = F L²/B2 = {g:.10e}");
+        }
+        _ => println!("critical  none: the shape is stable under any positive load"),
     }
 }
 
@@ -66,16 +183,17 @@ fn fail(code: u8, message: impl std::fmt::Display) -> ExitCode {
 }
 
 fn run_solve(path: PathBuf, output: Option<PathBuf>, set: &[String], force: bool) -> ExitCode {
-    let problem = match Problem::from_path(&path, set) {
+    let problem = match prepare(&path, &output, set, force) {
         Ok(p) => p,
-        Err(e) => return fail(2, format!("{}: {e}", path.display())),
+        Err(code) => return code,
     };
-    if let Some(out) = &output {
-        if let Err(e) = check_target(out, force) {
-            return fail(2, e);
-        }
+    if problem.shape.is_some() {
+        return fail(
+            2,
+            "a fixed-shape scene ([shape]) has no fixed intrinsic curvature to solve for; \
+             use `cosserat stability`",
+        );
     }
-    println!("problem   {}", path.display());
     println!(
         "model     {} ({})",
         problem.model.level.name(),
