@@ -84,7 +84,7 @@ fn main() -> ExitCode {
 
 /// Reads the problem and checks the output target before any work.
 fn prepare(
-    path: &PathBuf,
+    path: &std::path::Path,
     output: &Option<PathBuf>,
     set: &[String],
     force: bool,
