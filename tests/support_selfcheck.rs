@@ -29,3 +29,12 @@ fn cantilever_reference_matches_mattiasson_table() {
     assert!((1.0 - t.z - 0.05643).abs() < 1e-5, "z {}", t.z);
     assert!((t.angle - 0.46135).abs() < 1e-5, "angle {}", t.angle);
 }
+
+#[test]
+fn bessel_zeros_match_tabulated_values() {
+    // j_{0,1} = 2.404825557695773 and j_{1,1} = 3.831705970207512
+    // (Abramowitz & Stegun Table 9.5).
+    use support::bessel::first_zero;
+    assert!((first_zero(0.0, 1.0, 3.0) - 2.404_825_557_695_773).abs() < 1e-13);
+    assert!((first_zero(1.0, 3.0, 4.5) - 3.831_705_970_207_512).abs() < 1e-13);
+}

@@ -5,8 +5,8 @@
 //! full state y_j at the interior nodes s_j = jL/K. Residuals: the matching
 //! conditions Y_j(s_{j+1}; y_j) − y_{j+1} and the tip conditions g(Y(L)).
 //! The Jacobian comes from the variational equations integrated on the same
-//! steps as the state (exact derivative of the discrete flow), never from
-//! finite differences. With K = 1 this is single shooting; with K > 1 the
+//! steps as the state (exact derivative of the discrete flow), with the
+//! step size controlled on both, never from finite differences. With K = 1 this is single shooting; with K > 1 the
 //! products of segment sensitivities that make single shooting ill
 //! conditioned on long, soft or heavily loaded rods are never formed.
 
@@ -82,12 +82,17 @@ impl<'a> ShootingSystem<'a> {
             eq.rhs_linearized(s, &y[..n], cols, &y[n..], dy, dphi);
         };
         let (a, b) = (self.node(j), self.node(j + 1));
+        // Error control covers the sensitivities too (CVODES' "full" error
+        // control): a trivial state (a straight column) would otherwise let
+        // the steps grow until Φ, and so the Jacobian and the location of
+        // its singularities, is wrong.
+        let controlled = y.len();
         let stats = self.dop.integrate(
             rhs,
             a,
             b,
             &mut y,
-            n,
+            controlled,
             &self.tol,
             &[],
             |_, _| {},

@@ -281,6 +281,38 @@ impl FiniteElements {
         k
     }
 
+    /// The quadrature weights (times the element size), in the order of
+    /// [`Self::quadrature_points`].
+    pub fn quadrature_weights(&self) -> Vec<f64> {
+        let (_, w) = gauss(self.order + 1);
+        let h = self.h();
+        (0..self.elements)
+            .flat_map(|_| w.iter().map(move |wi| wi * h).collect::<Vec<_>>())
+            .collect()
+    }
+
+    /// (ω, ω') at the quadrature points for a vector of block unknowns: the
+    /// finite-element interpolant that K acts on.
+    pub fn interpolate(&self, block: Block, v: &[f64]) -> Vec<(Vector3<f64>, Vector3<f64>)> {
+        let nodal = self.nodal_rotations(block, v);
+        let (xs, _) = gauss(self.order + 1);
+        let (p, h) = (self.order, self.h());
+        let mut out = Vec::with_capacity(self.elements * xs.len());
+        for e in 0..self.elements {
+            for &x in &xs {
+                let (val, der) = self.shape(x);
+                let mut w = Vector3::zeros();
+                let mut dw = Vector3::zeros();
+                for a in 0..=p {
+                    w += nodal[e * p + a] * val[a];
+                    dw += nodal[e * p + a] * (der[a] / h);
+                }
+                out.push((w, dw));
+            }
+        }
+        out
+    }
+
     /// Nodal values of ω (3 components, zero at the clamp) from a vector of
     /// block unknowns.
     pub fn nodal_rotations(&self, block: Block, v: &[f64]) -> Vec<Vector3<f64>> {

@@ -2,5 +2,6 @@
 //! the solver's own output.
 #![allow(dead_code)]
 
+pub mod bessel;
 pub mod elliptic;
 pub mod references;
