@@ -36,7 +36,7 @@ pub enum EigenError {
 }
 
 /// Size up to which the dense solver is used.
-pub const DENSE_LIMIT: usize = 240;
+pub const DENSE_LIMIT: usize = 48;
 
 /// The number of eigenvalues of (K, G) below σ, from the inertia of K − σG
 /// (a zero pivot nudges σ by a relative 1e-12).
@@ -118,7 +118,7 @@ fn shift_below_spectrum(k: &SymmetricBanded, g: &SymmetricBanded) -> f64 {
         } else {
             hi = mid;
         }
-        if hi - lo <= 1e-3 * (hi.abs() + lo.abs()).max(1e-12 * scale) {
+        if hi - lo <= 0.05 * (hi.abs() + lo.abs()).max(1e-12 * scale) {
             break;
         }
     }
@@ -181,43 +181,50 @@ fn lanczos(
     order: impl Fn(f64, f64) -> std::cmp::Ordering,
 ) -> Result<Eigenpairs, EigenError> {
     let steps = n.min(steps);
-    let mut q: Vec<Vec<f64>> = Vec::with_capacity(steps);
+    let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+    // q_j and M q_j, so that every inner product is a plain dot product.
+    let (mut q, mut mq): (Vec<Vec<f64>>, Vec<Vec<f64>>) = (vec![], vec![]);
     let (mut alpha, mut beta) = (Vec::new(), Vec::new());
     // A deterministic start vector with components along every mode.
     let mut v: Vec<f64> = (0..n)
         .map(|i| 1.0 + 0.5 * ((i as f64) * 0.618).sin())
         .collect();
-    let norm = metric.inner(&v, &v).sqrt();
+    let mut mv = vec![0.0; n];
+    metric.matvec(&v, &mut mv);
+    let norm = dot(&v, &mv).sqrt();
     v.iter_mut().for_each(|x| *x /= norm);
+    mv.iter_mut().for_each(|x| *x /= norm);
     let mut w = vec![0.0; n];
-    for j in 0..steps {
+    let mut mw = vec![0.0; n];
+    loop {
+        let j = q.len();
         q.push(v.clone());
+        mq.push(mv.clone());
         apply(&q[j], &mut w);
-        alpha.push(metric.inner(&q[j], &w));
+        alpha.push(dot(&mq[j], &w));
         for _ in 0..2 {
-            for qi in &q {
-                let c = metric.inner(qi, &w);
+            for (qi, mqi) in q.iter().zip(&mq) {
+                let c = dot(mqi, &w);
                 w.iter_mut().zip(qi).for_each(|(a, b)| *a -= c * b);
             }
         }
-        let b = metric.inner(&w, &w).sqrt();
-        if j + 1 == steps || b <= 1e-14 * alpha[j].abs().max(f64::MIN_POSITIVE) {
+        metric.matvec(&w, &mut mw);
+        let b = dot(&w, &mw).max(0.0).sqrt();
+        let exhausted = b <= 1e-14 * alpha[j].abs().max(f64::MIN_POSITIVE);
+        let done = j + 1 >= steps
+            || exhausted
+            || (j + 1 >= count + 4
+                && (j + 1) % 4 == 0
+                && converged(&alpha, &beta, b, count, &order));
+        if done {
             break;
         }
         beta.push(b);
         v = w.iter().map(|x| x / b).collect();
+        mv = mw.iter().map(|x| x / b).collect();
     }
+    let eig = tridiagonal(&alpha, &beta).symmetric_eigen();
     let m = alpha.len();
-    let t = DMatrix::from_fn(m, m, |i, j| {
-        if i == j {
-            alpha[i]
-        } else if i.abs_diff(j) == 1 {
-            beta[i.min(j)]
-        } else {
-            0.0
-        }
-    });
-    let eig = t.symmetric_eigen();
     let mut idx: Vec<usize> = (0..m).collect();
     idx.sort_by(|&a, &b| order(eig.eigenvalues[a], eig.eigenvalues[b]));
     let mut pairs: Vec<(f64, Vec<f64>)> = idx
@@ -232,11 +239,43 @@ fn lanczos(
             (to_lambda(eig.eigenvalues[i]), x)
         })
         .collect();
-    pairs.sort_by(|a, b| a.0.partial_cmp(&b.0).unwrap());
+    pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
     Ok(Eigenpairs {
         values: pairs.iter().map(|p| p.0).collect(),
         vectors: pairs.into_iter().map(|p| p.1).collect(),
     })
+}
+
+fn tridiagonal(alpha: &[f64], beta: &[f64]) -> DMatrix<f64> {
+    let m = alpha.len();
+    DMatrix::from_fn(m, m, |i, j| {
+        if i == j {
+            alpha[i]
+        } else if i.abs_diff(j) == 1 {
+            beta[i.min(j)]
+        } else {
+            0.0
+        }
+    })
+}
+
+/// The Lanczos residual bound |β_m s_{m,i}| ≤ 1e-13 max|θ| for the
+/// `count` wanted Ritz values (Parlett, Sec. 13.2).
+fn converged(
+    alpha: &[f64],
+    beta: &[f64],
+    next_beta: f64,
+    count: usize,
+    order: &impl Fn(f64, f64) -> std::cmp::Ordering,
+) -> bool {
+    let eig = tridiagonal(alpha, beta).symmetric_eigen();
+    let m = alpha.len();
+    let scale = eig.eigenvalues.iter().fold(0.0_f64, |a, b| a.max(b.abs()));
+    let mut idx: Vec<usize> = (0..m).collect();
+    idx.sort_by(|&a, &b| order(eig.eigenvalues[a], eig.eigenvalues[b]));
+    idx.iter()
+        .take(count)
+        .all(|&i| (next_beta * eig.eigenvectors[(m - 1, i)]).abs() <= 1e-13 * scale)
 }
 
 /// The dense pencil: G = LLᵀ, C = L⁻¹KL⁻ᵀ, eigenvectors v = L⁻ᵀ u.
