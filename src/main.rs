@@ -56,6 +56,11 @@ enum Command {
         #[arg(long)]
         force: bool,
     },
+    /// Benchmarks: `cosserat bench work-precision [-o DIR]`.
+    Bench {
+        #[command(subcommand)]
+        which: cosserat::bench::BenchCommand,
+    },
 }
 
 fn main() -> ExitCode {
@@ -79,6 +84,7 @@ fn main() -> ExitCode {
             set,
             force,
         } => run_stability(problem, output, &set, force),
+        Command::Bench { which } => cosserat::bench::run(which),
     }
 }
 

@@ -36,7 +36,14 @@ fn solve_with(rod: &Rod, level: ModelLevel, method: Method) -> Equilibrium {
     solve(rod, &choice, &opts).unwrap_or_else(|e| panic!("{level:?} {method:?}: {e}"))
 }
 
-const METHODS: [Method; 2] = [Method::Shooting, Method::MultipleShooting { segments: 8 }];
+/// Every method: single and multiple shooting, and collocation of orders 4
+/// and 6 (adaptive, to its default tolerance 1e-10).
+const METHODS: [Method; 4] = [
+    Method::Shooting,
+    Method::MultipleShooting { segments: 8 },
+    Method::Collocation { stages: 2 },
+    Method::Collocation { stages: 3 },
+];
 const LEVELS: [ModelLevel; 2] = [ModelLevel::Planar, ModelLevel::Kirchhoff];
 
 #[test]
@@ -146,7 +153,19 @@ fn unloaded_rod_with_constant_intrinsic_curvature_is_a_helix() {
                 p.s
             );
         }
-        assert!(eq.director_drift <= 1e-12, "drift {}", eq.director_drift);
+        // Shooting projects the directors back to orthonormal after every
+        // step; collocation does not (d1·d2 and |d1|² − |d2|² are not
+        // quadratic invariants of the 9-ODE system), so its drift is
+        // discretization error, measured and bounded by its tolerance.
+        let bound = match method {
+            Method::Collocation { .. } => SolverOptions::default().collocation.tolerance,
+            _ => 1e-12,
+        };
+        assert!(
+            eq.director_drift <= bound,
+            "{method:?}: drift {}",
+            eq.director_drift
+        );
     }
 }
 

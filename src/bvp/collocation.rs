@@ -28,6 +28,7 @@
 
 use nalgebra::{DMatrix, DVector, Dyn, LU};
 
+use super::integrator::{Dop853, Tolerances};
 use super::newton::NewtonOptions;
 use crate::equations::{RodEquations, RodSample};
 
@@ -73,6 +74,14 @@ pub struct CollocationSolution {
     pub residual: f64,
     /// Scaled residual at every Newton iterate of the final solve.
     pub residual_history: Vec<f64>,
+    /// Newton steps over all meshes of the adaptation (the total work).
+    pub newton_steps: usize,
+    /// Newton steps that needed damping, over all meshes.
+    pub damped_steps: usize,
+    /// The largest ratio of successive Newton corrections (Deuflhard's
+    /// contraction Θ) on any mesh: well below 1 inside the region of
+    /// quadratic convergence.
+    pub contraction: f64,
     /// Accumulated local error estimate Σ_i est_i (scaled state, max-norm).
     pub error_estimate: f64,
     /// Largest |d_i·d_j − δ_ij| over the nodes (0 for the planar model).
@@ -95,6 +104,60 @@ impl CollocationSolution {
             .zip(&self.states)
             .map(|(&s, y)| eq.sample(s, y))
             .collect()
+    }
+
+    /// The states at sorted points of [0, L] to the accuracy of the nodes:
+    /// from the node s_i left of each point, one Gauss collocation step of
+    /// width s − s_i (its stages started from [`Self::interpolate`]). The
+    /// collocation polynomial itself is only O(h^{m+1}) accurate between
+    /// nodes; this step keeps the superconvergent O(h^{2m}) of the nodes
+    /// (local error O(h^{2m+1})) and, on a linear rotation, keeps the
+    /// directors orthonormal. Falls back to the polynomial if the step's
+    /// Newton iteration fails.
+    pub fn sample_states(&self, eq: &dyn RodEquations, points: &[f64]) -> Vec<Vec<f64>> {
+        let tab = Tableau::gauss(self.stage_count).expect("stored stage count is valid");
+        let grid = Grid::new(eq, tab, self.mesh.clone());
+        let last = self.mesh.len() - 1;
+        points
+            .iter()
+            .map(|&s| {
+                if s >= self.mesh[last] {
+                    return self.states[last].clone();
+                }
+                let i = self.mesh.partition_point(|&x| x <= s).clamp(1, last) - 1;
+                let t = s - self.mesh[i];
+                if t <= 0.0 {
+                    return self.states[i].clone();
+                }
+                let guess: Vec<f64> = grid
+                    .tab
+                    .c
+                    .iter()
+                    .flat_map(|c| self.interpolate(self.mesh[i] + c * t))
+                    .collect();
+                grid.local_step(self.mesh[i], t, &self.states[i], guess)
+                    .unwrap_or_else(|| self.interpolate(s))
+            })
+            .collect()
+    }
+
+    /// [`Self::sample_states`] in user quantities.
+    pub fn sample(&self, eq: &dyn RodEquations, points: &[f64]) -> Vec<RodSample> {
+        points
+            .iter()
+            .zip(self.sample_states(eq, points))
+            .map(|(&s, y)| eq.sample(s, &y))
+            .collect()
+    }
+
+    /// Gauss points per interval.
+    pub fn stages(&self) -> usize {
+        self.stage_count
+    }
+
+    /// Intervals of the mesh.
+    pub fn intervals(&self) -> usize {
+        self.mesh.len() - 1
     }
 
     /// The collocation polynomial at s ∈ [0, L]: on interval i it is the
@@ -145,6 +208,16 @@ pub enum CollocationError {
         intervals: usize,
         history: Vec<f64>,
     },
+    /// Without adaptation, the fixed mesh is too coarse for the tolerance
+    /// (returned by [`crate::bvp::solve`], which never passes off such a
+    /// solution as converged; [`solve_collocation`] returns it with its
+    /// `error_estimate`).
+    #[error("error estimate {estimate:.3e} on the fixed mesh of {intervals} intervals exceeds the tolerance {tolerance:.1e} (mesh adaptation is off)")]
+    CoarseMesh {
+        tolerance: f64,
+        estimate: f64,
+        intervals: usize,
+    },
     /// Adaptation would need more than `max_intervals` intervals.
     #[error("mesh error tolerance {tolerance:.1e} not reached within {max_intervals} intervals: error estimate {estimate:.3e} on {intervals} intervals, {flagged} of them above their share")]
     ToleranceNotReached {
@@ -173,7 +246,29 @@ pub fn solve_collocation(
     newton: &NewtonOptions,
     warm_start: Option<&CollocationSolution>,
 ) -> Result<CollocationSolution, CollocationError> {
+    solve_collocation_from(eq, opts, newton, warm_start, None)
+}
+
+/// [`solve_collocation`] with a guess `u` of the free values (the clamp
+/// curvature) for a cold start; ignored when a warm start is given.
+pub fn solve_collocation_from(
+    eq: &dyn RodEquations,
+    opts: &CollocationOptions,
+    newton: &NewtonOptions,
+    warm_start: Option<&CollocationSolution>,
+    guess: Option<&[f64]>,
+) -> Result<CollocationSolution, CollocationError> {
     let tab = check_options(opts)?;
+    if let Some(u) = guess {
+        if u.len() != eq.unknowns() {
+            return Err(CollocationError::Options(format!(
+                "the guess has {} free values, the equations {}",
+                u.len(),
+                eq.unknowns()
+            )));
+        }
+    }
+    let (mut steps, mut damped, mut contraction) = (0, 0, 0.0f64);
     let mut mesh = match warm_start {
         Some(w) if opts.adapt && w.mesh.len() >= 2 => rescale_mesh(&w.mesh, eq.length()),
         _ => uniform_mesh(eq.length(), opts.intervals),
@@ -181,10 +276,25 @@ pub fn solve_collocation(
     let mut warm = warm_start.cloned();
     loop {
         let grid = Grid::new(eq, tab.clone(), mesh);
-        let x0 = grid.start(warm.as_ref());
-        let outcome = damped_newton(&grid, x0, newton)?;
+        let x0 = grid.start_from(warm.as_ref(), guess, false);
+        // A cold start tries the initial value problem's shape first and
+        // the straight rod if Newton fails from it (at large loads the IVP
+        // from the linear guess can be far off).
+        let outcome = match damped_newton(&grid, x0, newton) {
+            Err(e) if warm.is_none() => {
+                let x1 = grid.start_from(None, guess, true);
+                damped_newton(&grid, x1, newton).map_err(|_| e)?
+            }
+            other => other?,
+        };
+        steps += outcome.iterations;
+        damped += outcome.damped_steps;
+        contraction = contraction.max(outcome.contraction);
         let errors = grid.local_errors(&outcome.x);
-        let sol = grid.solution(&outcome, &errors);
+        let mut sol = grid.solution(&outcome, &errors);
+        sol.newton_steps = steps;
+        sol.damped_steps = damped;
+        sol.contraction = contraction;
         let flagged = grid.flagged(&errors, opts.tolerance);
         if !opts.adapt || flagged.is_empty() {
             return Ok(sol);
@@ -198,7 +308,31 @@ pub fn solve_collocation(
                 flagged: flagged.len(),
             });
         }
-        mesh = refine(&grid.mesh, &flagged);
+        // Split each flagged interval into q pieces with q^{2m} ≥ est/share
+        // (the local error is O(h^{2m+1}), its share O(h)), 2 ≤ q ≤ 8, so
+        // that one or two refinements usually suffice; plain halving if
+        // that would exceed the budget.
+        let l = eq.length();
+        let mut pieces: Vec<(usize, usize)> = flagged
+            .iter()
+            .map(|&i| {
+                let share = opts.tolerance * grid.span(i).1 / l;
+                let ratio = errors[i] / share;
+                let q = if ratio.is_finite() {
+                    (1.1 * ratio.powf(0.5 / tab.m as f64))
+                        .ceil()
+                        .clamp(2.0, 8.0) as usize
+                } else {
+                    2
+                };
+                (i, q)
+            })
+            .collect();
+        let added: usize = pieces.iter().map(|&(_, q)| q - 1).sum();
+        if grid.intervals() + added > opts.max_intervals {
+            pieces.iter_mut().for_each(|p| p.1 = 2);
+        }
+        mesh = refine_into(&grid.mesh, &pieces);
         warm = Some(sol);
     }
 }
@@ -239,14 +373,23 @@ fn rescale_mesh(mesh: &[f64], length: f64) -> Vec<f64> {
 }
 
 /// The mesh with the `flagged` intervals (sorted indices) halved.
+#[cfg(test)]
 fn refine(mesh: &[f64], flagged: &[usize]) -> Vec<f64> {
-    let mut out = Vec::with_capacity(mesh.len() + flagged.len());
-    let mut f = flagged.iter().peekable();
+    let pieces: Vec<(usize, usize)> = flagged.iter().map(|&i| (i, 2)).collect();
+    refine_into(mesh, &pieces)
+}
+
+/// The mesh with interval i split into q equal pieces for every (i, q) of
+/// `pieces` (sorted by i).
+fn refine_into(mesh: &[f64], pieces: &[(usize, usize)]) -> Vec<f64> {
+    let mut out = Vec::with_capacity(mesh.len() + pieces.iter().map(|p| p.1).sum::<usize>());
+    let mut f = pieces.iter().peekable();
     for i in 0..mesh.len() - 1 {
         out.push(mesh[i]);
-        if f.peek() == Some(&&i) {
+        if let Some(&&(_, q)) = f.peek().filter(|p| p.0 == i) {
             f.next();
-            out.push(0.5 * (mesh[i] + mesh[i + 1]));
+            let h = mesh[i + 1] - mesh[i];
+            out.extend((1..q).map(|j| mesh[i] + h * j as f64 / q as f64));
         }
     }
     out.push(*mesh.last().unwrap());
@@ -384,28 +527,83 @@ impl<'a> Grid<'a> {
         (self.mesh[i], self.mesh[i + 1] - self.mesh[i])
     }
 
-    /// The starting unknowns: interpolated from a warm start, or the
-    /// straight rod with the guessed clamp curvature.
-    fn start(&self, warm: Option<&CollocationSolution>) -> Vec<f64> {
-        let state = |s: f64| match warm {
-            Some(w) => w.interpolate(s),
-            None => self.eq.straight_state(s),
-        };
-        let mut x = match warm {
+    /// The starting unknowns: interpolated from a warm start, or else a
+    /// cold start from the guessed clamp curvature u: the initial value
+    /// problem from u integrated with DOP853 (tolerance 1e-8) through the
+    /// nodes and stage points — for an unloaded rod that is its intrinsic
+    /// shape, however much it spirals — with the straight rod beyond a
+    /// blow-up; or, with `straight`, the straight rod.
+    fn start_from(
+        &self,
+        warm: Option<&CollocationSolution>,
+        guess: Option<&[f64]>,
+        straight: bool,
+    ) -> Vec<f64> {
+        let u = match warm {
             Some(w) => self.eq.unknowns_of(&w.states[0]),
-            None => self.eq.initial_guess(),
+            None => guess.map_or_else(|| self.eq.initial_guess(), <[f64]>::to_vec),
         };
-        for i in 1..=self.intervals() {
-            x.extend(state(self.mesh[i]));
-        }
-        for i in 0..self.intervals() {
+        // Points in order: per interval its stage points, then its right node.
+        let k = self.intervals();
+        let mut points = Vec::with_capacity(k * (self.tab.m + 1));
+        for i in 0..k {
             let (s, h) = self.span(i);
-            for &c in &self.tab.c {
-                x.extend(state(s + c * h));
+            points.extend(self.tab.c.iter().map(|c| s + c * h));
+            points.push(self.mesh[i + 1]);
+        }
+        let states: Vec<Vec<f64>> = match warm {
+            Some(w) => points.iter().map(|&s| w.interpolate(s)).collect(),
+            None if straight => points.iter().map(|&s| self.eq.straight_state(s)).collect(),
+            None => self.integrate_guess(&u, &points),
+        };
+        let (n, m) = (self.n, self.tab.m);
+        let mut x = u;
+        x.reserve(self.size());
+        for i in 0..k {
+            x.extend_from_slice(&states[i * (m + 1) + m]);
+        }
+        for i in 0..k {
+            for j in 0..m {
+                x.extend_from_slice(&states[i * (m + 1) + j]);
             }
         }
+        debug_assert!(states.iter().all(|y| y.len() == n));
         debug_assert_eq!(x.len(), self.size());
         x
+    }
+
+    /// y(s; u) of the initial value problem at sorted `points`.
+    fn integrate_guess(&self, u: &[f64], points: &[f64]) -> Vec<Vec<f64>> {
+        let n = self.n;
+        let mut y = vec![0.0; n];
+        self.eq.initial_state(u, &mut y);
+        let tol = Tolerances {
+            rtol: 1e-8,
+            atol: 1e-8,
+            max_steps: 100_000,
+        };
+        let eq = self.eq;
+        let mut out = Vec::with_capacity(points.len());
+        let _ = Dop853::new(n).integrate(
+            |s, y: &[f64], d: &mut [f64]| eq.rhs(s, y, d),
+            0.0,
+            eq.length(),
+            &mut y,
+            n,
+            &tol,
+            points,
+            |_, y| out.push(y.to_vec()),
+            |y| eq.project(y),
+        );
+        let usable = out.len().min(points.len());
+        out.truncate(usable);
+        let finite = out
+            .iter()
+            .position(|y| y.iter().any(|v| !v.is_finite()))
+            .unwrap_or(usable);
+        out.truncate(finite);
+        out.extend(points[finite..].iter().map(|&s| eq.straight_state(s)));
+        out
     }
 
     /// f at the stages of interval i (m·n numbers).
@@ -679,6 +877,9 @@ impl<'a> Grid<'a> {
             iterations: 0,
             residual: f64::NAN,
             residual_history: Vec::new(),
+            newton_steps: 0,
+            damped_steps: 0,
+            contraction: 0.0,
             error_estimate: f64::NAN,
             director_drift: 0.0,
             stage_values: (0..self.intervals())
@@ -728,6 +929,8 @@ struct NewtonOutcome {
     x: Vec<f64>,
     iterations: usize,
     history: Vec<f64>,
+    damped_steps: usize,
+    contraction: f64,
 }
 
 fn max_norm(r: &[f64]) -> f64 {
@@ -749,6 +952,7 @@ fn damped_newton(
     let mut x = x0;
     let mut f = grid.residual(&x);
     let mut history = vec![max_norm(&f)];
+    let (mut damped_steps, mut contraction, mut last_norm) = (0, 0.0f64, f64::NAN);
     let fail = |reason: String, history: Vec<f64>| CollocationError::NoConvergence {
         intervals,
         reason,
@@ -762,7 +966,10 @@ fn damped_newton(
     }
     for iteration in 0..=opts.max_iterations {
         if *history.last().unwrap() <= opts.tolerance {
-            return Ok(polish(grid, x, f, history));
+            let mut out = polish(grid, x, f, history);
+            out.damped_steps = damped_steps;
+            out.contraction = contraction;
+            return Ok(out);
         }
         if iteration == opts.max_iterations {
             break;
@@ -780,6 +987,10 @@ fn damped_newton(
             return Err(singular(history));
         }
         let step_norm = grid.step_norm(&step);
+        if last_norm > 0.0 {
+            contraction = contraction.max(step_norm / last_norm);
+        }
+        last_norm = step_norm;
         let mut lambda = 1.0;
         loop {
             let trial: Vec<f64> = x.iter().zip(&step).map(|(a, b)| a + lambda * b).collect();
@@ -800,6 +1011,9 @@ fn damped_newton(
                 );
                 return Err(fail(reason, history));
             }
+        }
+        if lambda < 1.0 {
+            damped_steps += 1;
         }
         history.push(max_norm(&f));
     }
@@ -838,6 +1052,8 @@ fn polish(grid: &Grid, mut x: Vec<f64>, mut f: Vec<f64>, mut history: Vec<f64>) 
         x,
         iterations: iterations.max(history.len() - 1),
         history,
+        damped_steps: 0,
+        contraction: 0.0,
     }
 }
 
@@ -909,16 +1125,22 @@ impl BandLu {
                     self.data.swap(a, b);
                 }
             }
-            for i in k + 1..=last {
-                let ik = self.idx(i, k);
-                let l = self.data[ik] / pivot;
-                self.data[ik] = l;
-                if l != 0.0 {
-                    for c in k + 1..=right {
-                        let v = self.get(k, c);
-                        let ic = self.idx(i, c);
-                        self.data[ic] -= l * v;
-                    }
+            // Multipliers below the pivot, then the rank-one update column
+            // by column (contiguous in the column-major band storage),
+            // skipping the zero columns of the pivot row.
+            let (lo, hi) = (self.idx(k + 1, k), self.idx(last, k) + 1);
+            for v in &mut self.data[lo..hi] {
+                *v /= pivot;
+            }
+            for c in k + 1..=right {
+                let v = self.get(k, c);
+                if v == 0.0 {
+                    continue;
+                }
+                let start = self.idx(k + 1, c);
+                for (off, i) in (k + 1..=last).enumerate() {
+                    let l = self.data[lo + i - (k + 1)];
+                    self.data[start + off] -= l * v;
                 }
             }
         }

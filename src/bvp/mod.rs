@@ -1,5 +1,6 @@
 //! Equilibria: the boundary value problem of a clamped rod solved by single
-//! or multiple shooting with a damped Newton method, falling back to a load
+//! or multiple shooting or by Gauss–Legendre collocation on an adapted mesh,
+//! each with a damped Newton method, falling back to a load
 //! ramp (natural-parameter homotopy from the unloaded rod) when the loads
 //! are too large for a direct start.
 //!
@@ -20,7 +21,8 @@ use nalgebra::DMatrix;
 use crate::equations::{KirchhoffEquations, PlanarEquations, RodEquations, RodSample};
 use crate::model::{ModelChoice, ModelLevel, Rod};
 pub use collocation::{
-    solve_collocation, CollocationError, CollocationOptions, CollocationSolution,
+    solve_collocation, solve_collocation_from, CollocationError, CollocationOptions,
+    CollocationSolution,
 };
 use integrator::{IntegrationStats, Tolerances};
 use newton::{NewtonFailure, NewtonOptions};
@@ -33,6 +35,12 @@ pub enum Method {
     Shooting,
     /// Multiple shooting on `segments` equal segments.
     MultipleShooting { segments: usize },
+    /// Gauss–Legendre collocation with `stages` points per interval (order
+    /// 2·stages at the nodes) on a mesh adapted until the error estimate
+    /// meets [`SolverOptions::collocation`]'s tolerance; the other settings
+    /// (starting mesh, tolerance, budget) come from there, its `stages`
+    /// field is overridden by this one.
+    Collocation { stages: usize },
 }
 
 impl Method {
@@ -41,12 +49,13 @@ impl Method {
         match self {
             Method::Shooting => "shooting",
             Method::MultipleShooting { .. } => "multiple-shooting",
+            Method::Collocation { .. } => "collocation",
         }
     }
 
     fn segments(&self) -> usize {
         match *self {
-            Method::Shooting => 1,
+            Method::Shooting | Method::Collocation { .. } => 1,
             Method::MultipleShooting { segments } => segments.max(1),
         }
     }
@@ -60,8 +69,10 @@ pub struct SolverOptions {
     /// Newton's tolerance and budget; the residual is scaled by the rod's
     /// moment scale (and matching conditions by L, 1/L), so it is relative.
     pub newton: NewtonOptions,
-    /// The integrator's tolerances.
+    /// The integrator's tolerances (shooting).
     pub integration: Tolerances,
+    /// Mesh, error tolerance and interval budget of collocation.
+    pub collocation: CollocationOptions,
     /// Number of equally spaced output points along the rod (≥ 2).
     pub output_points: usize,
     /// A guess of the curvature at the clamp; the straight-rod balance when
@@ -103,11 +114,23 @@ impl Default for SolverOptions {
             method: Method::Shooting,
             newton: NewtonOptions::default(),
             integration: Tolerances::default(),
+            collocation: CollocationOptions::default(),
             output_points: 201,
             initial_guess: None,
             strategy: Strategy::Auto,
         }
     }
+}
+
+/// What the solution is stored as, beyond its samples: enough to evaluate
+/// it anywhere ([`Equilibrium::resample`]).
+#[derive(Debug, Clone)]
+pub enum Discretization {
+    /// Shooting: the solution is re-integrated from
+    /// [`Equilibrium::unknowns`].
+    Shooting,
+    /// Collocation: the mesh, node states and stage values.
+    Collocation(Box<CollocationSolution>),
 }
 
 /// A converged equilibrium.
@@ -123,10 +146,14 @@ pub struct Equilibrium {
     pub clamp_curvature: Vec<f64>,
     /// The full vector of shooting unknowns (κ(0) and the interior node
     /// states of multiple shooting): enough to re-integrate the solution.
+    /// Empty for collocation (see `discretization`).
     pub unknowns: Vec<f64>,
     /// The scaled shooting Jacobian at the solution; singular exactly where
-    /// the linearized BVP is (folds and branch points).
+    /// the linearized BVP is (folds and branch points). 0 × 0 for
+    /// collocation.
     pub jacobian: DMatrix<f64>,
+    /// The discrete solution behind the samples.
+    pub discretization: Discretization,
     /// Newton steps of the final solve.
     pub iterations: usize,
     /// Scaled residual (max-norm) at every Newton iterate of the final solve.
@@ -137,7 +164,7 @@ pub struct Equilibrium {
     pub load_steps: usize,
     /// Largest |d_i·d_j − δ_ij| over the output points.
     pub director_drift: f64,
-    /// Integration work over all Newton iterations.
+    /// Integration work over all Newton iterations (zero for collocation).
     pub integration: IntegrationStats,
     /// Wall time of the solve (s).
     pub wall_time: f64,
@@ -152,8 +179,10 @@ impl Equilibrium {
     }
 
     /// The solution at other points (sorted, in [0, L]), re-integrated from
-    /// the converged unknowns with the tolerances in `opts`; used by the
-    /// stability analysis at its quadrature points.
+    /// the converged unknowns with the tolerances in `opts` (shooting) or
+    /// evaluated from the collocation solution
+    /// ([`CollocationSolution::sample`]); used by the stability analysis at
+    /// its quadrature points.
     pub fn resample(
         &self,
         rod: &Rod,
@@ -161,6 +190,9 @@ impl Equilibrium {
         points: &[f64],
     ) -> Result<Vec<RodSample>, SolveError> {
         let eq = equations(rod, self.model.level);
+        if let Discretization::Collocation(sol) = &self.discretization {
+            return Ok(sol.sample(eq.as_ref(), points));
+        }
         let mut sys = ShootingSystem::new(eq.as_ref(), self.method.segments(), opts.integration);
         let (samples, _) = sys
             .sample(&self.unknowns, points)
@@ -192,6 +224,13 @@ pub enum SolveError {
     /// The converged solution could not be re-integrated for output.
     #[error("sampling the converged solution failed: {0}")]
     Sampling(integrator::IntegrationError),
+    /// Collocation returned no solution (Newton failed, a singular
+    /// Jacobian, or the mesh tolerance not reached within the budget).
+    #[error("collocation (order {order}) failed: {failure}")]
+    Collocation {
+        order: usize,
+        failure: CollocationError,
+    },
     /// Options that cannot work.
     #[error("invalid solver options: {0}")]
     Options(String),
@@ -227,37 +266,111 @@ pub fn solve(
         Strategy::Ramp => true,
         Strategy::Auto => load_ratio(rod) > 1.0,
     };
-    let (x, report, load_steps) = if ramp_first {
+    let (solved, load_steps) = if ramp_first {
         ramp(rod, model.level, opts, &mut stats, None)?
     } else {
         match solve_at(rod, model.level, opts, None, &mut stats) {
-            Ok((x, report)) => (x, report, 0),
-            Err(e) if opts.strategy == Strategy::Auto => {
+            Ok(solved) => (solved, 0),
+            Err(e) if opts.strategy == Strategy::Auto && e.ramp_may_help() => {
                 ramp(rod, model.level, opts, &mut stats, Some(e))?
             }
             Err(e) => return Err(e),
         }
     };
     let eq = equations(rod, model.level);
-    let mut sys = ShootingSystem::new(eq.as_ref(), opts.method.segments(), opts.integration);
     let points = output_grid(rod.length, opts.output_points);
-    let (samples, drift) = sys.sample(&x, &points).map_err(SolveError::Sampling)?;
-    stats += sys.stats;
+    let drift_of = |samples: &[RodSample]| {
+        samples
+            .iter()
+            .map(RodSample::director_drift)
+            .fold(0.0, f64::max)
+    };
+    let equilibrium = match solved {
+        Solved::Shooting { x, report } => {
+            let mut sys =
+                ShootingSystem::new(eq.as_ref(), opts.method.segments(), opts.integration);
+            let (samples, drift) = sys.sample(&x, &points).map_err(SolveError::Sampling)?;
+            stats += sys.stats;
+            Equilibrium {
+                model: model.clone(),
+                method: opts.method,
+                samples,
+                clamp_curvature: sys.free_values(&x).to_vec(),
+                unknowns: x.clone(),
+                jacobian: report.jacobian.clone(),
+                discretization: Discretization::Shooting,
+                iterations: report.iterations,
+                residual: *report.history.last().unwrap_or(&f64::NAN),
+                residual_history: report.history,
+                load_steps,
+                director_drift: drift,
+                integration: stats,
+                wall_time: 0.0,
+            }
+        }
+        Solved::Collocation(sol) => {
+            let samples = sol.sample(eq.as_ref(), &points);
+            let drift = drift_of(&samples).max(sol.director_drift);
+            Equilibrium {
+                model: model.clone(),
+                method: opts.method,
+                clamp_curvature: eq.unknowns_of(&sol.states[0]),
+                samples,
+                unknowns: Vec::new(),
+                jacobian: DMatrix::zeros(0, 0),
+                iterations: sol.iterations,
+                residual: sol.residual,
+                residual_history: sol.residual_history.clone(),
+                discretization: Discretization::Collocation(Box::new(sol)),
+                load_steps,
+                director_drift: drift,
+                integration: stats,
+                wall_time: 0.0,
+            }
+        }
+    };
     Ok(Equilibrium {
-        model: model.clone(),
-        method: opts.method,
-        samples,
-        clamp_curvature: sys.free_values(&x).to_vec(),
-        unknowns: x.clone(),
-        jacobian: report.jacobian.clone(),
-        iterations: report.iterations,
-        residual: *report.history.last().unwrap_or(&f64::NAN),
-        residual_history: report.history,
-        load_steps,
-        director_drift: drift,
-        integration: stats,
         wall_time: start.elapsed().as_secs_f64(),
+        ..equilibrium
     })
+}
+
+impl SolveError {
+    /// Whether a load ramp could cure this failure of a direct solve: not
+    /// for bad options or a mesh budget that is too small.
+    fn ramp_may_help(&self) -> bool {
+        match self {
+            SolveError::Options(_) | SolveError::Model(_) => false,
+            SolveError::Collocation { failure, .. } => !matches!(
+                failure,
+                CollocationError::Options(_)
+                    | CollocationError::ToleranceNotReached { .. }
+                    | CollocationError::CoarseMesh { .. }
+            ),
+            _ => true,
+        }
+    }
+}
+
+/// A converged discrete solution, before sampling.
+enum Solved {
+    Shooting {
+        x: Vec<f64>,
+        report: newton::NewtonReport,
+    },
+    Collocation(CollocationSolution),
+}
+
+impl Solved {
+    /// Newton converged cleanly: no damping and contraction Θ ≤ `theta`.
+    fn clean(&self, theta: f64) -> bool {
+        match self {
+            Solved::Shooting { report, .. } => {
+                report.damped_steps == 0 && report.contraction <= theta
+            }
+            Solved::Collocation(sol) => sol.damped_steps == 0 && sol.contraction <= theta,
+        }
+    }
 }
 
 /// The energy Hessian must be positive definite for κ' to exist (DESIGN.md:
@@ -295,31 +408,63 @@ fn output_grid(length: f64, n: usize) -> Vec<f64> {
         .collect()
 }
 
-/// One Newton solve from a warm start `x0` (full unknown vector) or from the
-/// guess in the options.
+/// One Newton solve from a warm start (a solution of the same method at a
+/// nearby load) or from the guess in the options.
 fn solve_at(
     rod: &Rod,
     level: ModelLevel,
     opts: &SolverOptions,
-    x0: Option<&[f64]>,
+    warm: Option<&Solved>,
     stats: &mut IntegrationStats,
-) -> Result<(Vec<f64>, newton::NewtonReport), SolveError> {
+) -> Result<Solved, SolveError> {
     let eq = equations(rod, level);
+    let guess = |eq: &dyn RodEquations| match &opts.initial_guess {
+        Some(g) => guess_for_level(g, eq, level),
+        None => Ok(eq.initial_guess()),
+    };
+    if let Method::Collocation { stages } = opts.method {
+        let copts = CollocationOptions {
+            stages,
+            ..opts.collocation
+        };
+        let warm = match warm {
+            Some(Solved::Collocation(sol)) => Some(sol),
+            _ => None,
+        };
+        let u = match warm {
+            Some(_) => None,
+            None => Some(guess(eq.as_ref())?),
+        };
+        let fail = |failure| SolveError::Collocation {
+            order: 2 * stages,
+            failure,
+        };
+        let sol = solve_collocation_from(eq.as_ref(), &copts, &opts.newton, warm, u.as_deref())
+            .map_err(fail)?;
+        if !copts.adapt && (sol.error_estimate.is_nan() || sol.error_estimate > copts.tolerance) {
+            return Err(fail(CollocationError::CoarseMesh {
+                tolerance: copts.tolerance,
+                estimate: sol.error_estimate,
+                intervals: sol.intervals(),
+            }));
+        }
+        return Ok(Solved::Collocation(sol));
+    }
     let mut sys = ShootingSystem::new(eq.as_ref(), opts.method.segments(), opts.integration);
-    let x0 = match x0 {
-        Some(x) => x.to_vec(),
-        None => {
-            let u = match &opts.initial_guess {
-                Some(g) => guess_for_level(g, eq.as_ref(), level)?,
-                None => eq.initial_guess(),
-            };
+    let x0 = match warm {
+        Some(Solved::Shooting { x, .. }) => x.clone(),
+        _ => {
+            let u = guess(eq.as_ref())?;
             sys.initial_unknowns(&u)
         }
     };
     let outcome = newton::solve(&mut sys, &x0, &opts.newton);
     *stats += sys.stats;
     match outcome {
-        Ok(report) => Ok((report.x.clone(), report)),
+        Ok(report) => Ok(Solved::Shooting {
+            x: report.x.clone(),
+            report,
+        }),
         Err(failure) => Err(SolveError::NoConvergence {
             method: opts.method.name(),
             history: format_history(failure.history()),
@@ -368,11 +513,11 @@ fn ramp(
     opts: &SolverOptions,
     stats: &mut IntegrationStats,
     first_error: Option<SolveError>,
-) -> Result<(Vec<f64>, newton::NewtonReport, usize), SolveError> {
+) -> Result<(Solved, usize), SolveError> {
     const RAMP_ITERATIONS: usize = 8;
     const RAMP_CONTRACTION: f64 = 0.25;
     let (mut lambda, mut step): (f64, f64) = (0.0, 0.25);
-    let mut x: Option<Vec<f64>> = None;
+    let mut x: Option<Solved> = None;
     let mut last_error = first_error;
     let mut steps = 0;
     let step_opts = SolverOptions {
@@ -386,19 +531,18 @@ fn ramp(
     while step >= 1e-4 && steps < 400 {
         let target = (lambda + step).min(1.0);
         let scaled = rod.with_load_factor(target);
-        match solve_at(&scaled, level, &step_opts, x.as_deref(), stats) {
-            Ok((xn, report))
-                if report.damped_steps == 0 && report.contraction <= RAMP_CONTRACTION =>
-            {
+        match solve_at(&scaled, level, &step_opts, x.as_ref(), stats) {
+            Ok(solved) if solved.clean(RAMP_CONTRACTION) => {
                 steps += 1;
                 lambda = target;
-                x = Some(xn.clone());
                 if lambda >= 1.0 {
-                    return Ok((xn, report, steps));
+                    return Ok((solved, steps));
                 }
+                x = Some(solved);
                 step = (step * 1.5).min(0.5);
             }
             Ok(_) => step *= 0.5,
+            Err(e) if !e.ramp_may_help() => return Err(e),
             Err(e) => {
                 last_error = Some(e);
                 step *= 0.5;

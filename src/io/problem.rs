@@ -255,12 +255,22 @@ pub struct LoadSection {
 #[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct SolverSection {
-    /// "shooting" or "multiple-shooting".
+    /// "shooting", "multiple-shooting" or "collocation".
     #[serde(default = "default_method")]
     pub method: String,
     /// Segments of multiple shooting.
     #[serde(default = "default_segments")]
     pub segments: usize,
+    /// Gauss points per interval of collocation (1 to 3; order 2·stages).
+    #[serde(default = "default_stages")]
+    pub stages: usize,
+    /// Target of collocation's accumulated local error estimate (scaled
+    /// state, max-norm).
+    #[serde(default = "default_collocation_tolerance")]
+    pub collocation_tolerance: f64,
+    /// Intervals collocation's mesh adaptation may use at most.
+    #[serde(default = "default_max_intervals")]
+    pub max_intervals: usize,
     /// "auto", "planar" or "kirchhoff".
     #[serde(default = "default_auto")]
     pub model: String,
@@ -289,6 +299,15 @@ pub struct SolverSection {
 
 fn default_method() -> String {
     "shooting".into()
+}
+fn default_stages() -> usize {
+    3
+}
+fn default_collocation_tolerance() -> f64 {
+    1e-10
+}
+fn default_max_intervals() -> usize {
+    4096
 }
 fn default_segments() -> usize {
     8
@@ -638,12 +657,34 @@ fn build_options(s: &SolverSection) -> Result<SolverOptions, ProblemError> {
                 segments: s.segments,
             }
         }
+        "collocation" => {
+            if !(1..=3).contains(&s.stages) {
+                return Err(invalid("solver.stages", "must be 1, 2 or 3"));
+            }
+            Method::Collocation { stages: s.stages }
+        }
         other => {
             return Err(invalid(
                 "solver.method",
-                format!("unknown method `{other}`; expected \"shooting\" or \"multiple-shooting\""),
+                format!(
+                    "unknown method `{other}`; expected \"shooting\", \"multiple-shooting\" \
+                     or \"collocation\""
+                ),
             ))
         }
+    };
+    let defaults = crate::bvp::CollocationOptions::default();
+    if s.max_intervals < defaults.intervals {
+        return Err(invalid(
+            "solver.max_intervals",
+            format!("must be at least {}", defaults.intervals),
+        ));
+    }
+    let collocation = crate::bvp::CollocationOptions {
+        stages: s.stages,
+        tolerance: positive("solver.collocation_tolerance", s.collocation_tolerance)?,
+        max_intervals: s.max_intervals,
+        ..defaults
     };
     let strategy = match s.strategy.as_str() {
         "auto" => Strategy::Auto,
@@ -679,6 +720,7 @@ fn build_options(s: &SolverSection) -> Result<SolverOptions, ProblemError> {
             atol: tol,
             max_steps: s.max_steps.max(1),
         },
+        collocation,
         output_points: s.output_points,
         initial_guess,
         strategy,
