@@ -6,7 +6,9 @@
 //! file: build a [`model::Rod`] (with any [`model::StoredEnergy`]), pick a
 //! [`model::ModelChoice`], and call [`bvp::solve`].
 
+pub mod bench;
 pub mod bvp;
+pub mod continuation;
 pub mod equations;
 pub mod io;
 pub mod model;

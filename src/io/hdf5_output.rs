@@ -88,7 +88,7 @@ pub enum StabilityResult {
 
 /// Runs `write` on a temporary file next to `path` and renames it into
 /// place; removes the temporary on any failure.
-fn write_atomically(
+pub(crate) fn write_atomically(
     path: &Path,
     force: bool,
     write: impl FnOnce(&hdf5::File) -> hdf5::Result<()>,

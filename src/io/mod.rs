@@ -1,9 +1,11 @@
 //! Problem files in, results out: TOML problem files (serde), HDF5 results
 //! (the HDF5 C library through hdf5-metno).
 
+mod diagram;
 mod hdf5_output;
 mod problem;
 
+pub use diagram::write_diagram;
 pub use hdf5_output::{
     check_target, write_equilibrium, write_stability, OutputError, StabilityResult,
 };

@@ -1,0 +1,283 @@
+//! A one-parameter family of rods and its discretized equilibrium equations
+//! F(x, p) = 0 (shooting unknowns x, parameter p).
+//!
+//! F_x is the exact shooting Jacobian (variational equations). F_p is a
+//! central difference in p of the converged-tolerance residual; it only
+//! steers the predictor and the bordering row, so its O(tolerance/h) error
+//! slows the corrector at worst — the points themselves satisfy F = 0 to
+//! the Newton tolerance.
+
+use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+
+use crate::bvp::integrator::{IntegrationError, Tolerances};
+use crate::bvp::newton::NonlinearSystem;
+use crate::bvp::{equations, ShootingSystem};
+use crate::equations::RodSample;
+use crate::model::{ModelLevel, Profile, Rod};
+
+/// Which number of the rod the parameter sets.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Parameter {
+    /// All loads multiplied by p.
+    LoadScale,
+    /// Component i of the tip force.
+    TipForce(usize),
+    /// Component i of the tip couple.
+    TipCouple(usize),
+    /// Component i of the distributed force.
+    DistributedForce(usize),
+    /// The rod length.
+    Length,
+    /// The constant stiffness B_i (i = 0, 1, 2).
+    Stiffness(usize),
+    /// The constant intrinsic curvature κ⁰_i.
+    IntrinsicCurvature(usize),
+    /// The clamp turned by p (rad) about d2(0), d3 towards d1.
+    ClampAngle,
+}
+
+impl Parameter {
+    /// The parameter named by a problem-file key: `load_scale`,
+    /// `loads.tip_force[i]`, `loads.tip_couple[i]`,
+    /// `loads.distributed_force[i]`, `rod.length`, `energy.stiffness[i]`,
+    /// `energy.intrinsic_curvature[i]`, `clamp.angle`.
+    pub fn from_key(key: &str) -> Option<Parameter> {
+        let indexed = |prefix: &str| -> Option<usize> {
+            let rest = key
+                .strip_prefix(prefix)?
+                .strip_prefix('[')?
+                .strip_suffix(']')?;
+            rest.parse().ok().filter(|i| *i < 3)
+        };
+        Some(match key {
+            "load_scale" => Parameter::LoadScale,
+            "rod.length" => Parameter::Length,
+            "clamp.angle" => Parameter::ClampAngle,
+            _ => {
+                if let Some(i) = indexed("loads.tip_force") {
+                    Parameter::TipForce(i)
+                } else if let Some(i) = indexed("loads.tip_couple") {
+                    Parameter::TipCouple(i)
+                } else if let Some(i) = indexed("loads.distributed_force") {
+                    Parameter::DistributedForce(i)
+                } else if let Some(i) = indexed("energy.stiffness") {
+                    Parameter::Stiffness(i)
+                } else if let Some(i) = indexed("energy.intrinsic_curvature") {
+                    Parameter::IntrinsicCurvature(i)
+                } else {
+                    return None;
+                }
+            }
+        })
+    }
+}
+
+/// A rod whose one number is the parameter.
+#[derive(Debug, Clone)]
+pub struct Family {
+    base: Rod,
+    parameter: Parameter,
+    level: ModelLevel,
+    segments: usize,
+    tolerances: Tolerances,
+}
+
+/// Why a rod could not be built at a parameter value.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FamilyError {
+    /// The parameter needs a linear energy with constant profiles.
+    #[error(
+        "parameter {0:?} needs the linear energy with constant stiffness and intrinsic curvature"
+    )]
+    NotConstant(Parameter),
+    /// A value outside the physical range.
+    #[error("parameter {parameter:?} = {value} is not physical")]
+    NotPhysical { parameter: Parameter, value: f64 },
+}
+
+impl Family {
+    /// The family around `base` (its own value of the parameter is
+    /// replaced by p), discretized at `level` by shooting on `segments`.
+    pub fn new(
+        base: Rod,
+        parameter: Parameter,
+        level: ModelLevel,
+        segments: usize,
+        tolerances: Tolerances,
+    ) -> Self {
+        Family {
+            base,
+            parameter,
+            level,
+            segments: segments.max(1),
+            tolerances,
+        }
+    }
+
+    /// The BVP method of the family's discretization.
+    pub fn method(&self) -> crate::bvp::Method {
+        match self.segments {
+            1 => crate::bvp::Method::Shooting,
+            segments => crate::bvp::Method::MultipleShooting { segments },
+        }
+    }
+
+    /// The model level.
+    pub fn level(&self) -> ModelLevel {
+        self.level
+    }
+
+    /// The parameter.
+    pub fn parameter(&self) -> Parameter {
+        self.parameter
+    }
+
+    /// The rod at p.
+    pub fn rod_at(&self, p: f64) -> Result<Rod, FamilyError> {
+        let mut rod = self.base.clone();
+        let bad = || FamilyError::NotPhysical {
+            parameter: self.parameter,
+            value: p,
+        };
+        if !p.is_finite() {
+            return Err(bad());
+        }
+        match self.parameter {
+            Parameter::LoadScale => rod.loads = self.base.loads.scaled(p),
+            Parameter::TipForce(i) => rod.loads.tip_force[i] = p,
+            Parameter::TipCouple(i) => rod.loads.tip_couple[i] = p,
+            Parameter::DistributedForce(i) => rod.loads.distributed_force[i] = p,
+            Parameter::Length => {
+                if p <= 0.0 {
+                    return Err(bad());
+                }
+                rod.length = p;
+            }
+            Parameter::ClampAngle => {
+                let axis = self.base.clamp.director(1);
+                // About d2 by +p: d3 turns towards d1 (R d3 = d3 cos p + d1 sin p).
+                let turn =
+                    nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(axis), p);
+                rod.clamp.frame = turn.matrix() * self.base.clamp.frame;
+            }
+            Parameter::Stiffness(_) | Parameter::IntrinsicCurvature(_) => {
+                rod.energy = self.linear_with(p)?;
+            }
+        }
+        Ok(rod)
+    }
+
+    /// The linear energy with constant profiles, one of them set to p.
+    fn linear_with(
+        &self,
+        p: f64,
+    ) -> Result<std::sync::Arc<dyn crate::model::StoredEnergy>, FamilyError> {
+        let e = &self.base.energy;
+        if !e.is_quadratic() {
+            return Err(FamilyError::NotConstant(self.parameter));
+        }
+        let zero = Vector3::zeros();
+        let h = e.stiffness(0.0, &zero);
+        // For the linear energy M(0) = −B κ⁰ at κ = 0.
+        let m = e.moment(0.0, &zero);
+        let mut b = [h[(0, 0)], h[(1, 1)], h[(2, 2)]];
+        let mut k0 = [-m[0] / b[0], -m[1] / b[1], -m[2] / b[2]];
+        match self.parameter {
+            Parameter::Stiffness(i) => {
+                if p <= 0.0 {
+                    return Err(FamilyError::NotPhysical {
+                        parameter: self.parameter,
+                        value: p,
+                    });
+                }
+                b[i] = p
+            }
+            Parameter::IntrinsicCurvature(i) => k0[i] = p,
+            _ => unreachable!("only profile parameters"),
+        }
+        let linear = crate::model::LinearElastic {
+            stiffness: b.map(Profile::Constant),
+            intrinsic_curvature: k0.map(Profile::Constant),
+        };
+        Ok(std::sync::Arc::new(linear))
+    }
+
+    /// F(x, p) and F_x, scaled as in [`ShootingSystem`].
+    pub fn residual(
+        &self,
+        x: &[f64],
+        p: f64,
+        r: &mut DVector<f64>,
+        jac: &mut DMatrix<f64>,
+    ) -> Result<(), PointError> {
+        let rod = self.rod_at(p)?;
+        let eq = equations(&rod, self.level);
+        let mut sys = ShootingSystem::new(eq.as_ref(), self.segments, self.tolerances);
+        sys.evaluate(x, r, jac)?;
+        Ok(())
+    }
+
+    /// F_p by a central difference with h = 1e-4 max(1, |p|).
+    pub fn parameter_derivative(&self, x: &[f64], p: f64) -> Result<DVector<f64>, PointError> {
+        let n = x.len();
+        let h = 1e-4 * p.abs().max(1.0);
+        let (mut a, mut b) = (DVector::zeros(n), DVector::zeros(n));
+        let mut jac = DMatrix::zeros(n, n);
+        self.residual(x, p + h, &mut a, &mut jac)?;
+        self.residual(x, p - h, &mut b, &mut jac)?;
+        Ok((a - b) / (2.0 * h))
+    }
+
+    /// Number of discrete unknowns.
+    pub fn size(&self) -> usize {
+        let eq = equations(&self.base, self.level);
+        eq.unknowns() + eq.dim() * (self.segments - 1)
+    }
+
+    /// A starting vector of unknowns at p: the straight-rod balance guess,
+    /// integrated across the segments.
+    pub fn initial_unknowns(&self, p: f64) -> Result<Vec<f64>, PointError> {
+        let rod = self.rod_at(p)?;
+        let eq = equations(&rod, self.level);
+        let u = eq.initial_guess();
+        let mut sys = ShootingSystem::new(eq.as_ref(), self.segments, self.tolerances);
+        Ok(sys.initial_unknowns(&u))
+    }
+
+    /// The solution at sorted points.
+    pub fn samples(&self, x: &[f64], p: f64, points: &[f64]) -> Result<Vec<RodSample>, PointError> {
+        let rod = self.rod_at(p)?;
+        let eq = equations(&rod, self.level);
+        let mut sys = ShootingSystem::new(eq.as_ref(), self.segments, self.tolerances);
+        Ok(sys.sample(x, points)?.0)
+    }
+
+    /// The tip sample (position, directors) at (x, p).
+    pub fn tip(&self, x: &[f64], p: f64) -> Result<RodSample, PointError> {
+        let l = self.rod_at(p)?.length;
+        Ok(self.samples(x, p, &[l])?.remove(0))
+    }
+}
+
+/// Why a point of the family could not be evaluated.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PointError {
+    /// The rod is not defined at this parameter value.
+    #[error(transparent)]
+    Family(#[from] FamilyError),
+    /// The integration failed.
+    #[error(transparent)]
+    Integration(#[from] IntegrationError),
+    /// The eigensolver failed.
+    #[error("eigenvalues: {0}")]
+    Eigen(String),
+    /// Newton at fixed parameter did not converge.
+    #[error("Newton did not converge at p = {0}")]
+    NoConvergence(f64),
+}
+
+/// The angle (rad) between the tip tangent and the clamp tangent.
+pub fn tip_angle(clamp: &Matrix3<f64>, tip: &RodSample) -> f64 {
+    let t0 = clamp.column(2);
+    tip.directors[2].dot(&t0).clamp(-1.0, 1.0).acos()
+}

@@ -1,0 +1,207 @@
+//! The Hessian spectrum along a branch, tracked by eigenvector overlap.
+//!
+//! Sorting eigenvalues by size mixes up modes where two curves cross; the
+//! tracker matches each new eigenvector to the previous one it overlaps
+//! most in the G (L²) inner product, so that a column of the diagram is one
+//! mode.
+
+use nalgebra::Vector3;
+
+use super::family::{Family, PointError};
+use crate::stability::banded::SymmetricBanded;
+use crate::stability::eigen::{count_below, lowest_eigenpairs, lowest_eigenpairs_near};
+use crate::stability::{coefficients, Block, FiniteElements, StabilityOptions};
+
+/// The measured spectrum at one point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Spectrum {
+    /// Tracked eigenvalues, block after block.
+    pub values: Vec<f64>,
+    /// Eigenvectors per block, in tracked order.
+    pub vectors: Vec<Vec<Vec<f64>>>,
+    /// Morse index per block.
+    pub block_morse: Vec<usize>,
+    /// Total Morse index.
+    pub morse_index: usize,
+    /// √∫|κ|² ds.
+    pub curvature_norm: f64,
+    /// Positions at 21 equally spaced points.
+    pub shape: Vec<Vector3<f64>>,
+}
+
+/// K and G of one block.
+type BlockMatrices = (SymmetricBanded, SymmetricBanded);
+
+/// Measures spectra and keeps the last eigenvectors for matching.
+#[derive(Debug, Clone)]
+pub struct Tracker {
+    blocks: Vec<Block>,
+    opts: StabilityOptions,
+    base_length: f64,
+    previous: Option<Vec<Vec<Vec<f64>>>>,
+    previous_values: Option<Vec<Vec<f64>>>,
+}
+
+impl Tracker {
+    /// A tracker of `blocks` with the discretization in `opts`.
+    pub fn new(family: &Family, blocks: Vec<Block>, opts: StabilityOptions) -> Self {
+        let base_length = family
+            .rod_at(0.0)
+            .or_else(|_| family.rod_at(1.0))
+            .map_or(1.0, |r| r.length);
+        Tracker {
+            blocks,
+            opts,
+            base_length,
+            previous: None,
+            previous_values: None,
+        }
+    }
+
+    /// The blocks, in the order of the eigenvalue columns.
+    pub fn blocks(&self) -> &[Block] {
+        &self.blocks
+    }
+
+    /// Names of the eigenvalue columns.
+    pub fn names(&self) -> Vec<String> {
+        self.blocks
+            .iter()
+            .flat_map(|b| (0..self.opts.eigenvalues).map(move |i| format!("{}[{i}]", b.name())))
+            .collect()
+    }
+
+    /// Finite-element nodes of the modes (at the base length).
+    pub fn nodes(&self) -> Vec<f64> {
+        FiniteElements::new(self.base_length, self.opts.elements, self.opts.order).nodes()
+    }
+
+    /// Forget the previous eigenvectors (a new branch starts).
+    pub fn reset(&mut self) {
+        self.previous = None;
+        self.previous_values = None;
+    }
+
+    /// K and G of every block at (x, p), with the curvature norm.
+    fn matrices(
+        &self,
+        family: &Family,
+        x: &[f64],
+        p: f64,
+    ) -> Result<(FiniteElements, Vec<BlockMatrices>, f64), PointError> {
+        let rod = family.rod_at(p)?;
+        let fe = FiniteElements::new(rod.length, self.opts.elements, self.opts.order);
+        let samples = family.samples(x, p, &fe.quadrature_points())?;
+        let norm = samples
+            .iter()
+            .zip(fe.quadrature_weights())
+            .map(|(s, w)| w * s.curvature.norm_squared())
+            .sum::<f64>()
+            .sqrt();
+        let c = coefficients(&rod, &samples);
+        let mats = self
+            .blocks
+            .iter()
+            .map(|&b| (fe.stiffness(&c, b), fe.mass(b)))
+            .collect();
+        Ok((fe, mats, norm))
+    }
+
+    /// The spectrum at (x, p), matched to the previous point's modes.
+    pub fn measure(&mut self, family: &Family, x: &[f64], p: f64) -> Result<Spectrum, PointError> {
+        let (_, mats, norm) = self.matrices(family, x, p)?;
+        let mut values = vec![];
+        let mut vectors = vec![];
+        let mut block_morse = vec![];
+        for (bi, (k, g)) in mats.iter().enumerate() {
+            // The previous point's lowest two eigenvalues place the shift.
+            let near = self.previous_values.as_ref().map(|v| {
+                let mut b: Vec<f64> = v[bi].clone();
+                b.sort_by(|x, y| x.total_cmp(y));
+                (b[0], *b.get(1).unwrap_or(&b[0]))
+            });
+            let pairs = lowest_eigenpairs_near(k, g, self.opts.eigenvalues, near)
+                .map_err(|e| PointError::Eigen(e.to_string()))?;
+            let order = match &self.previous {
+                Some(prev) => match_modes(&prev[bi], &pairs.vectors, g),
+                None => (0..pairs.values.len()).collect(),
+            };
+            values.extend(order.iter().map(|&i| pairs.values[i]));
+            vectors.push(
+                order
+                    .iter()
+                    .map(|&i| pairs.vectors[i].clone())
+                    .collect::<Vec<_>>(),
+            );
+            block_morse.push(count_below(k, g, 0.0));
+        }
+        self.previous = Some(vectors.clone());
+        let k = self.opts.eigenvalues;
+        self.previous_values = Some(values.chunks(k).map(|c| c.to_vec()).collect());
+        let l = family.rod_at(p)?.length;
+        let grid: Vec<f64> = (0..21).map(|i| l * i as f64 / 20.0).collect();
+        let shape = family
+            .samples(x, p, &grid)?
+            .iter()
+            .map(|s| s.position)
+            .collect();
+        Ok(Spectrum {
+            values,
+            vectors,
+            morse_index: block_morse.iter().sum(),
+            block_morse,
+            curvature_norm: norm,
+            shape,
+        })
+    }
+
+    /// The eigenvalue of `block` nearest zero at (x, p) and its mode as
+    /// nodal rotations (for locating and classifying events).
+    pub fn nearest_zero(
+        &self,
+        family: &Family,
+        x: &[f64],
+        p: f64,
+        block: Block,
+    ) -> Result<(f64, Vec<Vector3<f64>>), PointError> {
+        let (fe, mats, _) = self.matrices(family, x, p)?;
+        let bi = self
+            .blocks
+            .iter()
+            .position(|&b| b == block)
+            .expect("a tracked block");
+        let (k, g) = &mats[bi];
+        let pairs = lowest_eigenpairs(k, g, self.opts.eigenvalues)
+            .map_err(|e| PointError::Eigen(e.to_string()))?;
+        let i = (0..pairs.values.len())
+            .min_by(|&a, &b| pairs.values[a].abs().total_cmp(&pairs.values[b].abs()))
+            .expect("at least one eigenvalue");
+        Ok((
+            pairs.values[i],
+            fe.nodal_rotations(block, &pairs.vectors[i]),
+        ))
+    }
+}
+
+/// For each previous mode (in order), the unused new mode with the largest
+/// |⟨v_old, G v_new⟩|.
+fn match_modes(previous: &[Vec<f64>], new: &[Vec<f64>], g: &SymmetricBanded) -> Vec<usize> {
+    let mut used = vec![false; new.len()];
+    let mut order = Vec::with_capacity(new.len());
+    for old in previous {
+        if old.len() != g.size() {
+            break;
+        }
+        let best = (0..new.len()).filter(|&j| !used[j]).max_by(|&a, &b| {
+            g.inner(old, &new[a])
+                .abs()
+                .total_cmp(&g.inner(old, &new[b]).abs())
+        });
+        if let Some(j) = best {
+            used[j] = true;
+            order.push(j);
+        }
+    }
+    order.extend((0..new.len()).filter(|&j| !used[j]));
+    order
+}

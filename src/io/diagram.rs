@@ -1,0 +1,176 @@
+//! Bifurcation diagrams as HDF5 files.
+//!
+//! Layout (a contract, see README.md): `/branches/<i>/parameter` (m),
+//! `tip_position` (m×3), `eigenvalues` (m×k), `stable` (m), `morse_index`
+//! (m), `norm` (m), `shapes` (m×21×3), attributes `parent` and
+//! `stop_reason`; `/special_points/kind` (strings), `branch`, `index`,
+//! `parameter`, `tip_position` (s×3), `block`, `symmetry_breaking`,
+//! `null_vectors` (s×nodes×3), `singularity` (s×2); the problem text as the
+//! root attribute `problem`, the run's `stop_reason` and the parameter name
+//! as root attributes.
+
+use std::path::Path;
+
+use hdf5::types::VarLenUnicode;
+
+use super::hdf5_output::{write_atomically, OutputError};
+use crate::continuation::Diagram;
+
+fn text(s: &str) -> hdf5::Result<VarLenUnicode> {
+    s.parse::<VarLenUnicode>()
+        .map_err(|e| hdf5::Error::from(e.to_string().as_str()))
+}
+
+fn string_attr(loc: &hdf5::Location, name: &str, value: &str) -> hdf5::Result<()> {
+    loc.new_attr::<VarLenUnicode>()
+        .create(name)?
+        .write_scalar(&text(value)?)
+}
+
+fn array(group: &hdf5::Group, name: &str, shape: &[usize], data: &[f64]) -> hdf5::Result<()> {
+    group
+        .new_dataset::<f64>()
+        .shape(shape)
+        .create(name)?
+        .write_raw(data)
+}
+
+fn integers(group: &hdf5::Group, name: &str, data: &[u64]) -> hdf5::Result<()> {
+    group
+        .new_dataset::<u64>()
+        .shape([data.len()])
+        .create(name)?
+        .write_raw(data)
+}
+
+fn strings(group: &hdf5::Group, name: &str, data: &[&str]) -> hdf5::Result<()> {
+    let values: Vec<VarLenUnicode> = data.iter().map(|s| text(s)).collect::<hdf5::Result<_>>()?;
+    group
+        .new_dataset::<VarLenUnicode>()
+        .shape([values.len()])
+        .create(name)?
+        .write_raw(&values)
+}
+
+/// Writes the diagram atomically (a temporary file renamed into place).
+pub fn write_diagram(
+    path: &Path,
+    problem: &str,
+    parameter: &str,
+    diagram: &Diagram,
+    force: bool,
+) -> Result<(), OutputError> {
+    write_atomically(path, force, |file| {
+        string_attr(file, "problem", problem)?;
+        string_attr(file, "parameter_name", parameter)?;
+        string_attr(file, "stop_reason", &diagram.stop_reason)?;
+        string_attr(
+            file,
+            "generator",
+            concat!("cosserat ", env!("CARGO_PKG_VERSION")),
+        )?;
+        write_branches(file, diagram)?;
+        write_special_points(file, diagram)
+    })
+}
+
+fn write_branches(file: &hdf5::File, d: &Diagram) -> hdf5::Result<()> {
+    let root = file.create_group("branches")?;
+    let names: Vec<&str> = d.eigenvalue_names.iter().map(String::as_str).collect();
+    strings(&root, "eigenvalue_names", &names)?;
+    for (i, b) in d.branches.iter().enumerate() {
+        let g = root.create_group(&i.to_string())?;
+        let m = b.points.len();
+        let k = d.eigenvalue_names.len();
+        let col = |f: &dyn Fn(&crate::continuation::Point) -> f64| {
+            b.points.iter().map(f).collect::<Vec<f64>>()
+        };
+        array(&g, "parameter", &[m], &col(&|p| p.parameter))?;
+        let tip: Vec<f64> = b
+            .points
+            .iter()
+            .flat_map(|p| p.tip.position.as_slice().to_vec())
+            .collect();
+        array(&g, "tip_position", &[m, 3], &tip)?;
+        let eig: Vec<f64> = b
+            .points
+            .iter()
+            .flat_map(|p| p.eigenvalues.clone())
+            .collect();
+        array(&g, "eigenvalues", &[m, k], &eig)?;
+        let stable: Vec<u64> = b.points.iter().map(|p| p.stable as u64).collect();
+        integers(&g, "stable", &stable)?;
+        let morse: Vec<u64> = b.points.iter().map(|p| p.morse_index as u64).collect();
+        integers(&g, "morse_index", &morse)?;
+        array(&g, "norm", &[m], &col(&|p| p.norm))?;
+        let shapes: Vec<f64> = b
+            .points
+            .iter()
+            .flat_map(|p| p.shape.iter().flat_map(|r| r.as_slice().to_vec()))
+            .collect();
+        let n_shape = b.points.first().map_or(0, |p| p.shape.len());
+        array(&g, "shapes", &[m, n_shape, 3], &shapes)?;
+        g.new_attr::<i64>()
+            .create("parent")?
+            .write_scalar(&b.parent.map_or(-1, |p| p as i64))?;
+        string_attr(&g, "stop_reason", &b.stop_reason)?;
+    }
+    Ok(())
+}
+
+fn write_special_points(file: &hdf5::File, d: &Diagram) -> hdf5::Result<()> {
+    let g = file.create_group("special_points")?;
+    let sp = &d.special_points;
+    let kinds: Vec<&str> = sp.iter().map(|s| s.kind.name()).collect();
+    strings(&g, "kind", &kinds)?;
+    let blocks: Vec<&str> = sp.iter().map(|s| s.block.name()).collect();
+    strings(&g, "block", &blocks)?;
+    integers(
+        &g,
+        "branch",
+        &sp.iter().map(|s| s.branch as u64).collect::<Vec<_>>(),
+    )?;
+    integers(
+        &g,
+        "index",
+        &sp.iter().map(|s| s.index as u64).collect::<Vec<_>>(),
+    )?;
+    integers(
+        &g,
+        "symmetry_breaking",
+        &sp.iter()
+            .map(|s| s.symmetry_breaking as u64)
+            .collect::<Vec<_>>(),
+    )?;
+    array(
+        &g,
+        "parameter",
+        &[sp.len()],
+        &sp.iter().map(|s| s.point.parameter).collect::<Vec<_>>(),
+    )?;
+    let tip: Vec<f64> = sp
+        .iter()
+        .flat_map(|s| s.point.tip.position.as_slice().to_vec())
+        .collect();
+    array(&g, "tip_position", &[sp.len(), 3], &tip)?;
+    let sing: Vec<f64> = sp
+        .iter()
+        .flat_map(|s| [s.singularity.0, s.singularity.1])
+        .collect();
+    array(&g, "singularity", &[sp.len(), 2], &sing)?;
+    let nodes = d.nodes.len();
+    let null: Vec<f64> = sp
+        .iter()
+        .flat_map(|s| {
+            let mut v: Vec<f64> = s
+                .null_mode
+                .iter()
+                .flat_map(|w| w.as_slice().to_vec())
+                .collect();
+            v.resize(nodes * 3, 0.0);
+            v
+        })
+        .collect();
+    array(&g, "null_vectors", &[sp.len(), nodes, 3], &null)?;
+    array(&g, "nodes", &[nodes], &d.nodes)
+}
