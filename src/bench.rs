@@ -244,7 +244,7 @@ fn work_precision(dir: &Path) -> Result<(), Box<dyn std::error::Error>> {
         );
     }
     std::fs::write(dir.join("work_precision.csv"), csv)?;
-    register_font();
+    crate::plot::register_font();
     let png = dir.join("work_precision.png");
     let svg = dir.join("work_precision.svg");
     chart(
@@ -262,11 +262,6 @@ fn work_precision(dir: &Path) -> Result<(), Box<dyn std::error::Error>> {
         svg.display()
     );
     Ok(())
-}
-
-fn register_font() {
-    static FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
-    let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
 }
 
 const FLOOR: f64 = 1e-16;

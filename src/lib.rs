@@ -12,4 +12,5 @@ pub mod continuation;
 pub mod equations;
 pub mod io;
 pub mod model;
+pub mod plot;
 pub mod stability;

@@ -6,6 +6,8 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+mod continue_command;
+
 use clap::{Parser, Subcommand};
 use cosserat::bvp::{solve, Equilibrium};
 use cosserat::io::{check_target, write_equilibrium, write_stability, Problem, StabilityResult};
@@ -56,6 +58,35 @@ enum Command {
         #[arg(long)]
         force: bool,
     },
+    /// Continue equilibria in a parameter ([continuation] table): branches,
+    /// tracked Hessian eigenvalues, folds, branch points, branch switching.
+    Continue {
+        /// The problem file (TOML).
+        problem: PathBuf,
+        /// The HDF5 bifurcation diagram to write.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Also draw the diagram (.png or .svg).
+        #[arg(long)]
+        plot: Option<PathBuf>,
+        /// Override any key of the problem file.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// Overwrite an existing output file.
+        #[arg(long)]
+        force: bool,
+    },
+    /// Draw a bifurcation diagram file.
+    Plot {
+        /// The HDF5 diagram from `cosserat continue`.
+        diagram: PathBuf,
+        /// The figure (.png or .svg).
+        #[arg(short, long, default_value = "diagram.png")]
+        output: PathBuf,
+        /// Vertical axis: tip_x, tip_y, tip_z, norm or tip_angle.
+        #[arg(long, default_value = "tip_x")]
+        measure: String,
+    },
     /// Benchmarks: `cosserat bench work-precision [-o DIR]`.
     Bench {
         #[command(subcommand)]
@@ -84,6 +115,21 @@ fn main() -> ExitCode {
             set,
             force,
         } => run_stability(problem, output, &set, force),
+        Command::Continue {
+            problem,
+            output,
+            plot,
+            set,
+            force,
+        } => continue_command::run_continue(problem, output, plot, &set, force),
+        Command::Plot {
+            diagram,
+            output,
+            measure,
+        } => match continue_command::plot_file(&diagram, &measure, &output) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(e) => fail(2, e),
+        },
         Command::Bench { which } => cosserat::bench::run(which),
     }
 }
@@ -183,7 +229,7 @@ fn report_critical(c: &CriticalLoad) {
     }
 }
 
-fn fail(code: u8, message: impl std::fmt::Display) -> ExitCode {
+pub(crate) fn fail(code: u8, message: impl std::fmt::Display) -> ExitCode {
     eprintln!("error: {message}");
     ExitCode::from(code)
 }

@@ -191,10 +191,12 @@ impl Run<'_> {
         tracker.reset();
         let spectrum = tracker.measure(self.family, &x, p).ok()?;
         let tip = self.family.tip(&x, p).ok()?;
+        let tip_angle = super::tip_angle(&self.family.rod_at(p).ok()?.clamp.frame, &tip);
         let point = Point {
             parameter: p,
             unknowns: x,
             tangent: stored,
+            tip_angle,
             tip,
             eigenvalues: spectrum.values,
             morse_index: spectrum.morse_index,

@@ -91,6 +91,8 @@ pub struct Point {
     pub tangent: Vec<f64>,
     /// The tip.
     pub tip: RodSample,
+    /// The angle (rad) between the tip tangent and the clamp tangent.
+    pub tip_angle: f64,
     /// Tracked eigenvalues, block after block.
     pub eigenvalues: Vec<f64>,
     /// Morse index.
@@ -221,12 +223,13 @@ pub fn continuation(
     while let Some((start, sign, parent, depth)) = queue.first().cloned() {
         queue.remove(0);
         let index = diagram.branches.len();
-        let outcome = run.follow(start, sign, index, &mut diagram, monitor);
         diagram.branches.push(Branch {
-            points: outcome.points,
+            points: vec![],
             parent,
-            stop_reason: outcome.stop_reason.clone(),
+            stop_reason: "in progress".into(),
         });
+        let outcome = run.follow(start, sign, index, &mut diagram, monitor);
+        diagram.branches[index].stop_reason = outcome.stop_reason.clone();
         if let Some(sp) = parent {
             diagram.special_points[sp].children.push(index);
         }
@@ -267,7 +270,6 @@ type Stepped = (Vec<f64>, f64, Vec<f64>, usize);
 
 /// What following one branch produced.
 struct Outcome {
-    points: Vec<Point>,
     special_points: Vec<usize>,
     stop_reason: String,
     interrupted: bool,
@@ -412,10 +414,15 @@ impl<'a> Run<'a> {
     ) -> Result<Point, ContinuationError> {
         let spectrum = self.tracker.measure(self.family, &x, p)?;
         let tip = self.family.tip(&x, p)?;
+        let tip_angle = tip_angle(
+            &self.family.rod_at(p).map_err(PointError::from)?.clamp.frame,
+            &tip,
+        );
         Ok(Point {
             parameter: p,
             unknowns: x,
             tangent,
+            tip_angle,
             tip,
             morse_index: spectrum.morse_index,
             stable: spectrum.morse_index == 0,
@@ -459,7 +466,9 @@ impl<'a> Run<'a> {
         None
     }
 
-    /// Follows one branch from `start` in direction `sign`.
+    /// Follows one branch from `start` in direction `sign`, appending its
+    /// points to `diagram.branches[branch]` as they come (so a monitor that
+    /// saves the diagram keeps every point).
     fn follow(
         &mut self,
         start: Point,
@@ -469,77 +478,52 @@ impl<'a> Run<'a> {
         monitor: &mut dyn FnMut(Progress, &Diagram) -> bool,
     ) -> Outcome {
         self.tracker.reset();
-        let mut points = vec![];
         let mut specials = vec![];
-        let start = match self.point(
+        let end = |specials: Vec<usize>, reason: String, interrupted: bool| Outcome {
+            special_points: specials,
+            stop_reason: reason,
+            interrupted,
+        };
+        match self.point(
             start.unknowns.clone(),
             start.parameter,
             start.tangent.clone(),
         ) {
-            Ok(p) => p,
-            Err(e) => {
-                return Outcome {
-                    points,
-                    special_points: specials,
-                    stop_reason: format!("start point failed: {e}"),
-                    interrupted: false,
-                }
-            }
-        };
-        points.push(start);
+            Ok(p) => diagram.branches[branch].points.push(p),
+            Err(e) => return end(specials, format!("start point failed: {e}"), false),
+        }
         let mut ds = self.opts.step;
         loop {
+            let points = &diagram.branches[branch].points;
             let last = points.last().expect("a branch has its start point").clone();
             if let Some(reason) = self.stop_reason(&last, points.len()) {
-                return Outcome {
-                    points,
-                    special_points: specials,
-                    stop_reason: reason,
-                    interrupted: false,
-                };
+                return end(specials, reason, false);
             }
-            let stepped = match self.step(&last, sign, ds) {
-                Ok(s) => s,
-                Err(e) => {
-                    return Outcome {
-                        points,
-                        special_points: specials,
-                        stop_reason: format!("stopped: {e}"),
-                        interrupted: false,
-                    }
-                }
-            };
-            let Some((x, p, tangent, iterations)) = stepped else {
-                ds *= 0.5;
-                if ds < self.opts.min_step {
-                    return Outcome {
-                        points,
-                        special_points: specials,
-                        stop_reason: format!(
+            let (x, p, tangent, iterations) = match self.step(&last, sign, ds) {
+                Ok(Some(stepped)) => stepped,
+                Ok(None) => {
+                    ds *= 0.5;
+                    if ds < self.opts.min_step {
+                        let reason = format!(
                             "step size below {:.1e}: the corrector does not converge",
                             self.opts.min_step
-                        ),
-                        interrupted: false,
-                    };
+                        );
+                        return end(specials, reason, false);
+                    }
+                    continue;
                 }
-                continue;
+                Err(e) => return end(specials, format!("stopped: {e}"), false),
             };
             let next = match self.point(x, p, tangent) {
                 Ok(pt) => pt,
-                Err(e) => {
-                    return Outcome {
-                        points,
-                        special_points: specials,
-                        stop_reason: format!("stopped: {e}"),
-                        interrupted: false,
-                    }
-                }
+                Err(e) => return end(specials, format!("stopped: {e}"), false),
             };
-            for sp in self.events(&last, &next, sign, branch, points.len() - 1) {
+            let index = diagram.branches[branch].points.len() - 1;
+            for sp in self.events(&last, &next, sign, branch, index) {
                 specials.push(diagram.special_points.len());
                 diagram.special_points.push(sp);
             }
-            points.push(next);
+            diagram.branches[branch].points.push(next);
             self.total_points += 1;
             if iterations <= 3 {
                 ds = (ds * 1.5).min(self.opts.max_step);
@@ -547,15 +531,10 @@ impl<'a> Run<'a> {
             let progress = Progress {
                 points: self.total_points,
                 branch,
-                parameter: points.last().unwrap().parameter,
+                parameter: p,
             };
             if !monitor(progress, diagram) {
-                return Outcome {
-                    points,
-                    special_points: specials,
-                    stop_reason: "interrupted".into(),
-                    interrupted: true,
-                };
+                return end(specials, "interrupted".into(), true);
             }
         }
     }

@@ -103,6 +103,7 @@ fn write_branches(file: &hdf5::File, d: &Diagram) -> hdf5::Result<()> {
         let morse: Vec<u64> = b.points.iter().map(|p| p.morse_index as u64).collect();
         integers(&g, "morse_index", &morse)?;
         array(&g, "norm", &[m], &col(&|p| p.norm))?;
+        array(&g, "tip_angle", &[m], &col(&|p| p.tip_angle))?;
         let shapes: Vec<f64> = b
             .points
             .iter()

@@ -1,10 +1,12 @@
 //! Problem files in, results out: TOML problem files (serde), HDF5 results
 //! (the HDF5 C library through hdf5-metno).
 
+mod continuation_section;
 mod diagram;
 mod hdf5_output;
 mod problem;
 
+pub use continuation_section::{ContinuationSection, MEASURES};
 pub use diagram::write_diagram;
 pub use hdf5_output::{
     check_target, write_equilibrium, write_stability, OutputError, StabilityResult,

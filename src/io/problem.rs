@@ -13,9 +13,11 @@ use nalgebra::Vector3;
 use serde::de::{self, MapAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize};
 
+use super::continuation_section::ContinuationSection;
 use crate::bvp::integrator::Tolerances;
 use crate::bvp::newton::NewtonOptions;
 use crate::bvp::{Method, SolverOptions, Strategy};
+use crate::continuation::{ContinuationOptions, Family, Parameter};
 use crate::model::{
     Clamp, DeadLoads, LinearElastic, ModelChoice, ModelLevel, Profile, QuarticStiffening, Rod,
     StoredEnergy,
@@ -42,7 +44,7 @@ pub enum ProblemError {
     Invalid { field: String, message: String },
 }
 
-fn invalid(field: impl Into<String>, message: impl Into<String>) -> ProblemError {
+pub(crate) fn invalid(field: impl Into<String>, message: impl Into<String>) -> ProblemError {
     ProblemError::Invalid {
         field: field.into(),
         message: message.into(),
@@ -73,6 +75,9 @@ pub struct ProblemFile {
     /// How the second variation is discretized.
     #[serde(default)]
     pub stability: StabilitySection,
+    /// What to continue, for `cosserat continue`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub continuation: Option<ContinuationSection>,
 }
 
 /// `[shape]`.
@@ -216,6 +221,10 @@ pub struct ClampSection {
     /// d3(0), the tangent, a unit vector orthogonal to d1.
     #[serde(default = "unit_z")]
     pub d3: [f64; 3],
+    /// The frame (d1, d3) turned about d2 by this angle (rad), d3 towards
+    /// d1: the clamp angle of the paper's Fig. 2.
+    #[serde(default)]
+    pub angle: f64,
 }
 
 fn unit_x() -> [f64; 3] {
@@ -232,6 +241,7 @@ impl Default for ClampSection {
             position: [0.0; 3],
             d1: unit_x(),
             d3: unit_z(),
+            angle: 0.0,
         }
     }
 }
@@ -353,6 +363,8 @@ pub struct Problem {
     pub shape: Option<FixedShape>,
     /// The discretization of the second variation.
     pub stability: StabilityOptions,
+    /// The continued family and how to continue it.
+    pub continuation: Option<(Family, ContinuationOptions)>,
 }
 
 impl Problem {
@@ -375,6 +387,7 @@ impl Problem {
         let options = build_options(&file.solver)?;
         let shape = build_shape(&file)?;
         let stability = build_stability(&file.stability)?;
+        let continuation = build_continuation(&file, &rod, &model, &options, shape.as_ref())?;
         Ok(Problem {
             rod,
             model,
@@ -382,6 +395,7 @@ impl Problem {
             text,
             shape,
             stability,
+            continuation,
         })
     }
 }
@@ -566,7 +580,18 @@ fn build_clamp(c: &ClampSection) -> Result<Clamp, ProblemError> {
             format!("must be orthogonal to clamp.d1, d1·d3 = {}", d1.dot(&d3)),
         ));
     }
-    Ok(Clamp::new(position, d1, d3))
+    let angle = finite("clamp.angle", c.angle)?;
+    let clamp = Clamp::new(position, d1, d3);
+    Ok(Clamp {
+        frame: turned(&clamp, angle),
+        ..clamp
+    })
+}
+
+/// The clamp frame turned by `angle` about d2, d3 towards d1.
+fn turned(clamp: &Clamp, angle: f64) -> nalgebra::Matrix3<f64> {
+    let axis = nalgebra::Unit::new_normalize(clamp.director(1));
+    nalgebra::Rotation3::from_axis_angle(&axis, angle).matrix() * clamp.frame
 }
 
 fn choose_model(rod: &Rod, model: &str) -> Result<ModelChoice, ProblemError> {
@@ -582,6 +607,57 @@ fn choose_model(rod: &Rod, model: &str) -> Result<ModelChoice, ProblemError> {
         }
     };
     ModelChoice::forced(rod, level).map_err(|m| invalid("solver.model", m))
+}
+
+/// The family of a `[continuation]` table, discretized by the solver's
+/// shooting method at the scene's model level.
+fn build_continuation(
+    file: &ProblemFile,
+    rod: &Rod,
+    model: &ModelChoice,
+    options: &SolverOptions,
+    shape: Option<&FixedShape>,
+) -> Result<Option<(Family, ContinuationOptions)>, ProblemError> {
+    let Some(section) = &file.continuation else {
+        return Ok(None);
+    };
+    let (parameter, opts) = section.build()?;
+    let segments = match options.method {
+        Method::Shooting => 1,
+        Method::MultipleShooting { segments } => segments,
+        _ => {
+            return Err(invalid(
+                "solver.method",
+                "continuation runs on shooting or multiple-shooting",
+            ))
+        }
+    };
+    if let Some(shape) = shape {
+        // A fixed shape's κ⁰ follows from the load; continuation needs a
+        // rod with one κ⁰: only shapes on which the loads make no moment
+        // (κ⁰ = φ', e.g. a straight column under an axial load) qualify.
+        let fe_points: Vec<f64> = (0..=64).map(|i| rod.length * i as f64 / 64.0).collect();
+        let moment = shape
+            .samples(rod, &fe_points)
+            .iter()
+            .map(|p| p.moment.norm())
+            .fold(0.0, f64::max);
+        if moment > 1e-12 * rod.moment_scale()
+            || !matches!(shape.turning_angle, Profile::Constant(_))
+        {
+            return Err(invalid(
+                "shape",
+                "continuation from a fixed shape needs a straight shape on which the loads make no moment",
+            ));
+        }
+    }
+    let mut base = rod.clone();
+    if parameter == Parameter::ClampAngle {
+        // The parameter is the absolute angle: start from the unturned frame.
+        base.clamp.frame = turned(&rod.clamp, -file.clamp.angle);
+    }
+    let family = Family::new(base, parameter, model.level, segments, options.integration);
+    Ok(Some((family, opts)))
 }
 
 fn build_shape(file: &ProblemFile) -> Result<Option<FixedShape>, ProblemError> {

@@ -1,0 +1,195 @@
+//! The `[continuation]` table of a problem file: which number to continue
+//! and how (BifurcationKit's ContinuationPar, as TOML).
+
+use serde::{Deserialize, Serialize};
+
+use super::problem::{invalid, ProblemError};
+use crate::continuation::{ContinuationOptions, Parameter};
+use crate::stability::StabilityOptions;
+
+/// `[continuation]`.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ContinuationSection {
+    /// The key of the continued number: `load_scale`, `loads.tip_force[i]`,
+    /// `loads.tip_couple[i]`, `loads.distributed_force[i]`, `rod.length`,
+    /// `energy.stiffness[i]`, `energy.intrinsic_curvature[i]`, `clamp.angle`.
+    pub parameter: String,
+    /// The value to start from.
+    pub start: f64,
+    /// [min, max]: a branch stops when the parameter leaves it.
+    pub bounds: [f64; 2],
+    /// Initial arclength step.
+    #[serde(default = "default_step")]
+    pub step: f64,
+    /// Smallest step.
+    #[serde(default = "default_min_step")]
+    pub min_step: f64,
+    /// Largest step.
+    #[serde(default = "default_max_step")]
+    pub max_step: f64,
+    /// Points per branch at most.
+    #[serde(default = "default_max_points")]
+    pub max_points: usize,
+    /// Follow the first branch both ways from the start.
+    #[serde(default)]
+    pub both_directions: bool,
+    /// Depth of recursive branch switching.
+    #[serde(default = "default_depth")]
+    pub switch_depth: usize,
+    /// Stop a branch when the tip tangent has turned this far (degrees).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tip_angle_limit: Option<f64>,
+    /// Finite elements of the tracked second variation.
+    #[serde(default = "default_elements")]
+    pub elements: usize,
+    /// Their Lagrange order.
+    #[serde(default = "default_order")]
+    pub order: usize,
+    /// Eigenvalues tracked per block.
+    #[serde(default = "default_eigenvalues")]
+    pub eigenvalues: usize,
+    /// Corrector tolerance (scaled residual).
+    #[serde(default = "default_tolerance")]
+    pub tolerance: f64,
+    /// What `cosserat plot` puts on the vertical axis by default: `tip_x`,
+    /// `tip_y`, `tip_z`, `norm` or `tip_angle`.
+    #[serde(default = "default_measure")]
+    pub measure: String,
+}
+
+fn default_step() -> f64 {
+    0.05
+}
+fn default_min_step() -> f64 {
+    1e-7
+}
+fn default_max_step() -> f64 {
+    0.2
+}
+fn default_max_points() -> usize {
+    400
+}
+fn default_depth() -> usize {
+    1
+}
+fn default_elements() -> usize {
+    40
+}
+fn default_order() -> usize {
+    2
+}
+fn default_eigenvalues() -> usize {
+    4
+}
+fn default_tolerance() -> f64 {
+    1e-11
+}
+fn default_measure() -> String {
+    "tip_x".into()
+}
+
+/// The measures `cosserat plot` knows.
+pub const MEASURES: [&str; 5] = ["tip_x", "tip_y", "tip_z", "norm", "tip_angle"];
+
+fn positive(field: &str, v: f64) -> Result<f64, ProblemError> {
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(invalid(
+            field,
+            format!("must be a positive finite number, got {v}"),
+        ))
+    }
+}
+
+impl ContinuationSection {
+    /// The parameter and the options, validated.
+    pub fn build(&self) -> Result<(Parameter, ContinuationOptions), ProblemError> {
+        let parameter = Parameter::from_key(&self.parameter).ok_or_else(|| {
+            invalid(
+                "continuation.parameter",
+                format!(
+                    "unknown parameter `{}`; expected load_scale, loads.tip_force[i], \
+                     loads.tip_couple[i], loads.distributed_force[i], rod.length, \
+                     energy.stiffness[i], energy.intrinsic_curvature[i] or clamp.angle",
+                    self.parameter
+                ),
+            )
+        })?;
+        let [lo, hi] = self.bounds;
+        if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+            return Err(invalid(
+                "continuation.bounds",
+                format!("need finite lo < hi, got [{lo}, {hi}]"),
+            ));
+        }
+        if !(self.start.is_finite() && (lo..=hi).contains(&self.start)) {
+            return Err(invalid(
+                "continuation.start",
+                format!("{} is not inside the bounds", self.start),
+            ));
+        }
+        let step = positive("continuation.step", self.step)?;
+        let min_step = positive("continuation.min_step", self.min_step)?;
+        let max_step = positive("continuation.max_step", self.max_step)?;
+        if !(min_step <= step && step <= max_step) {
+            return Err(invalid(
+                "continuation.step",
+                "need min_step ≤ step ≤ max_step",
+            ));
+        }
+        if !(1..=3).contains(&self.order) {
+            return Err(invalid(
+                "continuation.order",
+                format!("must be 1, 2 or 3, got {}", self.order),
+            ));
+        }
+        if self.elements < 2 || self.eigenvalues < 1 || self.max_points < 1 {
+            return Err(invalid(
+                "continuation",
+                "elements ≥ 2, eigenvalues ≥ 1 and max_points ≥ 1 are needed",
+            ));
+        }
+        let tip_angle_limit = match self.tip_angle_limit {
+            Some(a) if a.is_finite() && a > 0.0 => Some(a.to_radians()),
+            Some(a) => {
+                return Err(invalid(
+                    "continuation.tip_angle_limit",
+                    format!("must be positive, got {a}"),
+                ))
+            }
+            None => None,
+        };
+        if !MEASURES.contains(&self.measure.as_str()) {
+            return Err(invalid(
+                "continuation.measure",
+                format!(
+                    "unknown measure `{}`; expected one of {MEASURES:?}",
+                    self.measure
+                ),
+            ));
+        }
+        Ok((
+            parameter,
+            ContinuationOptions {
+                start: self.start,
+                bounds: (lo, hi),
+                step,
+                min_step,
+                max_step,
+                max_points: self.max_points,
+                both_directions: self.both_directions,
+                switch_depth: self.switch_depth,
+                tip_angle_limit,
+                stability: StabilityOptions {
+                    elements: self.elements,
+                    order: self.order,
+                    eigenvalues: self.eigenvalues,
+                },
+                tolerance: positive("continuation.tolerance", self.tolerance)?,
+                event_tolerance: 1e-11,
+            },
+        ))
+    }
+}

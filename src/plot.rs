@@ -1,0 +1,328 @@
+//! Bifurcation-diagram charts (plotters; PNG or SVG by the file extension).
+//!
+//! Left panel: the parameter against a measure of the solution, stable
+//! stretches solid and unstable dashed, folds and branch points marked and
+//! labelled (F1, BP1, ...). Right panel: rod shapes (height −x against the
+//! horizontal z, the paper's axes) at the special points and branch ends.
+
+use std::path::Path;
+
+use plotters::prelude::*;
+
+/// One branch as read from a diagram file.
+#[derive(Debug, Clone, Default)]
+pub struct BranchData {
+    /// Parameter values.
+    pub parameter: Vec<f64>,
+    /// Tip positions.
+    pub tip: Vec<[f64; 3]>,
+    /// Tip angles (rad).
+    pub tip_angle: Vec<f64>,
+    /// Curvature norms.
+    pub norm: Vec<f64>,
+    /// Stable flags.
+    pub stable: Vec<bool>,
+    /// Shapes, 21 positions each.
+    pub shapes: Vec<Vec<[f64; 3]>>,
+}
+
+/// A special point as read from a diagram file.
+#[derive(Debug, Clone)]
+pub struct SpecialData {
+    /// "fold" or "branch_point".
+    pub kind: String,
+    /// The branch it lies on.
+    pub branch: usize,
+    /// The point index before it.
+    pub index: usize,
+    /// Its parameter.
+    pub parameter: f64,
+    /// Its tip.
+    pub tip: [f64; 3],
+}
+
+/// A diagram file's contents needed for charts.
+#[derive(Debug, Clone, Default)]
+pub struct DiagramData {
+    /// The continued parameter's name.
+    pub parameter_name: String,
+    /// Branches.
+    pub branches: Vec<BranchData>,
+    /// Special points.
+    pub specials: Vec<SpecialData>,
+}
+
+fn rows3(v: Vec<f64>) -> Vec<[f64; 3]> {
+    v.chunks(3).map(|c| [c[0], c[1], c[2]]).collect()
+}
+
+/// Reads a diagram written by `cosserat continue`.
+pub fn read_diagram(path: &Path) -> hdf5::Result<DiagramData> {
+    let f = hdf5::File::open(path)?;
+    let parameter_name = f
+        .attr("parameter_name")?
+        .read_scalar::<hdf5::types::VarLenUnicode>()?
+        .as_str()
+        .to_string();
+    let root = f.group("branches")?;
+    let mut branches = vec![];
+    for i in 0.. {
+        let Ok(g) = root.group(&i.to_string()) else {
+            break;
+        };
+        let read = |name: &str| g.dataset(name).and_then(|d| d.read_raw::<f64>());
+        let shapes_ds = g.dataset("shapes")?;
+        let per = shapes_ds.shape().get(1).copied().unwrap_or(0);
+        let shapes = shapes_ds.read_raw::<f64>()?;
+        branches.push(BranchData {
+            parameter: read("parameter")?,
+            tip: rows3(read("tip_position")?),
+            tip_angle: read("tip_angle")?,
+            norm: read("norm")?,
+            stable: g
+                .dataset("stable")?
+                .read_raw::<u64>()?
+                .iter()
+                .map(|s| *s == 1)
+                .collect(),
+            shapes: shapes
+                .chunks((per * 3).max(1))
+                .map(|c| rows3(c.to_vec()))
+                .collect(),
+        });
+    }
+    let sp = f.group("special_points")?;
+    let kinds = sp
+        .dataset("kind")?
+        .read_raw::<hdf5::types::VarLenUnicode>()?;
+    let branch = sp.dataset("branch")?.read_raw::<u64>()?;
+    let index = sp.dataset("index")?.read_raw::<u64>()?;
+    let parameter = sp.dataset("parameter")?.read_raw::<f64>()?;
+    let tip = rows3(sp.dataset("tip_position")?.read_raw::<f64>()?);
+    let specials = (0..kinds.len())
+        .map(|i| SpecialData {
+            kind: kinds[i].as_str().to_string(),
+            branch: branch[i] as usize,
+            index: index[i] as usize,
+            parameter: parameter[i],
+            tip: tip[i],
+        })
+        .collect();
+    Ok(DiagramData {
+        parameter_name,
+        branches,
+        specials,
+    })
+}
+
+/// The value of `measure` at a tip.
+pub fn measure_value(measure: &str, tip: &[f64; 3], angle: f64, norm: f64) -> f64 {
+    match measure {
+        "tip_y" => tip[1],
+        "tip_z" => tip[2],
+        "norm" => norm,
+        "tip_angle" => angle.to_degrees(),
+        _ => tip[0],
+    }
+}
+
+/// Registers the shipped DejaVu Sans (no system font libraries needed).
+pub fn register_font() {
+    static FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSans.ttf");
+    let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
+}
+
+/// Draws the diagram to `out` (.png or .svg).
+pub fn draw(
+    data: &DiagramData,
+    measure: &str,
+    out: &Path,
+) -> Result<(), Box<dyn std::error::Error>> {
+    register_font();
+    let svg = out
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("svg"));
+    if svg {
+        panels(
+            SVGBackend::new(out, (1400, 600)).into_drawing_area(),
+            data,
+            measure,
+        )
+    } else {
+        panels(
+            BitMapBackend::new(out, (1400, 600)).into_drawing_area(),
+            data,
+            measure,
+        )
+    }
+}
+
+const COLORS: [RGBColor; 6] = [
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 158, 115),
+    RGBColor(204, 121, 167),
+    RGBColor(230, 159, 0),
+    RGBColor(86, 180, 233),
+];
+
+fn bounds(values: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite())
+        .fold((f64::MAX, f64::MIN), |(a, b), v| (a.min(v), b.max(v)));
+    if lo > hi {
+        return (0.0, 1.0);
+    }
+    let pad = 0.05 * (hi - lo).max(1e-9);
+    (lo - pad, hi + pad)
+}
+
+fn label(s: &SpecialData, counts: &mut [usize; 2]) -> String {
+    let (tag, slot) = if s.kind == "fold" {
+        ("F", 0)
+    } else {
+        ("BP", 1)
+    };
+    counts[slot] += 1;
+    format!("{tag}{}", counts[slot])
+}
+
+fn panels<DB: DrawingBackend>(
+    root: DrawingArea<DB, plotters::coord::Shift>,
+    data: &DiagramData,
+    measure: &str,
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE)?;
+    let (left, right) = root.split_horizontally(820);
+    diagram_panel(&left, data, measure)?;
+    shapes_panel(&right, data)?;
+    root.present()?;
+    Ok(())
+}
+
+fn diagram_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    data: &DiagramData,
+    measure: &str,
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
+    let value =
+        |b: &BranchData, i: usize| measure_value(measure, &b.tip[i], b.tip_angle[i], b.norm[i]);
+    let xs = bounds(
+        data.branches
+            .iter()
+            .flat_map(|b| b.parameter.iter().copied()),
+    );
+    let ys = bounds(
+        data.branches
+            .iter()
+            .flat_map(|b| (0..b.parameter.len()).map(move |i| value(b, i))),
+    );
+    let mut chart = ChartBuilder::on(area)
+        .caption(
+            "bifurcation diagram (solid: stable, dashed: unstable)",
+            ("sans-serif", 20),
+        )
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(65)
+        .build_cartesian_2d(xs.0..xs.1, ys.0..ys.1)?;
+    chart
+        .configure_mesh()
+        .x_desc(data.parameter_name.as_str())
+        .y_desc(measure)
+        .label_style(("sans-serif", 15))
+        .draw()?;
+    for (bi, b) in data.branches.iter().enumerate() {
+        let color = COLORS[bi % COLORS.len()];
+        let mut start = 0;
+        while start + 1 < b.parameter.len() {
+            let stable = b.stable[start + 1];
+            let mut end = start + 1;
+            while end + 1 < b.parameter.len() && b.stable[end + 1] == stable {
+                end += 1;
+            }
+            let pts: Vec<(f64, f64)> = (start..=end)
+                .map(|i| (b.parameter[i], value(b, i)))
+                .collect();
+            let style = color.stroke_width(2);
+            if stable {
+                chart.draw_series(LineSeries::new(pts, style))?;
+            } else {
+                chart.draw_series(DashedLineSeries::new(pts, 8, 6, style))?;
+            }
+            start = end;
+        }
+    }
+    let mut counts = [0, 0];
+    for s in &data.specials {
+        let b = &data.branches[s.branch];
+        let i = s.index.min(b.parameter.len().saturating_sub(1));
+        let y = measure_value(
+            measure,
+            &s.tip,
+            b.tip_angle.get(i).copied().unwrap_or(0.0),
+            b.norm.get(i).copied().unwrap_or(0.0),
+        );
+        let name = label(s, &mut counts);
+        let marker = (s.parameter, y);
+        let element = EmptyElement::at(marker)
+            + Circle::new((0, 0), 6, BLACK.filled())
+            + Text::new(name, (8, -22), ("sans-serif", 16));
+        chart.draw_series(std::iter::once(element))?;
+    }
+    Ok(())
+}
+
+fn shapes_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, plotters::coord::Shift>,
+    data: &DiagramData,
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
+    // The shapes at the special points' neighbours and the branch ends.
+    let mut picks: Vec<(usize, usize)> =
+        data.specials.iter().map(|s| (s.branch, s.index)).collect();
+    for (bi, b) in data.branches.iter().enumerate() {
+        if !b.shapes.is_empty() {
+            picks.push((bi, b.shapes.len() - 1));
+        }
+    }
+    let shapes: Vec<(usize, &Vec<[f64; 3]>)> = picks
+        .iter()
+        .filter_map(|&(b, i)| {
+            data.branches
+                .get(b)
+                .and_then(|br| br.shapes.get(i))
+                .map(|s| (b, s))
+        })
+        .collect();
+    let zs = bounds(shapes.iter().flat_map(|(_, s)| s.iter().map(|r| r[2])));
+    let hs = bounds(shapes.iter().flat_map(|(_, s)| s.iter().map(|r| -r[0])));
+    let mut chart = ChartBuilder::on(area)
+        .caption("rod shapes (height −x against z)", ("sans-serif", 20))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(55)
+        .build_cartesian_2d(zs.0..zs.1, hs.0..hs.1)?;
+    chart
+        .configure_mesh()
+        .x_desc("z")
+        .y_desc("−x")
+        .label_style(("sans-serif", 15))
+        .draw()?;
+    for (b, s) in shapes {
+        let color = COLORS[b % COLORS.len()];
+        chart.draw_series(LineSeries::new(
+            s.iter().map(|r| (r[2], -r[0])),
+            color.stroke_width(2),
+        ))?;
+    }
+    Ok(())
+}
