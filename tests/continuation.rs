@@ -1,0 +1,384 @@
+//! Continuation on the shipped problem files: Euler's branch point and the
+//! elastica, singular Hessian and BVP Jacobian at every special point, the
+//! Morse index across special points, a fold that natural-parameter
+//! stepping cannot pass, branch switching onto new branches, the HDF5
+//! diagram contract, and interrupted runs keeping their points.
+mod support;
+
+use std::f64::consts::PI;
+use std::path::Path;
+use std::sync::OnceLock;
+
+use cosserat::bvp::integrator::Tolerances;
+use cosserat::bvp::{equations, newton::NonlinearSystem, ShootingSystem};
+use cosserat::continuation::{continuation, Diagram, Family, SpecialKind};
+use cosserat::io::Problem;
+use cosserat::model::ModelLevel;
+use cosserat::stability::Block;
+use nalgebra::{DMatrix, DVector};
+use support::elliptic::ellip_f;
+
+const FILES: [&str; 3] = [
+    "euler_column",
+    "planar_clamp_angle",
+    "lateral_torsional_buckling",
+];
+
+fn problem(name: &str) -> Problem {
+    let path = format!("{}/problems/{name}.toml", env!("CARGO_MANIFEST_DIR"));
+    Problem::from_path(Path::new(&path), &[]).unwrap()
+}
+
+/// Each shipped diagram, computed once.
+fn diagram(name: &str) -> &'static (Problem, Diagram) {
+    static CACHE: OnceLock<Vec<(Problem, Diagram)>> = OnceLock::new();
+    let all = CACHE.get_or_init(|| {
+        FILES
+            .iter()
+            .map(|f| {
+                let p = problem(f);
+                let (family, opts) = p.continuation.clone().unwrap();
+                let d = continuation(&family, &opts, &mut |_, _| true).unwrap();
+                (p, d)
+            })
+            .collect()
+    });
+    &all[FILES.iter().position(|f| *f == name).unwrap()]
+}
+
+fn family(p: &Problem) -> &Family {
+    &p.continuation.as_ref().unwrap().0
+}
+
+#[test]
+fn euler_branch_point_and_the_elastica() {
+    let (_, d) = diagram("euler_column");
+    let bp = d
+        .special_points
+        .iter()
+        .find(|s| s.kind == SpecialKind::BranchPoint && s.block == Block::InPlane)
+        .expect("the in-plane branch point");
+    let euler = PI * PI / 4.0;
+    assert!(
+        (bp.point.parameter - euler).abs() <= 1e-8 * euler,
+        "{}",
+        bp.point.parameter
+    );
+    assert!(bp.symmetry_breaking);
+    assert_eq!(bp.children.len(), 2, "both halves of the pitchfork");
+    // The buckled elastica: F L²/B = K(k)², k = sin(α/2), α the tip angle
+    // (Timoshenko & Gere, Sec. 2.7).
+    for &child in &bp.children {
+        let b = &d.branches[child];
+        assert!(b.stop_reason.contains("tip angle"), "{}", b.stop_reason);
+        for p in b.points.iter().skip(1) {
+            let k = (p.tip_angle / 2.0).sin();
+            let exact = ellip_f(PI / 2.0, k).powi(2);
+            assert!(
+                (p.parameter - exact).abs() <= 1e-8 * exact,
+                "α = {}: {} vs {exact}",
+                p.tip_angle,
+                p.parameter
+            );
+        }
+        assert!(b.points.last().unwrap().tip_angle >= 170f64.to_radians());
+    }
+}
+
+/// The smallest singular value of the 9-ODE shooting Jacobian at a point
+/// of a family, relative to the largest (planar points are lifted to
+/// κ(0) = (0, κ2(0), 0)).
+fn kirchhoff_singularity(f: &Family, x: &[f64], p: f64) -> f64 {
+    let rod = f.rod_at(p).unwrap();
+    let eq = equations(&rod, ModelLevel::Kirchhoff);
+    let mut sys = ShootingSystem::new(eq.as_ref(), 1, Tolerances::default());
+    let u = if x.len() == 1 {
+        vec![0.0, x[0], 0.0]
+    } else {
+        x[..3].to_vec()
+    };
+    let (mut r, mut j) = (DVector::zeros(3), DMatrix::zeros(3, 3));
+    sys.evaluate(&u, &mut r, &mut j).unwrap();
+    let sv = j.singular_values();
+    sv.min() / sv.max()
+}
+
+/// The eigenvalue nearest zero of `block` at (x, p) on 160 elements of
+/// order 2.
+fn fine_eigenvalue(f: &Family, x: &[f64], p: f64, block: Block) -> f64 {
+    use cosserat::stability::{coefficients, eigen::lowest_eigenpairs, FiniteElements};
+    let rod = f.rod_at(p).unwrap();
+    let fe = FiniteElements::new(rod.length, 160, 2);
+    let samples = f.samples(x, p, &fe.quadrature_points()).unwrap();
+    let c = coefficients(&rod, &samples);
+    let pairs = lowest_eigenpairs(&fe.stiffness(&c, block), &fe.mass(block), 4).unwrap();
+    pairs
+        .values
+        .into_iter()
+        .min_by(|a, b| a.abs().total_cmp(&b.abs()))
+        .unwrap()
+}
+
+#[test]
+fn hessian_and_bvp_jacobian_are_singular_at_every_special_point() {
+    for name in FILES {
+        let (p, d) = diagram(name);
+        assert!(!d.special_points.is_empty(), "{name}: no special points");
+        for s in &d.special_points {
+            // The Hessian on a mesh 8× finer than the tracking one, so that
+            // what is checked is the second variation, not its mesh.
+            let eigenvalue =
+                fine_eigenvalue(family(p), &s.point.unknowns, s.point.parameter, s.block);
+            assert!(
+                eigenvalue.abs() <= 1e-6,
+                "{name}: Hessian eigenvalue {eigenvalue} at {:?} p = {}",
+                s.kind,
+                s.point.parameter
+            );
+            let sing = kirchhoff_singularity(family(p), &s.point.unknowns, s.point.parameter);
+            // Located by det F_x (to the integration tolerance) or, for
+            // modes the model does not carry, by the finite-element
+            // eigenvalue (to the mesh).
+            assert!(
+                sing <= 1e-5,
+                "{name}: σ_min/σ_max = {sing} at {:?} p = {}",
+                s.kind,
+                s.point.parameter
+            );
+        }
+    }
+}
+
+#[test]
+fn morse_index_changes_by_the_number_of_special_points_crossed() {
+    for name in FILES {
+        let (_, d) = diagram(name);
+        for (bi, b) in d.branches.iter().enumerate() {
+            for i in 0..b.points.len().saturating_sub(1) {
+                let crossed = d
+                    .special_points
+                    .iter()
+                    .filter(|s| s.branch == bi && s.index == i)
+                    .count();
+                let jump = b.points[i]
+                    .morse_index
+                    .abs_diff(b.points[i + 1].morse_index);
+                assert_eq!(
+                    jump,
+                    crossed,
+                    "{name}: branch {bi} between points {i} and {}",
+                    i + 1
+                );
+            }
+        }
+    }
+}
+
+/// Natural-parameter stepping (Newton at fixed clamp angle from the last
+/// solution) cannot pass the fold that pseudo-arclength went round.
+#[test]
+fn natural_parameter_stepping_fails_at_a_fold() {
+    let (p, d) = diagram("planar_clamp_angle");
+    let fold = d
+        .special_points
+        .iter()
+        .find(|s| s.kind == SpecialKind::Fold && s.branch == 0)
+        .unwrap();
+    let f = family(p);
+    // Pseudo-arclength turned back at the fold: the parameter decreases
+    // after it on the same branch.
+    let b = &d.branches[0];
+    let after = &b.points[fold.index + 1..];
+    assert!(after
+        .iter()
+        .any(|q| q.parameter < fold.point.parameter - 0.1));
+    // Natural stepping from just before the fold, in the same direction.
+    let before = &b.points[fold.index];
+    let direction = (fold.point.parameter - before.parameter).signum();
+    let mut x = before.unknowns.clone();
+    let mut angle = before.parameter;
+    let mut reached_beyond = None;
+    for _ in 0..40 {
+        angle += direction * 0.01;
+        let n = x.len();
+        let (mut r, mut j) = (DVector::zeros(n), DMatrix::zeros(n, n));
+        let mut ok = false;
+        for _ in 0..30 {
+            if f.residual(&x, angle, &mut r, &mut j).is_err() {
+                break;
+            }
+            if r.amax() <= 1e-11 {
+                ok = true;
+                break;
+            }
+            let Some(dx) = j.clone().lu().solve(&(-&r)) else {
+                break;
+            };
+            x.iter_mut().zip(dx.iter()).for_each(|(a, b)| *a += b);
+        }
+        if !ok {
+            break;
+        }
+        if (angle - fold.point.parameter) * direction > 0.0 {
+            reached_beyond = Some(f.tip(&x, angle).unwrap().position);
+            break;
+        }
+    }
+    // Either Newton fails past the fold, or it lands on a distant branch:
+    // no solution continues the folded branch beyond the fold.
+    if let Some(tip) = reached_beyond {
+        let jump = (tip - fold.point.tip.position).norm();
+        assert!(
+            jump > 0.3,
+            "natural stepping crossed the fold smoothly: jump {jump}"
+        );
+    }
+}
+
+#[test]
+fn branch_switching_lands_on_new_branches() {
+    for name in ["euler_column", "lateral_torsional_buckling"] {
+        let (_, d) = diagram(name);
+        let switched: Vec<_> = d
+            .special_points
+            .iter()
+            .filter(|s| !s.children.is_empty())
+            .collect();
+        assert!(!switched.is_empty(), "{name}: no branch switched");
+        for s in switched {
+            for &c in &s.children {
+                let child = &d.branches[c];
+                assert_eq!(
+                    child.parent,
+                    Some(d.special_points.iter().position(|x| x == s).unwrap())
+                );
+                // The child's points are off the parent branch: the old
+                // branch is straight (Euler) or planar (lateral-torsional).
+                let off = child.points.iter().skip(2).map(|p| match name {
+                    "euler_column" => p.tip.position[0].abs(),
+                    _ => p.tip.position[1].abs(),
+                });
+                assert!(
+                    off.clone().all(|v| v > 1e-4),
+                    "{name}: child {c} back on the parent"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn lateral_torsional_branch_point_is_out_of_plane_and_above_timoshenko() {
+    let (_, d) = diagram("lateral_torsional_buckling");
+    let first = &d.special_points[0];
+    assert_eq!(first.kind, SpecialKind::BranchPoint);
+    assert!(first.symmetry_breaking);
+    // The out-of-plane null mode: ω1, ω3 dominate ω2.
+    let (oop, ip): (f64, f64) = first.null_mode.iter().fold((0.0, 0.0), |(a, b), w| {
+        (a + w[0].abs() + w[2].abs(), b + w[1].abs())
+    });
+    assert!(oop > 100.0 * ip, "{oop} vs {ip}");
+    // The straight-rod value is 2 j₋₁/₄,₁ √(B1B3)/L² = 0.40126; in-plane
+    // pre-buckling bending raises it (B2 is only 10× B1 here).
+    let timoshenko = 2.0 * support::bessel::first_zero(-0.25, 1.0, 3.0) * 0.1;
+    assert!(first.point.parameter > timoshenko && first.point.parameter < 1.3 * timoshenko);
+}
+
+fn read_f64(g: &hdf5::Group, name: &str) -> Vec<f64> {
+    g.dataset(name).unwrap().read_raw::<f64>().unwrap()
+}
+
+#[test]
+fn cli_writes_the_diagram_contract_and_a_plot() {
+    let dir = std::env::temp_dir().join(format!("cosserat-cont-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("euler.h5");
+    let png = dir.join("euler.svg");
+    let file = format!("{}/problems/euler_column.toml", env!("CARGO_MANIFEST_DIR"));
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_cosserat"))
+        .args([
+            "continue",
+            &file,
+            "-o",
+            out.to_str().unwrap(),
+            "--plot",
+            png.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let f = hdf5::File::open(&out).unwrap();
+    assert!(f.attr("problem").is_ok());
+    let b0 = f.group("branches/0").unwrap();
+    let m = read_f64(&b0, "parameter").len();
+    assert!(m > 10);
+    assert_eq!(b0.dataset("tip_position").unwrap().shape(), vec![m, 3]);
+    assert_eq!(b0.dataset("eigenvalues").unwrap().shape()[0], m);
+    assert_eq!(b0.dataset("stable").unwrap().shape(), vec![m]);
+    assert_eq!(b0.dataset("morse_index").unwrap().shape(), vec![m]);
+    let sp = f.group("special_points").unwrap();
+    let kinds = sp
+        .dataset("kind")
+        .unwrap()
+        .read_raw::<hdf5::types::VarLenUnicode>()
+        .unwrap();
+    assert!(kinds
+        .iter()
+        .all(|k| k.as_str() == "fold" || k.as_str() == "branch_point"));
+    for name in [
+        "branch",
+        "index",
+        "parameter",
+        "tip_position",
+        "null_vectors",
+    ] {
+        assert!(sp.dataset(name).is_ok(), "{name}");
+    }
+    let svg = std::fs::read_to_string(&png).unwrap();
+    assert!(svg.contains("<svg") && svg.contains("BP1"));
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
+fn interrupted_run_keeps_its_points() {
+    let dir = std::env::temp_dir().join(format!("cosserat-int-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("slow.h5");
+    let file = format!("{}/problems/euler_column.toml", env!("CARGO_MANIFEST_DIR"));
+    // Tiny steps make the run last long enough to be interrupted.
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_cosserat"))
+        .args(["continue", &file, "-o", out.to_str().unwrap()])
+        .args([
+            "--set",
+            "continuation.step=0.0005",
+            "--set",
+            "continuation.max_step=0.0005",
+        ])
+        .args(["--set", "continuation.max_points=100000"])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(2600));
+    let _ = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status();
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(130), "interrupted runs exit with 130");
+    let f = hdf5::File::open(&out).unwrap();
+    let reason = f
+        .attr("stop_reason")
+        .unwrap()
+        .read_scalar::<hdf5::types::VarLenUnicode>()
+        .unwrap();
+    assert_eq!(reason.as_str(), "interrupted");
+    let points = read_f64(&f.group("branches/0").unwrap(), "parameter");
+    assert!(points.len() > 5, "{} points kept", points.len());
+    // No temporary files left behind.
+    let left: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left.len(), 1, "{left:?}");
+    std::fs::remove_dir_all(dir).unwrap();
+}
