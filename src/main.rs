@@ -257,6 +257,7 @@ fn run_solve(path: PathBuf, output: Option<PathBuf>, set: &[String], force: bool
         Err(e) => return fail(2, e),
     };
     report(&eq);
+    verdict(&problem, &eq);
     let tolerance = problem.options.newton.tolerance;
     if eq.residual.is_nan() || eq.residual > tolerance {
         // Belt and braces: solve() returns only converged results, but a
@@ -276,6 +277,30 @@ fn run_solve(path: PathBuf, output: Option<PathBuf>, set: &[String], force: bool
         println!("written   {}", out.display());
     }
     ExitCode::SUCCESS
+}
+
+/// The stability verdict of a solved equilibrium (conservative loads): a
+/// converged but unstable equilibrium is one the loading does not reach —
+/// say so rather than let it pass as the answer.
+fn verdict(problem: &Problem, eq: &Equilibrium) {
+    let opts = cosserat::stability::StabilityOptions {
+        elements: 40,
+        order: 2,
+        eigenvalues: 1,
+    };
+    match analyze(&problem.rod, eq, &problem.options, &opts) {
+        Ok(st) if st.stable => println!("stability stable (Morse index 0)"),
+        Ok(st) => {
+            println!("stability UNSTABLE (Morse index {})", st.morse_index);
+            eprintln!(
+                "warning: this equilibrium is unstable (Morse index {}): loading the rod \
+                 would not settle here; follow the load with `cosserat continue` or try \
+                 --method multiple-shooting / collocation",
+                st.morse_index
+            );
+        }
+        Err(e) => println!("stability not decided: {e}"),
+    }
 }
 
 fn report(eq: &Equilibrium) {

@@ -257,3 +257,40 @@ fn impossible_tolerance_is_an_error_not_a_result() {
         &["did not converge"],
     );
 }
+
+/// A long soft cantilever where single shooting (even with the load ramp)
+/// converges to a looped, unstable equilibrium: the report says so.
+#[test]
+fn unstable_result_is_flagged() {
+    let file = format!(
+        "{}/problems/cantilever_tip_load.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let o = run(&[
+        "solve",
+        &file,
+        "--set",
+        "rod.length=12",
+        "--set",
+        "loads.tip_force=[1,0,0]",
+    ]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    let err = stderr(&o);
+    assert!(
+        out.contains("UNSTABLE") && err.contains("warning: this equilibrium is unstable"),
+        "{out}\n{err}"
+    );
+    let o = run(&[
+        "solve",
+        &file,
+        "--set",
+        "rod.length=12",
+        "--set",
+        "loads.tip_force=[1,0,0]",
+        "--method",
+        "multiple-shooting",
+        "--set",
+        "solver.segments=16",
+    ]);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("stability stable"));
+}
