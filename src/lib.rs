@@ -12,5 +12,7 @@ pub mod continuation;
 pub mod equations;
 pub mod io;
 pub mod model;
+pub mod optimize;
 pub mod plot;
 pub mod stability;
+pub mod validate;

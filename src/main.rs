@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 mod continue_command;
+mod optimize_command;
 
 use clap::{Parser, Subcommand};
 use cosserat::bvp::{solve, Equilibrium};
@@ -76,6 +77,20 @@ enum Command {
         #[arg(long)]
         force: bool,
     },
+    /// The longest soft robotic arm of an [arm] table (paper Sec. 3–4).
+    Optimize {
+        /// The problem file (TOML).
+        problem: PathBuf,
+        /// Write the optimum to this HDF5 file.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// Override any key of the problem file.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// Overwrite an existing output file.
+        #[arg(long)]
+        force: bool,
+    },
     /// Draw a bifurcation diagram file.
     Plot {
         /// The HDF5 diagram from `cosserat continue`.
@@ -92,6 +107,8 @@ enum Command {
         #[command(subcommand)]
         which: cosserat::bench::BenchCommand,
     },
+    /// Classical benchmarks against every method, with a Markdown report.
+    Validate(cosserat::validate::ValidateArgs),
 }
 
 fn main() -> ExitCode {
@@ -122,6 +139,12 @@ fn main() -> ExitCode {
             set,
             force,
         } => continue_command::run_continue(problem, output, plot, &set, force),
+        Command::Optimize {
+            problem,
+            output,
+            set,
+            force,
+        } => optimize_command::run_optimize(problem, output, &set, force),
         Command::Plot {
             diagram,
             output,
@@ -131,6 +154,7 @@ fn main() -> ExitCode {
             Err(e) => fail(2, e),
         },
         Command::Bench { which } => cosserat::bench::run(which),
+        Command::Validate(args) => cosserat::validate::run_cli(args),
     }
 }
 

@@ -1,11 +1,15 @@
 //! Problem files in, results out: TOML problem files (serde), HDF5 results
 //! (the HDF5 C library through hdf5-metno).
 
+mod arm_output;
+mod arm_section;
 mod continuation_section;
 mod diagram;
 mod hdf5_output;
 mod problem;
 
+pub use arm_output::write_arm;
+pub use arm_section::ArmSection;
 pub use continuation_section::{ContinuationSection, MEASURES};
 pub use diagram::write_diagram;
 pub use hdf5_output::{

@@ -13,6 +13,7 @@ use nalgebra::Vector3;
 use serde::de::{self, MapAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize};
 
+use super::arm_section::ArmSection;
 use super::continuation_section::ContinuationSection;
 use crate::bvp::integrator::Tolerances;
 use crate::bvp::newton::NewtonOptions;
@@ -22,6 +23,7 @@ use crate::model::{
     Clamp, DeadLoads, LinearElastic, ModelChoice, ModelLevel, Profile, QuarticStiffening, Rod,
     StoredEnergy,
 };
+use crate::optimize::{ArmProblem, SearchOptions};
 use crate::stability::{FixedShape, StabilityOptions};
 
 /// Why a problem could not be read.
@@ -78,6 +80,9 @@ pub struct ProblemFile {
     /// What to continue, for `cosserat continue`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub continuation: Option<ContinuationSection>,
+    /// The longest-arm optimization, for `cosserat optimize`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub arm: Option<ArmSection>,
 }
 
 /// `[shape]`.
@@ -365,6 +370,8 @@ pub struct Problem {
     pub stability: StabilityOptions,
     /// The continued family and how to continue it.
     pub continuation: Option<(Family, ContinuationOptions)>,
+    /// The arm optimization, its search, and whether to compute R̂0.
+    pub arm: Option<(ArmProblem, SearchOptions, bool)>,
 }
 
 impl Problem {
@@ -388,6 +395,7 @@ impl Problem {
         let shape = build_shape(&file)?;
         let stability = build_stability(&file.stability)?;
         let continuation = build_continuation(&file, &rod, &model, &options, shape.as_ref())?;
+        let arm = file.arm.as_ref().map(|a| a.build(&rod)).transpose()?;
         Ok(Problem {
             rod,
             model,
@@ -396,6 +404,7 @@ impl Problem {
             shape,
             stability,
             continuation,
+            arm,
         })
     }
 }

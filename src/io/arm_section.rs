@@ -1,0 +1,129 @@
+//! The `[arm]` table: the longest-arm optimization of a problem file
+//! (paper Sec. 3). The rod is non-dimensional: B̄1 = B1/B2 and B̄3 = B3/B2
+//! come from `energy.stiffness`.
+
+use serde::{Deserialize, Serialize};
+
+use super::problem::{invalid, ProblemError};
+use crate::model::Rod;
+use crate::optimize::{ArmProblem, SearchOptions};
+use crate::stability::StabilityOptions;
+
+/// `[arm]`.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ArmSection {
+    /// Reach direction (degrees above the horizontal).
+    #[serde(default)]
+    pub alpha: f64,
+    /// M, the number of Taylor coefficients of φ(s̄).
+    pub coefficients: usize,
+    /// Bounds of c2..cM, M − 1 pairs.
+    pub bounds: Vec<[f64; 2]>,
+    /// Halton samples of the global stage.
+    #[serde(default = "default_samples")]
+    pub samples: usize,
+    /// Nelder–Mead polishes.
+    #[serde(default = "default_starts")]
+    pub starts: usize,
+    /// Iterations per polish.
+    #[serde(default = "default_iterations")]
+    pub iterations: u64,
+    /// Finite elements of the second variation.
+    #[serde(default = "default_elements")]
+    pub elements: usize,
+    /// Their Lagrange order.
+    #[serde(default = "default_order")]
+    pub order: usize,
+    /// Also compute R̂0 of the intrinsically straight arm.
+    #[serde(default = "default_true")]
+    pub straight: bool,
+}
+
+fn default_samples() -> usize {
+    400
+}
+fn default_starts() -> usize {
+    4
+}
+fn default_iterations() -> u64 {
+    400
+}
+fn default_elements() -> usize {
+    100
+}
+fn default_order() -> usize {
+    1
+}
+fn default_true() -> bool {
+    true
+}
+
+impl ArmSection {
+    /// The arm problem of `rod` (constant stiffness) and the search options.
+    pub fn build(&self, rod: &Rod) -> Result<(ArmProblem, SearchOptions, bool), ProblemError> {
+        let h = rod.energy.stiffness(0.0, &nalgebra::Vector3::zeros());
+        let constant = rod.energy.is_quadratic()
+            && [0.5, 1.0].iter().all(|s| {
+                rod.energy
+                    .stiffness(s * rod.length, &nalgebra::Vector3::zeros())
+                    == h
+            });
+        if !constant {
+            return Err(invalid(
+                "energy",
+                "the arm needs the linear energy with constant stiffness",
+            ));
+        }
+        if self.coefficients < 1 || self.bounds.len() + 1 != self.coefficients {
+            return Err(invalid(
+                "arm.bounds",
+                format!(
+                    "needs coefficients − 1 = {} pairs, got {}",
+                    self.coefficients.saturating_sub(1),
+                    self.bounds.len()
+                ),
+            ));
+        }
+        for (i, [lo, hi]) in self.bounds.iter().enumerate() {
+            if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+                return Err(invalid(
+                    format!("arm.bounds[{i}]"),
+                    format!("need finite lo < hi, got [{lo}, {hi}]"),
+                ));
+            }
+        }
+        if !self.alpha.is_finite() || self.alpha.abs() > 180.0 {
+            return Err(invalid(
+                "arm.alpha",
+                format!("must be in [−180, 180] degrees, got {}", self.alpha),
+            ));
+        }
+        if !(1..=3).contains(&self.order) || self.elements < 2 || self.samples < 1 {
+            return Err(invalid(
+                "arm",
+                "order 1–3, elements ≥ 2 and samples ≥ 1 are needed",
+            ));
+        }
+        let b2 = h[(1, 1)];
+        Ok((
+            ArmProblem {
+                b1: h[(0, 0)] / b2,
+                b3: h[(2, 2)] / b2,
+                alpha: self.alpha.to_radians(),
+                bounds: self.bounds.iter().map(|[a, b]| (*a, *b)).collect(),
+                stability: StabilityOptions {
+                    elements: self.elements,
+                    order: self.order,
+                    eigenvalues: 1,
+                },
+            },
+            SearchOptions {
+                samples: self.samples,
+                starts: self.starts,
+                iterations: self.iterations,
+            },
+            self.straight,
+        ))
+    }
+}

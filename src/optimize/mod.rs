@@ -1,0 +1,457 @@
+//! The longest soft robotic arm (Sipos & Várkonyi 2019, Sec. 3–4): the
+//! loaded shape that reaches farthest in a direction α before the arm loses
+//! stability, with the intrinsic curvature that produces it.
+//!
+//! The loaded shape is the turning angle φ(s̄) = Σ_{i=1}^{M} c_i s̄^{i−1}
+//! (paper (52)); c1 is a rigid rotation fixed by the reach direction
+//! (third condition of (46)); the critical load γ_crit = F L²/B2 of the
+//! shape held fixed is a generalized eigenvalue of the verified second
+//! variation ([`crate::stability::critical_load`], both blocks); the reach
+//! is R̂ = √γ_crit |(x̄(1), z̄(1))| in units of √(B2/F) (paper (54)–(55)).
+//! The intrinsic curvature follows from (43): κ̄⁰2 = φ' − γ m̄2, with m̄2 the
+//! moment of the unit tip load on the shape.
+//!
+//! The search is deterministic: a Halton set over the box of c2..cM (the
+//! global stage), then Nelder–Mead (argmin) from the best few (the polish).
+
+use std::sync::Arc;
+
+use argmin::core::{CostFunction, Error as ArgminError, Executor, State};
+use argmin::solver::neldermead::NelderMead;
+use nalgebra::Vector3;
+
+use crate::model::{Clamp, DeadLoads, LinearElastic, Profile, Rod};
+use crate::stability::{critical_load, FixedShape, StabilityOptions};
+
+/// The arm to design.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ArmProblem {
+    /// B̄1 = B1/B2.
+    pub b1: f64,
+    /// B̄3 = B3/B2.
+    pub b3: f64,
+    /// Reach direction (rad) above the horizontal: the tip at elevation α.
+    pub alpha: f64,
+    /// Bounds of c2..cM (M − 1 pairs).
+    pub bounds: Vec<(f64, f64)>,
+    /// Discretization of the second variation.
+    pub stability: StabilityOptions,
+}
+
+/// How hard to search.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct SearchOptions {
+    /// Halton samples of the global stage.
+    pub samples: usize,
+    /// Nelder–Mead polishes from the best samples.
+    pub starts: usize,
+    /// Iterations of each polish.
+    pub iterations: u64,
+}
+
+impl Default for SearchOptions {
+    fn default() -> Self {
+        SearchOptions {
+            samples: 400,
+            starts: 4,
+            iterations: 400,
+        }
+    }
+}
+
+/// One evaluated design.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ArmDesign {
+    /// R̂ = √γ_crit |(x̄(1), z̄(1))|.
+    pub reach: f64,
+    /// γ_crit = F L²/B2.
+    pub gamma: f64,
+    /// c1..cM of the loaded shape φ(s̄).
+    pub shape_coefficients: Vec<f64>,
+}
+
+/// The optimum with what a user keeps of it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ArmOptimum {
+    /// The design.
+    pub design: ArmDesign,
+    /// b1..bM: the least-squares Taylor fit of κ̄⁰2(s̄) (paper (59)).
+    pub curvature_coefficients: Vec<f64>,
+    /// The loaded shape in scaled coordinates (x̂, ŷ, ẑ) = √γ (x̄, ȳ, z̄).
+    pub loaded_shape: Vec<[f64; 3]>,
+    /// The unloaded (intrinsic) shape, same scaling and clamp.
+    pub unloaded_shape: Vec<[f64; 3]>,
+    /// κ̄⁰2 at the shape points.
+    pub intrinsic_curvature: Vec<f64>,
+    /// Designs evaluated.
+    pub evaluations: usize,
+}
+
+/// Composite Gauss–Legendre nodes (5 points on each of 32 panels) on [0, 1].
+fn quadrature() -> Vec<(f64, f64)> {
+    const X: [f64; 5] = [
+        -0.906_179_845_938_664,
+        -0.538_469_310_105_683_1,
+        0.0,
+        0.538_469_310_105_683_1,
+        0.906_179_845_938_664,
+    ];
+    const W: [f64; 5] = [
+        0.236_926_885_056_189_1,
+        0.478_628_670_499_366_5,
+        0.568_888_888_888_888_9,
+        0.478_628_670_499_366_5,
+        0.236_926_885_056_189_1,
+    ];
+    let panels = 32;
+    let h = 1.0 / panels as f64;
+    (0..panels)
+        .flat_map(|p| {
+            X.iter()
+                .zip(W)
+                .map(move |(x, w)| ((p as f64 + 0.5 * (x + 1.0)) * h, 0.5 * w * h))
+        })
+        .collect()
+}
+
+fn polynomial(c: &[f64], s: f64) -> f64 {
+    c.iter().rev().fold(0.0, |acc, ci| acc * s + ci)
+}
+
+impl ArmProblem {
+    /// M, the number of shape coefficients.
+    pub fn coefficients(&self) -> usize {
+        self.bounds.len() + 1
+    }
+
+    /// The non-dimensional rod: L = 1, B = (B̄1, 1, B̄3), a unit tip load
+    /// pulling down (e1), clamped at the origin with d3 horizontal.
+    pub fn rod(&self) -> Rod {
+        Rod {
+            length: 1.0,
+            energy: Arc::new(LinearElastic::uniform([self.b1, 1.0, self.b3], [0.0; 3])),
+            clamp: Clamp::paper(),
+            loads: DeadLoads {
+                tip_force: Vector3::new(1.0, 0.0, 0.0),
+                ..Default::default()
+            },
+        }
+    }
+
+    /// The full coefficients c1..cM: c1 turns the shape so that the tip
+    /// lies at elevation α (atan2(−x̄, z̄) = α).
+    pub fn full_coefficients(&self, rest: &[f64]) -> (Vec<f64>, f64) {
+        let mut c = vec![0.0];
+        c.extend_from_slice(rest);
+        let (mut z, mut x) = (0.0, 0.0);
+        for (s, w) in quadrature() {
+            let (sin, cos) = polynomial(&c, s).sin_cos();
+            z += w * cos;
+            x += w * sin;
+        }
+        c[0] = -self.alpha - x.atan2(z);
+        (c, x.hypot(z))
+    }
+
+    /// R̂ and γ_crit of the shape with coefficients c2..cM; None when the
+    /// shape is stable under any load (no finite critical load).
+    pub fn design(&self, rest: &[f64]) -> Option<ArmDesign> {
+        let (c, chord) = self.full_coefficients(rest);
+        let shape = FixedShape {
+            turning_angle: Profile::Polynomial(c.clone()),
+        };
+        let crit = critical_load(&self.rod(), &shape, &self.stability).ok()?;
+        let gamma = crit.load_factor?;
+        Some(ArmDesign {
+            reach: gamma.sqrt() * chord,
+            gamma,
+            shape_coefficients: c,
+        })
+    }
+
+    /// Clamps a point into the bounds.
+    fn project(&self, p: &[f64]) -> Vec<f64> {
+        p.iter()
+            .zip(&self.bounds)
+            .map(|(v, (lo, hi))| v.clamp(*lo, *hi))
+            .collect()
+    }
+
+    /// The best design: Halton samples of the box, then Nelder–Mead from
+    /// the best few.
+    pub fn optimize(&self, opts: &SearchOptions) -> Option<ArmOptimum> {
+        let dim = self.bounds.len();
+        let mut evaluations = 0;
+        let mut sampled: Vec<(f64, Vec<f64>)> = (1..=opts.samples)
+            .filter_map(|i| {
+                let p: Vec<f64> = self
+                    .bounds
+                    .iter()
+                    .enumerate()
+                    .map(|(d, (lo, hi))| lo + (hi - lo) * halton(i, PRIMES[d % PRIMES.len()]))
+                    .collect();
+                evaluations += 1;
+                self.design(&p).map(|d| (d.reach, p))
+            })
+            .collect();
+        if dim == 0 {
+            return self.finish(self.design(&[])?, evaluations);
+        }
+        sampled.sort_by(|a, b| b.0.total_cmp(&a.0));
+        let mut best: Option<ArmDesign> = None;
+        for (_, start) in sampled.iter().take(opts.starts) {
+            let (design, used) = self.polish(start, opts.iterations);
+            evaluations += used;
+            if let Some(d) = design {
+                if best.as_ref().is_none_or(|b| d.reach > b.reach) {
+                    best = Some(d);
+                }
+            }
+        }
+        self.finish(best?, evaluations)
+    }
+
+    /// Nelder–Mead from `start` on −R̂ (projected into the bounds).
+    fn polish(&self, start: &[f64], iterations: u64) -> (Option<ArmDesign>, usize) {
+        let simplex: Vec<Vec<f64>> = std::iter::once(start.to_vec())
+            .chain((0..start.len()).map(|d| {
+                let mut p = start.to_vec();
+                let (lo, hi) = self.bounds[d];
+                let step = 0.05 * (hi - lo);
+                p[d] = if p[d] + step <= hi {
+                    p[d] + step
+                } else {
+                    p[d] - step
+                };
+                p
+            }))
+            .collect();
+        let cost = ReachCost {
+            problem: self,
+            calls: std::cell::Cell::new(0),
+        };
+        let Ok(solver) = NelderMead::new(simplex).with_sd_tolerance(1e-12) else {
+            return (None, 0);
+        };
+        let result = Executor::new(&cost, solver)
+            .configure(|state| state.max_iters(iterations))
+            .run();
+        let calls = cost.calls.get();
+        let design = result.ok().and_then(|r| {
+            let p = r.state().get_best_param()?.clone();
+            self.design(&self.project(&p))
+        });
+        (design, calls)
+    }
+
+    fn finish(&self, design: ArmDesign, evaluations: usize) -> Option<ArmOptimum> {
+        let rod = self.rod();
+        let shape = FixedShape {
+            turning_angle: Profile::Polynomial(design.shape_coefficients.clone()),
+        };
+        let n = 101;
+        let points: Vec<f64> = (0..n).map(|i| i as f64 / (n - 1) as f64).collect();
+        let samples = shape.samples(&rod, &points);
+        let c = &design.shape_coefficients;
+        let dphi: Vec<f64> = c
+            .iter()
+            .enumerate()
+            .skip(1)
+            .map(|(i, ci)| i as f64 * ci)
+            .collect();
+        let kappa0: Vec<f64> = samples
+            .iter()
+            .map(|p| polynomial(&dphi, p.s) - design.gamma * p.moment[1])
+            .collect();
+        let scale = design.gamma.sqrt();
+        let loaded = samples
+            .iter()
+            .map(|p| {
+                [
+                    p.position[0] * scale,
+                    p.position[1] * scale,
+                    p.position[2] * scale,
+                ]
+            })
+            .collect();
+        let unloaded = intrinsic_shape(c[0], &points, &kappa0, scale);
+        Some(ArmOptimum {
+            curvature_coefficients: least_squares_polynomial(&points, &kappa0, c.len()),
+            design,
+            loaded_shape: loaded,
+            unloaded_shape: unloaded,
+            intrinsic_curvature: kappa0,
+            evaluations,
+        })
+    }
+}
+
+/// The unloaded shape: φ⁰ = c1 + ∫κ⁰ (trapezoidal on the fine grid), then
+/// positions by the same rule; scaled by √γ.
+fn intrinsic_shape(phi0: f64, s: &[f64], kappa0: &[f64], scale: f64) -> Vec<[f64; 3]> {
+    let mut out = vec![[0.0; 3]];
+    let (mut phi, mut x, mut z) = (phi0, 0.0, 0.0);
+    for i in 1..s.len() {
+        let h = s[i] - s[i - 1];
+        let next = phi + 0.5 * h * (kappa0[i] + kappa0[i - 1]);
+        x += 0.5 * h * (phi.sin() + next.sin());
+        z += 0.5 * h * (phi.cos() + next.cos());
+        phi = next;
+        out.push([x * scale, 0.0, z * scale]);
+    }
+    out
+}
+
+/// Coefficients b1..bM of the least-squares polynomial Σ b_i s^{i−1}.
+fn least_squares_polynomial(s: &[f64], y: &[f64], m: usize) -> Vec<f64> {
+    let a = nalgebra::DMatrix::from_fn(s.len(), m, |i, j| s[i].powi(j as i32));
+    let b = nalgebra::DVector::from_column_slice(y);
+    a.svd(true, true)
+        .solve(&b, 1e-14)
+        .map(|v| v.as_slice().to_vec())
+        .unwrap_or_else(|_| vec![f64::NAN; m])
+}
+
+const PRIMES: [usize; 12] = [2, 3, 5, 7, 11, 13, 17, 19, 23, 29, 31, 37];
+
+/// The i-th element of the van der Corput sequence in base b.
+fn halton(mut i: usize, b: usize) -> f64 {
+    let (mut f, mut r) = (1.0, 0.0);
+    while i > 0 {
+        f /= b as f64;
+        r += f * (i % b) as f64;
+        i /= b;
+    }
+    r
+}
+
+/// −R̂ for Nelder–Mead; points outside the box are projected into it and
+/// charged their squared distance.
+struct ReachCost<'a> {
+    problem: &'a ArmProblem,
+    calls: std::cell::Cell<usize>,
+}
+
+impl CostFunction for &ReachCost<'_> {
+    type Param = Vec<f64>;
+    type Output = f64;
+
+    fn cost(&self, p: &Vec<f64>) -> Result<f64, ArgminError> {
+        self.calls.set(self.calls.get() + 1);
+        let q = self.problem.project(p);
+        let outside: f64 = p.iter().zip(&q).map(|(a, b)| (a - b).powi(2)).sum();
+        let reach = self.problem.design(&q).map_or(0.0, |d| d.reach);
+        Ok(-reach + outside)
+    }
+}
+
+/// The intrinsically straight arm (κ⁰ = 0), solved directly: for each load
+/// γ the clamp angle that puts the tip at elevation α (secant on the BVP
+/// solution), and the largest γ at which that equilibrium is stable
+/// (bisection on the Morse index of the verified second variation).
+#[derive(Debug, Clone, PartialEq)]
+pub struct StraightArm {
+    /// R̂0 = √γ |tip|.
+    pub reach: f64,
+    /// The critical γ.
+    pub gamma: f64,
+    /// The clamp angle (rad, d3 turned towards d1).
+    pub clamp_angle: f64,
+    /// The loaded shape, scaled by √γ.
+    pub loaded_shape: Vec<[f64; 3]>,
+}
+
+impl ArmProblem {
+    /// The straight rod at load γ with the clamp turned by θ.
+    fn straight_rod(&self, gamma: f64, theta: f64) -> Rod {
+        let mut rod = self.rod();
+        rod.loads = rod.loads.scaled(gamma);
+        let axis = nalgebra::Unit::new_normalize(rod.clamp.director(1));
+        rod.clamp.frame =
+            nalgebra::Rotation3::from_axis_angle(&axis, theta).matrix() * rod.clamp.frame;
+        rod
+    }
+
+    /// The equilibrium at (γ, θ) and its tip elevation error.
+    fn straight_equilibrium(
+        &self,
+        gamma: f64,
+        theta: f64,
+    ) -> Option<(crate::bvp::Equilibrium, f64)> {
+        let rod = self.straight_rod(gamma, theta);
+        let choice = crate::model::ModelChoice::for_rod(&rod);
+        let opts = crate::bvp::SolverOptions {
+            method: crate::bvp::Method::MultipleShooting { segments: 8 },
+            output_points: 101,
+            ..Default::default()
+        };
+        let eq = crate::bvp::solve(&rod, &choice, &opts).ok()?;
+        let tip = eq.tip().position;
+        let error = (-tip[0]).atan2(tip[2]) - self.alpha;
+        Some((eq, error))
+    }
+
+    /// The clamp angle at load γ that puts the tip at elevation α.
+    fn level_clamp(&self, gamma: f64, guess: f64) -> Option<(f64, crate::bvp::Equilibrium)> {
+        let (mut t0, mut t1) = (guess, guess + 0.05);
+        let mut f0 = self.straight_equilibrium(gamma, t0)?.1;
+        for _ in 0..60 {
+            let (eq, f1) = self.straight_equilibrium(gamma, t1)?;
+            if f1.abs() < 1e-12 {
+                return Some((t1, eq));
+            }
+            let next = t1 - f1 * (t1 - t0) / (f1 - f0);
+            (t0, f0, t1) = (t1, f1, next.clamp(t1 - 0.5, t1 + 0.5));
+        }
+        None
+    }
+
+    /// R̂0 of the intrinsically straight arm.
+    pub fn straight(&self) -> Option<StraightArm> {
+        let opts = crate::bvp::SolverOptions::default();
+        let stable = |gamma: f64, guess: f64| -> Option<(bool, f64, crate::bvp::Equilibrium)> {
+            let (theta, eq) = self.level_clamp(gamma, guess)?;
+            let rod = self.straight_rod(gamma, theta);
+            let st = crate::stability::analyze(&rod, &eq, &opts, &self.stability).ok()?;
+            Some((st.stable, theta, eq))
+        };
+        // A load where no level equilibrium is found on the branch counts as
+        // beyond the limit, like an unstable one.
+        let (mut lo, mut hi, mut theta) = (0.0, 0.5, 0.0);
+        while let Some((true, t, _)) = stable(hi, theta) {
+            (lo, theta) = (hi, t);
+            hi *= 1.5;
+            if hi > 1e4 {
+                return None;
+            }
+        }
+        for _ in 0..40 {
+            let mid = 0.5 * (lo + hi);
+            match stable(mid, theta) {
+                Some((true, t, _)) => (lo, theta) = (mid, t),
+                _ => hi = mid,
+            }
+            if hi - lo < 1e-10 * hi {
+                break;
+            }
+        }
+        let (theta, eq) = self.level_clamp(lo, theta)?;
+        let scale = lo.sqrt();
+        Some(StraightArm {
+            reach: scale * eq.tip().position.norm(),
+            gamma: lo,
+            clamp_angle: theta,
+            loaded_shape: eq
+                .samples
+                .iter()
+                .map(|p| {
+                    [
+                        p.position[0] * scale,
+                        p.position[1] * scale,
+                        p.position[2] * scale,
+                    ]
+                })
+                .collect(),
+        })
+    }
+}

@@ -1,0 +1,95 @@
+//! `cosserat optimize`: the longest arm of a problem file's `[arm]` table.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+use cosserat::io::{check_target, write_arm, Problem};
+
+use crate::fail;
+
+/// Optimizes the arm and writes the result.
+pub fn run_optimize(
+    path: PathBuf,
+    output: Option<PathBuf>,
+    set: &[String],
+    force: bool,
+) -> ExitCode {
+    let problem = match Problem::from_path(&path, set) {
+        Ok(p) => p,
+        Err(e) => return fail(2, format!("{}: {e}", path.display())),
+    };
+    let Some((arm, search, straight)) = &problem.arm else {
+        return fail(
+            2,
+            format!("{}: arm: the problem has no [arm] table", path.display()),
+        );
+    };
+    if let Some(out) = &output {
+        if let Err(e) = check_target(out, force) {
+            return fail(2, e);
+        }
+    }
+    println!("problem   {}", path.display());
+    println!(
+        "arm       B̄1 = {:.4}, B̄3 = {:.4}, α = {:.2}°, M = {}, {} elements of order {}",
+        arm.b1,
+        arm.b3,
+        arm.alpha.to_degrees(),
+        arm.coefficients(),
+        arm.stability.elements,
+        arm.stability.order
+    );
+    let t = Instant::now();
+    let Some(opt) = arm.optimize(search) else {
+        return fail(
+            2,
+            "no design with a finite critical load was found in the bounds",
+        );
+    };
+    let time = t.elapsed().as_secs_f64();
+    let fmt = |v: &[f64]| {
+        v.iter()
+            .map(|x| format!("{x:+.6}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    };
+    println!(
+        "optimum   R* = {:.6} (√(B2/F)), γ_crit = {:.6}",
+        opt.design.reach, opt.design.gamma
+    );
+    println!(
+        "          shape c = [{}]",
+        fmt(&opt.design.shape_coefficients)
+    );
+    println!(
+        "          κ⁰ fit b = [{}]",
+        fmt(&opt.curvature_coefficients)
+    );
+    println!("          {} evaluations, {:.2} s", opt.evaluations, time);
+    let straight_arm = if *straight {
+        let t = Instant::now();
+        let s = arm.straight();
+        match &s {
+            Some(s) => println!(
+                "straight  R0 = {:.6}, γ_crit = {:.6}, clamp angle {:.3}° ({:.2} s); R*/R0 = {:.3}",
+                s.reach,
+                s.gamma,
+                s.clamp_angle.to_degrees(),
+                t.elapsed().as_secs_f64(),
+                opt.design.reach / s.reach
+            ),
+            None => println!("straight  no stable level equilibrium found"),
+        }
+        s
+    } else {
+        None
+    };
+    if let Some(out) = output {
+        if let Err(e) = write_arm(&out, &problem.text, &opt, straight_arm.as_ref(), force) {
+            return fail(1, e);
+        }
+        println!("written   {}", out.display());
+    }
+    ExitCode::SUCCESS
+}

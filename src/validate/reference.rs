@@ -1,0 +1,288 @@
+//! Closed-form references of the validation cases, evaluated here from
+//! their formulas — independently of the solvers under test (nothing in
+//! this file calls into `bvp`, `stability` or `continuation`).
+//!
+//! Elliptic integrals: Carlson's symmetric forms R_F, R_D by the
+//! duplication algorithm (DLMF 19.36.i; Carlson, Numer. Algorithms 10,
+//! 1995), Legendre's F, E through DLMF 19.25.5 and 19.25.9. Bessel zeros:
+//! bisection on the power series of J_ν (DLMF 10.2.2).
+
+use std::collections::BTreeMap;
+use std::f64::consts::{FRAC_1_SQRT_2, FRAC_PI_2, PI};
+
+/// Carlson's R_F(x, y, z).
+pub fn carlson_rf(x: f64, y: f64, z: f64) -> f64 {
+    let (mut x, mut y, mut z) = (x, y, z);
+    for _ in 0..100 {
+        let (sx, sy, sz) = (x.sqrt(), y.sqrt(), z.sqrt());
+        let lam = sx * sy + sy * sz + sz * sx;
+        x = 0.25 * (x + lam);
+        y = 0.25 * (y + lam);
+        z = 0.25 * (z + lam);
+        let a = (x + y + z) / 3.0;
+        let (dx, dy, dz) = (1.0 - x / a, 1.0 - y / a, 1.0 - z / a);
+        if dx.abs().max(dy.abs()).max(dz.abs()) < 1e-4 {
+            let e2 = dx * dy - dz * dz;
+            let e3 = dx * dy * dz;
+            return (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0)
+                / a.sqrt();
+        }
+    }
+    f64::NAN
+}
+
+/// Carlson's R_D(x, y, z).
+pub fn carlson_rd(x: f64, y: f64, z: f64) -> f64 {
+    let (mut x, mut y, mut z) = (x, y, z);
+    let (mut sum, mut fac) = (0.0, 1.0);
+    for _ in 0..100 {
+        let (sx, sy, sz) = (x.sqrt(), y.sqrt(), z.sqrt());
+        let lam = sx * sy + sy * sz + sz * sx;
+        sum += fac / (sz * (z + lam));
+        fac *= 0.25;
+        x = 0.25 * (x + lam);
+        y = 0.25 * (y + lam);
+        z = 0.25 * (z + lam);
+        let a = (x + y + 3.0 * z) / 5.0;
+        let (dx, dy, dz) = (1.0 - x / a, 1.0 - y / a, 1.0 - z / a);
+        if dx.abs().max(dy.abs()).max(dz.abs()) < 1e-4 {
+            let ea = dx * dy;
+            let eb = dz * dz;
+            let ec = ea - eb;
+            let ed = ea - 6.0 * eb;
+            let ee = ed + ec + ec;
+            let series = 1.0
+                + ed * (-3.0 / 14.0 + 9.0 / 88.0 * ed - 4.5 / 26.0 * dz * ee)
+                + dz * (ee / 6.0 + dz * (-9.0 / 22.0 * ec + dz * 3.0 / 26.0 * ea));
+            return 3.0 * sum + fac * series / (a * a.sqrt());
+        }
+    }
+    f64::NAN
+}
+
+/// F(φ, k) = ∫_0^φ dθ / √(1 − k² sin²θ), 0 ≤ φ ≤ π/2.
+pub fn ellip_f(phi: f64, k: f64) -> f64 {
+    let (s, c) = phi.sin_cos();
+    s * carlson_rf(c * c, 1.0 - (k * s).powi(2), 1.0)
+}
+
+/// E(φ, k) = ∫_0^φ √(1 − k² sin²θ) dθ, 0 ≤ φ ≤ π/2.
+pub fn ellip_e(phi: f64, k: f64) -> f64 {
+    let (s, c) = phi.sin_cos();
+    let q = 1.0 - (k * s).powi(2);
+    s * carlson_rf(c * c, q, 1.0) - (k * k) * s.powi(3) * carlson_rd(c * c, q, 1.0) / 3.0
+}
+
+/// The first positive zero of J_ν in (lo, hi), from the reduced power
+/// series S(x) = Σ_m (−x²/4)^m / (m! (ν + 1)_m), whose zeros for x > 0 are
+/// those of J_ν.
+pub fn bessel_first_zero(nu: f64, lo: f64, hi: f64) -> f64 {
+    let series = |x: f64| {
+        let q = -x * x / 4.0;
+        let (mut term, mut sum) = (1.0, 1.0);
+        for m in 1..200 {
+            term *= q / (m as f64 * (nu + m as f64));
+            sum += term;
+            if term.abs() < 1e-18 * sum.abs().max(1e-300) {
+                break;
+            }
+        }
+        sum
+    };
+    let (mut a, mut b) = (lo, hi);
+    let fa = series(a);
+    if fa * series(b) >= 0.0 {
+        return f64::NAN;
+    }
+    for _ in 0..200 {
+        let m = 0.5 * (a + b);
+        if series(m) * fa > 0.0 {
+            a = m;
+        } else {
+            b = m;
+        }
+    }
+    0.5 * (a + b)
+}
+
+/// Tip of the planar cantilever of unit length under a tip force
+/// perpendicular to the clamp's tangent, k = F L²/B (Bisshopp & Drucker,
+/// Q. Appl. Math. 3, 1945): with the tip angle φ0, p² = (1 + sin φ0)/2 and
+/// sin θ0 = 1/(p√2), √k = K(p) − F(θ0, p); the deflection along the force
+/// is 1 − 2 (E(p) − E(θ0, p))/√k and the projection on the clamp's tangent
+/// √(2 sin φ0 / k). Returns (deflection, projection, tip angle).
+pub fn cantilever_tip(k: f64) -> (f64, f64, f64) {
+    let sqrt_k = k.sqrt();
+    let lhs = |p: f64| {
+        let theta0 = (1.0 / (p * 2f64.sqrt())).asin();
+        ellip_f(FRAC_PI_2, p) - ellip_f(theta0, p)
+    };
+    let (mut lo, mut hi) = (FRAC_1_SQRT_2, 1.0);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if lhs(mid) < sqrt_k {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let p = 0.5 * (lo + hi);
+    let theta0 = (1.0 / (p * 2f64.sqrt())).asin();
+    let sin_phi0 = 2.0 * p * p - 1.0;
+    (
+        1.0 - 2.0 * (ellip_e(FRAC_PI_2, p) - ellip_e(theta0, p)) / sqrt_k,
+        (2.0 * sin_phi0 / k).sqrt(),
+        sin_phi0.asin(),
+    )
+}
+
+/// The formulas a case file can name, with their parameters and their
+/// source; every length is for L = 1, every load is F L²/B.
+pub const FORMULAS: &[(&str, &str, &str)] = &[
+    (
+        "cantilever_tip_x",
+        "k",
+        "deflection 1 − 2(E(p) − E(θ0, p))/√k (Bisshopp & Drucker 1945)",
+    ),
+    (
+        "cantilever_tip_z",
+        "k",
+        "projection √(2 sin φ0 / k) (Bisshopp & Drucker 1945)",
+    ),
+    (
+        "cantilever_tip_angle",
+        "k",
+        "tip angle φ0, √k = K(p) − F(θ0, p), p² = (1 + sin φ0)/2 (Bisshopp & Drucker 1945)",
+    ),
+    ("euler_clamped_free", "", "F L²/B = π²/4 (Euler 1744)"),
+    (
+        "elastica_column_load",
+        "alpha_deg",
+        "F L²/B = K(sin(α/2))² (clamped–free elastica)",
+    ),
+    (
+        "elastica_column_tip_deflection",
+        "alpha_deg",
+        "δ/L = 2 sin(α/2)/K(sin(α/2))",
+    ),
+    (
+        "elastica_column_tip_axial",
+        "alpha_deg",
+        "z(L)/L = 2E(sin(α/2))/K(sin(α/2)) − 1",
+    ),
+    (
+        "elastica_column_tip_angle",
+        "alpha_deg",
+        "the tip angle α itself",
+    ),
+    (
+        "circle_tip_x",
+        "m",
+        "(1 − cos m)/m: a circular arc of curvature m = M L/B",
+    ),
+    (
+        "circle_tip_z",
+        "m",
+        "sin m / m: a circular arc of curvature m = M L/B",
+    ),
+    (
+        "circle_tip_angle",
+        "m",
+        "the tip angle m, wrapped to (−π, π]",
+    ),
+    ("circle_chord", "m", "|r(L) − r(0)| = 2|sin(m/2)|/m"),
+    (
+        "none",
+        "",
+        "no such value exists (e.g. no static critical load): the reference is `none`",
+    ),
+    (
+        "timoshenko_ltb",
+        "",
+        "F L²/√(B1 B3) = 2 j₋₁/₄,₁ (Timoshenko & Gere 1961, Sec. 6.3)",
+    ),
+    (
+        "timoshenko_chi",
+        "",
+        "χ = √(2 j₋₁/₄,₁), the paper's eq. (1): L ≤ χ (B1 B3)^¼ / F^½",
+    ),
+];
+
+fn param(params: &BTreeMap<String, f64>, name: &str, formula: &str) -> Result<f64, String> {
+    params
+        .get(name)
+        .copied()
+        .ok_or_else(|| format!("formula `{formula}` needs the parameter `{name}`"))
+}
+
+/// Evaluates the formula `name` with the point's parameters.
+pub fn evaluate(name: &str, params: &BTreeMap<String, f64>) -> Result<f64, String> {
+    let k = || param(params, "k", name);
+    let m = || param(params, "m", name);
+    let modulus = || param(params, "alpha_deg", name).map(|a| (a.to_radians() / 2.0).sin());
+    let j = || bessel_first_zero(-0.25, 1.0, 3.0);
+    Ok(match name {
+        "cantilever_tip_x" => cantilever_tip(k()?).0,
+        "cantilever_tip_z" => cantilever_tip(k()?).1,
+        "cantilever_tip_angle" => cantilever_tip(k()?).2,
+        "euler_clamped_free" => PI * PI / 4.0,
+        "elastica_column_load" => ellip_f(FRAC_PI_2, modulus()?).powi(2),
+        "elastica_column_tip_deflection" => {
+            let p = modulus()?;
+            2.0 * p / ellip_f(FRAC_PI_2, p)
+        }
+        "elastica_column_tip_axial" => {
+            let p = modulus()?;
+            2.0 * ellip_e(FRAC_PI_2, p) / ellip_f(FRAC_PI_2, p) - 1.0
+        }
+        "elastica_column_tip_angle" => param(params, "alpha_deg", name)?.to_radians(),
+        "circle_tip_x" => {
+            let m = m()?;
+            (1.0 - m.cos()) / m
+        }
+        "circle_tip_z" => {
+            let m = m()?;
+            m.sin() / m
+        }
+        "circle_tip_angle" => {
+            let m = m()?;
+            m.sin().atan2(m.cos())
+        }
+        "circle_chord" => {
+            let m = m()?;
+            2.0 * (m / 2.0).sin().abs() / m
+        }
+        "none" => f64::NAN,
+        "timoshenko_ltb" => 2.0 * j(),
+        "timoshenko_chi" => (2.0 * j()).sqrt(),
+        other => {
+            let known: Vec<&str> = FORMULAS.iter().map(|f| f.0).collect();
+            return Err(format!(
+                "unknown formula `{other}`; known: {}",
+                known.join(", ")
+            ));
+        }
+    })
+}
+
+/// The description of a formula, for the report.
+pub fn describe(name: &str) -> &'static str {
+    FORMULAS.iter().find(|f| f.0 == name).map_or("", |f| f.2)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn known_values() {
+        // K(1/√2) = Γ(1/4)²/(4√π) (DLMF 19.6.2 / 19.20).
+        let k = ellip_f(FRAC_PI_2, FRAC_1_SQRT_2);
+        assert!((k - 1.854_074_677_301_372).abs() < 1e-14, "{k}");
+        // j₋₁/₄,₁: 2j = 4.0126 (Timoshenko & Gere).
+        assert!((2.0 * bessel_first_zero(-0.25, 1.0, 3.0) - 4.0126).abs() < 1e-4);
+        // The cantilever's small-load limit: x ≈ k/3.
+        let (x, _, _) = cantilever_tip(1e-4);
+        assert!((x - 1e-4 / 3.0).abs() < 1e-9);
+    }
+}
