@@ -14,7 +14,6 @@
 //! the mesh size (integration steps for shooting, intervals for
 //! collocation). Output: `work_precision.csv`, `.png`, `.svg`.
 
-use std::f64::consts::FRAC_PI_2;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
@@ -342,28 +341,10 @@ where
 }
 
 /// Tip (x, z) of the unit cantilever under a tip force perpendicular to the
-/// clamp, k = F L²/B (Bisshopp & Drucker 1945): with the tip angle φ0,
-/// p² = (1 + sin φ0)/2, sin θ0 = 1/(p√2), √k = K(p) − F(θ0, p),
-/// x = 1 − 2 (E(p) − E(θ0, p))/√k, z = √(2 sin φ0/k).
+/// clamp (Bisshopp & Drucker 1945), from the validation references.
 pub fn cantilever_tip(k: f64) -> (f64, f64) {
-    let sqrt_k = k.sqrt();
-    let theta = |p: f64| (1.0 / (p * 2f64.sqrt())).asin();
-    let lhs = |p: f64| ellip_f(FRAC_PI_2, p) - ellip_f(theta(p), p);
-    let (mut lo, mut hi) = (std::f64::consts::FRAC_1_SQRT_2, 1.0);
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if lhs(mid) < sqrt_k {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    let p = 0.5 * (lo + hi);
-    let sin_phi0 = 2.0 * p * p - 1.0;
-    (
-        1.0 - 2.0 * (ellip_e(FRAC_PI_2, p) - ellip_e(theta(p), p)) / sqrt_k,
-        (2.0 * sin_phi0 / k).sqrt(),
-    )
+    let (x, z, _) = crate::validate::reference::cantilever_tip(k);
+    (x, z)
 }
 
 /// Tip of the unloaded rod with constant intrinsic curvature κ⁰ clamped
@@ -375,78 +356,4 @@ pub fn helix_tip(kappa0: Vector3<f64>, s: f64) -> Vector3<f64> {
         + k * ((1.0 - (w * s).cos()) / (w * w))
         + k * k * ((w * s - (w * s).sin()) / (w * w * w));
     m * Vector3::z()
-}
-
-/// Carlson's R_F by duplication (DLMF 19.36.i).
-fn carlson_rf(x: f64, y: f64, z: f64) -> f64 {
-    let (mut x, mut y, mut z) = (x, y, z);
-    loop {
-        let (sx, sy, sz) = (x.sqrt(), y.sqrt(), z.sqrt());
-        let lam = sx * sy + sy * sz + sz * sx;
-        x = 0.25 * (x + lam);
-        y = 0.25 * (y + lam);
-        z = 0.25 * (z + lam);
-        let a = (x + y + z) / 3.0;
-        let (dx, dy, dz) = (1.0 - x / a, 1.0 - y / a, 1.0 - z / a);
-        if dx.abs().max(dy.abs()).max(dz.abs()) < 1e-4 {
-            let e2 = dx * dy - dz * dz;
-            let e3 = dx * dy * dz;
-            return (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0)
-                / a.sqrt();
-        }
-    }
-}
-
-/// Carlson's R_D by duplication (DLMF 19.36.i).
-fn carlson_rd(x: f64, y: f64, z: f64) -> f64 {
-    let (mut x, mut y, mut z) = (x, y, z);
-    let (mut sum, mut fac) = (0.0, 1.0);
-    loop {
-        let (sx, sy, sz) = (x.sqrt(), y.sqrt(), z.sqrt());
-        let lam = sx * sy + sy * sz + sz * sx;
-        sum += fac / (sz * (z + lam));
-        fac *= 0.25;
-        x = 0.25 * (x + lam);
-        y = 0.25 * (y + lam);
-        z = 0.25 * (z + lam);
-        let a = (x + y + 3.0 * z) / 5.0;
-        let (dx, dy, dz) = (1.0 - x / a, 1.0 - y / a, 1.0 - z / a);
-        if dx.abs().max(dy.abs()).max(dz.abs()) < 1e-4 {
-            let ea = dx * dy;
-            let eb = dz * dz;
-            let ec = ea - eb;
-            let ed = ea - 6.0 * eb;
-            let ee = ed + ec + ec;
-            let series = 1.0
-                + ed * (-3.0 / 14.0 + 9.0 / 88.0 * ed - 4.5 / 26.0 * dz * ee)
-                + dz * (ee / 6.0 + dz * (-9.0 / 22.0 * ec + dz * 3.0 / 26.0 * ea));
-            return 3.0 * sum + fac * series / (a * a.sqrt());
-        }
-    }
-}
-
-/// F(φ, k), DLMF 19.25.5.
-fn ellip_f(phi: f64, k: f64) -> f64 {
-    let (s, c) = phi.sin_cos();
-    s * carlson_rf(c * c, 1.0 - (k * s).powi(2), 1.0)
-}
-
-/// E(φ, k), DLMF 19.25.9.
-fn ellip_e(phi: f64, k: f64) -> f64 {
-    let (s, c) = phi.sin_cos();
-    let q = 1.0 - (k * s).powi(2);
-    s * carlson_rf(c * c, q, 1.0) - (k * k) * s.powi(3) * carlson_rd(c * c, q, 1.0) / 3.0
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The k = 3 tip (x = 0.6032534…, z = 0.7455798…; the shooting
-    /// solution at 1e-12 agrees to 1e-11).
-    #[test]
-    fn reference_cantilever() {
-        let (x, z) = cantilever_tip(3.0);
-        assert!((x - 0.6032534411).abs() < 1e-9 && (z - 0.7455798154).abs() < 1e-9);
-    }
 }
