@@ -26,7 +26,9 @@
 //! exceeds the tolerance per unit length (so the accumulated local error
 //! stays below the tolerance).
 
-use nalgebra::{DMatrix, DVector, Dyn, LU};
+use nalgebra::DMatrix;
+#[cfg(test)]
+use nalgebra::DVector;
 
 use super::integrator::{Dop853, Tolerances};
 use super::newton::NewtonOptions;
@@ -117,6 +119,8 @@ impl CollocationSolution {
     pub fn sample_states(&self, eq: &dyn RodEquations, points: &[f64]) -> Vec<Vec<f64>> {
         let tab = Tableau::gauss(self.stage_count).expect("stored stage count is valid");
         let grid = Grid::new(eq, tab, self.mesh.clone());
+        let (n, m) = (grid.n, grid.tab.m);
+        let mut ws = Scratch::new(n, m);
         let last = self.mesh.len() - 1;
         points
             .iter()
@@ -129,14 +133,24 @@ impl CollocationSolution {
                 if t <= 0.0 {
                     return self.states[i].clone();
                 }
-                let guess: Vec<f64> = grid
-                    .tab
-                    .c
-                    .iter()
-                    .flat_map(|c| self.interpolate(self.mesh[i] + c * t))
-                    .collect();
-                grid.local_step(self.mesh[i], t, &self.states[i], guess)
-                    .unwrap_or_else(|| self.interpolate(s))
+                let mut st = vec![0.0; m * n];
+                for (j, c) in grid.tab.c.iter().enumerate() {
+                    self.interpolate_into(self.mesh[i] + c * t, &mut st[j * n..(j + 1) * n]);
+                }
+                let mut y = vec![0.0; n];
+                if grid.local_step(
+                    self.mesh[i],
+                    t,
+                    &self.states[i],
+                    &mut st,
+                    &mut y,
+                    &mut ws,
+                    None,
+                ) {
+                    y
+                } else {
+                    self.interpolate(s)
+                }
             })
             .collect()
     }
@@ -163,20 +177,27 @@ impl CollocationSolution {
     /// The collocation polynomial at s ∈ [0, L]: on interval i it is the
     /// degree-m polynomial through y_i and the stage values.
     pub fn interpolate(&self, s: f64) -> Vec<f64> {
+        let mut y = vec![0.0; self.states[0].len()];
+        self.interpolate_into(s, &mut y);
+        y
+    }
+
+    /// [`Self::interpolate`] into `y`.
+    fn interpolate_into(&self, s: f64, y: &mut [f64]) {
         let last = self.mesh.len() - 1;
         if s >= self.mesh[last] {
-            return self.states[last].clone();
+            y.copy_from_slice(&self.states[last]);
+            return;
         }
         let i = self.mesh.partition_point(|&x| x <= s).clamp(1, last) - 1;
         let h = self.mesh[i + 1] - self.mesh[i];
         let t = (s - self.mesh[i]) / h;
-        let tab = Tableau::gauss(self.stage_count).expect("stored stage count is valid");
-        let mut nodes = vec![0.0];
-        nodes.extend_from_slice(&tab.c);
-        let n = self.states[i].len();
-        let mut y = vec![0.0; n];
-        for (q, _) in nodes.iter().enumerate() {
-            let w = lagrange(&nodes, q, t);
+        let (nodes, count) = interpolation_nodes(self.stage_count);
+        let nodes = &nodes[..count];
+        let n = y.len();
+        y.fill(0.0);
+        for q in 0..count {
+            let w = lagrange(nodes, q, t);
             let v = if q == 0 {
                 &self.states[i][..]
             } else {
@@ -184,7 +205,6 @@ impl CollocationSolution {
             };
             y.iter_mut().zip(v).for_each(|(a, b)| *a += w * b);
         }
-        y
     }
 }
 
@@ -290,7 +310,7 @@ pub fn solve_collocation_from(
         steps += outcome.iterations;
         damped += outcome.damped_steps;
         contraction = contraction.max(outcome.contraction);
-        let errors = grid.local_errors(&outcome.x);
+        let errors = grid.local_errors(&outcome.x, outcome.lin.as_ref());
         let mut sol = grid.solution(&outcome, &errors);
         sol.newton_steps = steps;
         sol.damped_steps = damped;
@@ -437,6 +457,23 @@ impl Tableau {
     }
 }
 
+/// The nodes (0, c_1 … c_m) of the collocation polynomial on [0, 1] and
+/// their count m + 1 (the Gauss points of [`Tableau::gauss`], without its
+/// allocations).
+fn interpolation_nodes(m: usize) -> ([f64; 4], usize) {
+    match m {
+        1 => ([0.0, 0.5, 0.0, 0.0], 2),
+        2 => {
+            let d = 3f64.sqrt() / 6.0;
+            ([0.0, 0.5 - d, 0.5 + d, 0.0], 3)
+        }
+        _ => {
+            let d = 15f64.sqrt() / 10.0;
+            ([0.0, 0.5 - d, 0.5, 0.5 + d], 4)
+        }
+    }
+}
+
 /// ℓ_q(t) for the Lagrange basis on `nodes`.
 fn lagrange(nodes: &[f64], q: usize, t: f64) -> f64 {
     nodes
@@ -474,6 +511,36 @@ struct Grid<'a> {
     moment_scale: f64,
     /// ∂y_0/∂u.
     sens: DMatrix<f64>,
+    /// The n × n identity, column-major: the tangent vectors that make
+    /// `rhs_linearized` return the Jacobian ∂f/∂y (one call per point).
+    ident: Vec<f64>,
+}
+
+/// Buffers of one interval's stage computations, reused across intervals
+/// and iterations (no allocation per interval).
+struct Scratch {
+    /// f at the m stages (m·n).
+    f: Vec<f64>,
+    /// ∂f/∂y at the m stages, each n × n column-major.
+    jac: Vec<f64>,
+    /// The stage matrix W (mn × mn, row-major), factored in place.
+    w: Vec<f64>,
+    piv: Vec<usize>,
+    /// A stage-sized right-hand side (m·n).
+    g: Vec<f64>,
+}
+
+impl Scratch {
+    fn new(n: usize, m: usize) -> Self {
+        let mn = m * n;
+        Scratch {
+            f: vec![0.0; mn],
+            jac: vec![0.0; m * n * n],
+            w: vec![0.0; mn * mn],
+            piv: vec![0; mn],
+            g: vec![0.0; mn],
+        }
+    }
 }
 
 impl<'a> Grid<'a> {
@@ -488,6 +555,7 @@ impl<'a> Grid<'a> {
             w: eq.state_scales().iter().map(|v| 1.0 / v).collect(),
             moment_scale: eq.moment_scale(),
             sens: eq.initial_sensitivity(),
+            ident: DMatrix::<f64>::identity(n, n).as_slice().to_vec(),
         }
     }
 
@@ -514,6 +582,16 @@ impl<'a> Grid<'a> {
             y0
         } else {
             x[p + n * (i - 1)..p + n * i].to_vec()
+        }
+    }
+
+    /// The node state y_i for i ≥ 1, or `y0` (y_0 computed by the caller).
+    fn node_ref<'x>(&self, x: &'x [f64], y0: &'x [f64], i: usize) -> &'x [f64] {
+        let (n, p) = (self.n, self.p);
+        if i == 0 {
+            y0
+        } else {
+            &x[p + n * (i - 1)..p + n * i]
         }
     }
 
@@ -551,14 +629,30 @@ impl<'a> Grid<'a> {
             points.extend(self.tab.c.iter().map(|c| s + c * h));
             points.push(self.mesh[i + 1]);
         }
-        let states: Vec<Vec<f64>> = match warm {
-            Some(w) => points.iter().map(|&s| w.interpolate(s)).collect(),
-            None if straight => points.iter().map(|&s| self.eq.straight_state(s)).collect(),
-            None => self.integrate_guess(&u, &points),
-        };
         let (n, m) = (self.n, self.tab.m);
         let mut x = u;
         x.reserve(self.size());
+        if let Some(w) = warm {
+            // Interpolated straight into x: the nodes, then the stages.
+            let (p, o) = (x.len(), x.len() + n * k);
+            x.resize(self.size(), 0.0);
+            for i in 0..k {
+                for (j, &s) in points[i * (m + 1)..(i + 1) * (m + 1)].iter().enumerate() {
+                    let r = if j == m {
+                        p + n * i..p + n * (i + 1)
+                    } else {
+                        o + (i * m + j) * n..o + (i * m + j + 1) * n
+                    };
+                    w.interpolate_into(s, &mut x[r]);
+                }
+            }
+            return x;
+        }
+        let states: Vec<Vec<f64>> = if straight {
+            points.iter().map(|&s| self.eq.straight_state(s)).collect()
+        } else {
+            self.integrate_guess(&x, &points)
+        };
         for i in 0..k {
             x.extend_from_slice(&states[i * (m + 1) + m]);
         }
@@ -606,155 +700,248 @@ impl<'a> Grid<'a> {
         out
     }
 
-    /// f at the stages of interval i (m·n numbers).
-    fn stage_rates(&self, i: usize, stages: &[f64]) -> Vec<f64> {
-        let (n, (s, h)) = (self.n, self.span(i));
-        let mut f = vec![0.0; stages.len()];
+    /// f at the m stages `st` of the step of width h from s, into `f`.
+    fn stage_rates(&self, s: f64, h: f64, st: &[f64], f: &mut [f64]) {
+        let n = self.n;
         for (j, c) in self.tab.c.iter().enumerate() {
             let r = j * n..(j + 1) * n;
-            self.eq.rhs(s + c * h, &stages[r.clone()], &mut f[r]);
+            self.eq.rhs(s + c * h, &st[r.clone()], &mut f[r]);
         }
-        f
+    }
+
+    /// f and ∂f/∂y at the m stages `st` (one `rhs_linearized` call each),
+    /// into `f` and `jac` (n × n column-major per stage).
+    fn stage_jacobians(&self, s: f64, h: f64, st: &[f64], f: &mut [f64], jac: &mut [f64]) {
+        let n = self.n;
+        for (j, c) in self.tab.c.iter().enumerate() {
+            let r = j * n..(j + 1) * n;
+            self.eq.rhs_linearized(
+                s + c * h,
+                &st[r.clone()],
+                n,
+                &self.ident,
+                &mut f[r],
+                &mut jac[j * n * n..(j + 1) * n * n],
+            );
+        }
+    }
+
+    /// W = I − h (A ⊗ I) diag(J_l) (row-major, into `w`): the stage block of
+    /// the Jacobian.
+    fn stage_matrix(&self, h: f64, jac: &[f64], w: &mut [f64]) {
+        let (n, m) = (self.n, self.tab.m);
+        let mn = m * n;
+        for j in 0..m {
+            for l in 0..m {
+                let coef = h * self.tab.a(j, l);
+                let jl = &jac[l * n * n..(l + 1) * n * n];
+                for r in 0..n {
+                    let row = &mut w[(j * n + r) * mn + l * n..(j * n + r) * mn + (l + 1) * n];
+                    for (c, v) in row.iter_mut().enumerate() {
+                        let id = if j == l && r == c { 1.0 } else { 0.0 };
+                        *v = id - jl[c * n + r] * coef;
+                    }
+                }
+            }
+        }
     }
 
     /// The scaled residual: per interval the m·n stage equations and the n
     /// node equations, then the p tip conditions.
     fn residual(&self, x: &[f64]) -> Vec<f64> {
-        let (n, m) = (self.n, self.tab.m);
+        let (n, m, p) = (self.n, self.tab.m, self.p);
         let mut r = Vec::with_capacity(self.size());
-        let mut y = self.node(x, 0);
+        let mut y0 = vec![0.0; n];
+        self.eq.initial_state(&x[..p], &mut y0);
+        let mut f = vec![0.0; m * n];
         for i in 0..self.intervals() {
-            let h = self.span(i).1;
+            let (s, h) = self.span(i);
             let st = self.stages(x, i);
-            let f = self.stage_rates(i, st);
+            self.stage_rates(s, h, st, &mut f);
+            let y = self.node_ref(x, &y0, i);
             for j in 0..m {
                 for k in 0..n {
                     let acc: f64 = (0..m).map(|l| self.tab.a(j, l) * f[l * n + k]).sum();
                     r.push((st[j * n + k] - y[k] - h * acc) * self.w[k]);
                 }
             }
-            let next = self.node(x, i + 1);
+            let next = self.node_ref(x, &y0, i + 1);
             for k in 0..n {
                 let acc: f64 = (0..m).map(|j| self.tab.b[j] * f[j * n + k]).sum();
                 r.push((next[k] - y[k] - h * acc) * self.w[k]);
             }
-            y = next;
         }
-        let mut g = vec![0.0; self.p];
-        self.eq.tip_residual(&y, &mut g);
+        let mut g = vec![0.0; p];
+        self.eq
+            .tip_residual(self.node_ref(x, &y0, self.intervals()), &mut g);
         r.extend(g.iter().map(|v| v / self.moment_scale));
         r
     }
 
-    /// ∂f/∂y at (s, y), from the linearization applied to the identity.
-    fn jacobian(&self, s: f64, y: &[f64]) -> DMatrix<f64> {
-        let n = self.n;
-        let id = DMatrix::<f64>::identity(n, n);
-        let (mut dy, mut dphi) = (vec![0.0; n], vec![0.0; n * n]);
-        self.eq
-            .rhs_linearized(s, y, n, id.as_slice(), &mut dy, &mut dphi);
-        DMatrix::from_column_slice(n, n, &dphi)
-    }
-
-    /// W = I − h (A ⊗ I) diag(J_l): the stage block of the Jacobian.
-    fn stage_matrix(&self, h: f64, jacs: &[DMatrix<f64>]) -> DMatrix<f64> {
-        let (n, m) = (self.n, self.tab.m);
-        let mut w = DMatrix::identity(m * n, m * n);
-        for j in 0..m {
-            for (l, jl) in jacs.iter().enumerate() {
-                let mut blk = w.view_mut((j * n, l * n), (n, n));
-                blk -= jl * (h * self.tab.a(j, l));
-            }
+    /// Storage for the Newton matrix of this mesh.
+    fn new_linearization(&self) -> Linearization {
+        let (n, m, p, k) = (self.n, self.tab.m, self.p, self.intervals());
+        let mn = m * n;
+        Linearization {
+            lu: vec![0.0; k * mn * mn],
+            piv: vec![0; k * mn],
+            z: vec![0.0; k * mn * n],
+            hbj: vec![0.0; k * m * n * n],
+            band: BandLu::zeros(p + n * k, 2 * n - 1 - p, n + p - 1),
+            valid: false,
         }
-        w
     }
 
-    /// The Newton matrix at x, condensed and factored; None if singular.
-    fn linearize(&self, x: &[f64]) -> Option<Linearization> {
+    /// The Newton matrix at x, condensed and factored into `lin` (reusing
+    /// its storage); false if singular.
+    fn linearize(&self, x: &[f64], lin: &mut Linearization, ws: &mut Scratch) -> bool {
+        lin.valid = false;
         let (n, p, k) = (self.n, self.p, self.intervals());
-        let mut band = BandLu::zeros(p + n * k, 2 * n - 1 - p, n + p - 1);
-        let mut blocks = Vec::with_capacity(k);
+        lin.band.clear();
+        let mut gamma = vec![0.0; n * n];
+        let mut gamma0 = vec![0.0; n * p];
         for i in 0..k {
-            let blk = self.condense(i, self.stages(x, i))?;
-            let gamma = if i == 0 {
-                &blk.gamma * &self.sens
+            if !self.condense(i, self.stages(x, i), lin, ws, &mut gamma) {
+                return false;
+            }
+            let (g, cols): (&[f64], usize) = if i == 0 {
+                // Γ_0 S (n × p, row-major).
+                for r in 0..n {
+                    for c in 0..p {
+                        gamma0[r * p + c] =
+                            (0..n).map(|q| gamma[r * n + q] * self.sens[(q, c)]).sum();
+                    }
+                }
+                (&gamma0, p)
             } else {
-                blk.gamma.clone()
+                (&gamma, n)
             };
             let col = if i == 0 { 0 } else { p + n * (i - 1) };
             for r in 0..n {
-                for c in 0..gamma.ncols() {
-                    band.add(n * i + r, col + c, -gamma[(r, c)] * self.w[r]);
+                for c in 0..cols {
+                    lin.band
+                        .add(n * i + r, col + c, -g[r * cols + c] * self.w[r]);
                 }
-                band.add(n * i + r, p + n * i + r, self.w[r]);
+                lin.band.add(n * i + r, p + n * i + r, self.w[r]);
             }
-            blocks.push(blk);
         }
         let y_tip = self.node(x, k);
         let gt = self.eq.tip_residual_jacobian(&y_tip) / self.moment_scale;
         for r in 0..p {
             for c in 0..n {
-                band.add(n * k + r, p + n * (k - 1) + c, gt[(r, c)]);
+                lin.band.add(n * k + r, p + n * (k - 1) + c, gt[(r, c)]);
             }
         }
-        band.factor().ok()?;
-        Some(Linearization { blocks, band })
+        lin.valid = lin.band.factor().is_ok();
+        lin.valid
     }
 
-    /// Condensation of interval i: δY = v + Z δy_i with W Z = E (stacked
-    /// identities), and Γ = I + h Σ_j b_j J_j Z_j (AMR §7.2.1).
-    fn condense(&self, i: usize, st: &[f64]) -> Option<Condensed> {
+    /// Condensation of interval i into `lin`: δY = v + Z δy_i with W Z = E
+    /// (stacked identities), and Γ = I + h Σ_j b_j J_j Z_j (AMR §7.2.1),
+    /// into `gamma` (n × n, row-major); false if W is singular.
+    fn condense(
+        &self,
+        i: usize,
+        st: &[f64],
+        lin: &mut Linearization,
+        ws: &mut Scratch,
+        gamma: &mut [f64],
+    ) -> bool {
         let (n, m, (s, h)) = (self.n, self.tab.m, self.span(i));
-        let jacs: Vec<DMatrix<f64>> = (0..m)
-            .map(|j| self.jacobian(s + self.tab.c[j] * h, &st[j * n..(j + 1) * n]))
-            .collect();
-        let lu = self.stage_matrix(h, &jacs).lu();
-        let e = DMatrix::from_fn(m * n, n, |r, c| if r % n == c { 1.0 } else { 0.0 });
-        let z = lu.solve(&e)?;
-        let hbj: Vec<DMatrix<f64>> = jacs
-            .into_iter()
-            .enumerate()
-            .map(|(j, jj)| jj * (h * self.tab.b[j]))
-            .collect();
-        let mut gamma = DMatrix::identity(n, n);
-        for (j, hb) in hbj.iter().enumerate() {
-            gamma += hb * z.rows(j * n, n);
+        let (mn, nn) = (m * n, n * n);
+        self.stage_jacobians(s, h, st, &mut ws.f, &mut ws.jac);
+        let lu = &mut lin.lu[i * mn * mn..(i + 1) * mn * mn];
+        let piv = &mut lin.piv[i * mn..(i + 1) * mn];
+        self.stage_matrix(h, &ws.jac, lu);
+        if !dense_lu(lu, mn, piv) {
+            return false;
         }
-        z.iter()
-            .all(|v| v.is_finite())
-            .then_some(Condensed { lu, z, hbj, gamma })
+        let z = &mut lin.z[i * mn * n..(i + 1) * mn * n];
+        for c in 0..n {
+            let col = &mut z[c * mn..(c + 1) * mn];
+            col.iter_mut()
+                .enumerate()
+                .for_each(|(r, v)| *v = if r % n == c { 1.0 } else { 0.0 });
+            dense_solve(lu, mn, piv, col);
+        }
+        if !z.iter().all(|v| v.is_finite()) {
+            return false;
+        }
+        let hbj = &mut lin.hbj[i * m * nn..(i + 1) * m * nn];
+        for j in 0..m {
+            let hb = h * self.tab.b[j];
+            hbj[j * nn..(j + 1) * nn]
+                .iter_mut()
+                .zip(&ws.jac[j * nn..(j + 1) * nn])
+                .for_each(|(a, b)| *a = b * hb);
+        }
+        for r in 0..n {
+            for c in 0..n {
+                gamma[r * n + c] = if r == c { 1.0 } else { 0.0 };
+            }
+        }
+        for j in 0..m {
+            let hb = &hbj[j * nn..(j + 1) * nn];
+            for r in 0..n {
+                for c in 0..n {
+                    let zc = &z[c * mn + j * n..c * mn + (j + 1) * n];
+                    let t: f64 = (0..n).map(|q| hb[q * n + r] * zc[q]).sum();
+                    gamma[r * n + c] += t;
+                }
+            }
+        }
+        true
     }
 
     /// −J⁻¹F for a scaled residual F, in the unknowns' layout.
     fn newton_correction(&self, lin: &Linearization, f: &[f64]) -> Vec<f64> {
         let (n, m, p, k) = (self.n, self.tab.m, self.p, self.intervals());
-        let mut rhs = vec![0.0; p + n * k];
-        let mut vs = Vec::with_capacity(k);
-        for (i, blk) in lin.blocks.iter().enumerate() {
+        let (mn, nn) = (m * n, n * n);
+        let mut dx = vec![0.0; self.size()];
+        let (head, stages) = dx.split_at_mut(p + n * k);
+        for i in 0..k {
             let base = i * (m + 1) * n;
-            let g = DVector::from_fn(m * n, |r, _| -f[base + r] / self.w[r % n]);
-            let v = blk.lu.solve(&g).unwrap_or_else(|| g.map(|_| f64::NAN));
+            let v = &mut stages[i * mn..(i + 1) * mn];
+            v.iter_mut()
+                .enumerate()
+                .for_each(|(r, a)| *a = -f[base + r] / self.w[r % n]);
+            dense_solve(
+                &lin.lu[i * mn * mn..(i + 1) * mn * mn],
+                mn,
+                &lin.piv[i * mn..(i + 1) * mn],
+                v,
+            );
+            let hbj = &lin.hbj[i * m * nn..(i + 1) * m * nn];
             for r in 0..n {
-                let mut acc = -f[base + m * n + r] / self.w[r];
-                for (j, hb) in blk.hbj.iter().enumerate() {
-                    acc += (hb.row(r) * v.rows(j * n, n))[0];
+                let mut acc = -f[base + mn + r] / self.w[r];
+                for j in 0..m {
+                    let hb = &hbj[j * nn..(j + 1) * nn];
+                    let vj = &v[j * n..(j + 1) * n];
+                    acc += (0..n).map(|q| hb[q * n + r] * vj[q]).sum::<f64>();
                 }
-                rhs[n * i + r] = acc * self.w[r];
+                head[n * i + r] = acc * self.w[r];
             }
-            vs.push(v);
         }
         for q in 0..p {
-            rhs[n * k + q] = -f[k * (m + 1) * n + q];
+            head[n * k + q] = -f[k * (m + 1) * n + q];
         }
-        lin.band.solve(&mut rhs);
-        let mut dx = rhs.clone();
-        for (i, (blk, v)) in lin.blocks.iter().zip(vs).enumerate() {
+        lin.band.solve(head);
+        let mut dy0 = vec![0.0; n];
+        for (r, d) in dy0.iter_mut().enumerate() {
+            *d = (0..p).map(|c| self.sens[(r, c)] * head[c]).sum();
+        }
+        for i in 0..k {
             let dyi = if i == 0 {
-                &self.sens * DVector::from_column_slice(&rhs[..p])
+                &dy0[..]
             } else {
-                DVector::from_column_slice(&rhs[p + n * (i - 1)..p + n * i])
+                &head[p + n * (i - 1)..p + n * i]
             };
-            dx.extend((v + &blk.z * dyi).iter());
+            let z = &lin.z[i * mn * n..(i + 1) * mn * n];
+            let v = &mut stages[i * mn..(i + 1) * mn];
+            for (r, a) in v.iter_mut().enumerate() {
+                let t: f64 = (0..n).map(|c| z[c * mn + r] * dyi[c]).sum();
+                *a += t;
+            }
         }
         dx
     }
@@ -763,8 +950,12 @@ impl<'a> Grid<'a> {
     /// stages, each component divided by its scale).
     fn step_norm(&self, dx: &[f64]) -> f64 {
         let (n, p) = (self.n, self.p);
-        let dy0 = &self.sens * DVector::from_column_slice(&dx[..p]);
-        let head: f64 = dy0.iter().zip(&self.w).map(|(d, w)| (d * w).powi(2)).sum();
+        let head: f64 = (0..n)
+            .map(|r| {
+                let d: f64 = (0..p).map(|c| self.sens[(r, c)] * dx[c]).sum();
+                (d * self.w[r]).powi(2)
+            })
+            .sum();
         let rest: f64 = dx[p..]
             .iter()
             .enumerate()
@@ -773,86 +964,151 @@ impl<'a> Grid<'a> {
         (head + rest).sqrt()
     }
 
-    /// One collocation step of width h from y at s, its stage equations
-    /// solved by Newton from `guess`; None if that fails.
-    fn local_step(&self, s: f64, h: f64, y: &[f64], guess: Vec<f64>) -> Option<Vec<f64>> {
+    /// One collocation step of width h from y at s: its stage equations
+    /// solved in `st` (holding the guess) by Newton, the end state into
+    /// `out`; false if that fails. The stage matrix is factored at the
+    /// guess and refreshed only while the iteration contracts slowly
+    /// (Θ > 1/4); `frozen`, a factored stage matrix of this width at nearby
+    /// stages, is used instead while it contracts fast. The iteration stops
+    /// once the remainder is below round-off (see the test below), at the
+    /// latest one correction after the first of at most 1e-13 (scaled).
+    #[allow(clippy::too_many_arguments)]
+    fn local_step(
+        &self,
+        s: f64,
+        h: f64,
+        y: &[f64],
+        st: &mut [f64],
+        out: &mut [f64],
+        ws: &mut Scratch,
+        frozen: Option<(&[f64], &[usize])>,
+    ) -> bool {
         let (n, m) = (self.n, self.tab.m);
-        let mut st = guess;
-        let rates = |st: &[f64]| -> Vec<f64> {
-            let mut f = vec![0.0; m * n];
-            for j in 0..m {
-                let r = j * n..(j + 1) * n;
-                self.eq
-                    .rhs(s + self.tab.c[j] * h, &st[r.clone()], &mut f[r]);
-            }
-            f
-        };
-        let mut small = false;
+        let mn = m * n;
+        let mut use_frozen = frozen.is_some();
+        let (mut factored, mut refresh) = (false, !use_frozen);
+        let (mut small, mut prev) = (false, f64::NAN);
         for _ in 0..30 {
-            let f = rates(&st);
-            let g = DVector::from_fn(m * n, |r, _| {
-                let (j, k) = (r / n, r % n);
-                let acc: f64 = (0..m).map(|l| self.tab.a(j, l) * f[l * n + k]).sum();
-                y[k] + h * acc - st[r]
-            });
-            let jacs: Vec<_> = (0..m)
-                .map(|j| self.jacobian(s + self.tab.c[j] * h, &st[j * n..(j + 1) * n]))
-                .collect();
-            let d = self.stage_matrix(h, &jacs).lu().solve(&g)?;
-            st.iter_mut().zip(d.iter()).for_each(|(a, b)| *a += b);
-            let size = d
-                .iter()
-                .enumerate()
-                .map(|(r, v)| (v * self.w[r % n]).abs())
-                .fold(0.0, f64::max);
-            if !size.is_finite() {
-                return None;
+            if refresh {
+                self.stage_jacobians(s, h, st, &mut ws.f, &mut ws.jac);
+                self.stage_matrix(h, &ws.jac, &mut ws.w);
+                if !dense_lu(&mut ws.w, mn, &mut ws.piv) {
+                    return false;
+                }
+                (factored, use_frozen) = (true, false);
+            } else {
+                self.stage_rates(s, h, st, &mut ws.f);
             }
-            if small {
+            for (r, (g, v)) in ws.g.iter_mut().zip(st.iter()).enumerate() {
+                let (j, k) = (r / n, r % n);
+                let acc: f64 = (0..m).map(|l| self.tab.a(j, l) * ws.f[l * n + k]).sum();
+                *g = y[k] + h * acc - v;
+            }
+            match frozen.filter(|_| use_frozen) {
+                Some((lu, piv)) => dense_solve(lu, mn, piv, &mut ws.g),
+                None => dense_solve(&ws.w, mn, &ws.piv, &mut ws.g),
+            }
+            st.iter_mut().zip(&ws.g).for_each(|(a, b)| *a += b);
+            let size =
+                ws.g.iter()
+                    .enumerate()
+                    .map(|(r, v)| (v * self.w[r % n]).abs())
+                    .fold(0.0, f64::max);
+            if !size.is_finite() {
+                return false;
+            }
+            let theta = size / prev;
+            // Converged: after the correction following one of at most
+            // 1e-13 (the rule of a plain Newton iteration), or as soon as
+            // the remainder is below round-off: Θ·‖δ‖ ≤ 1e-17 with a reliable
+            // Θ ≤ 1/4, or ‖δ‖ ≤ 1e-15 at the first correction of a matrix
+            // factored at (nearly) these stages.
+            if small || size <= 1e-15 || (theta <= 0.25 && theta * size <= 1e-17) {
                 break;
             }
             small = size <= 1e-13;
+            // Slow contraction: refactor at the current stages.
+            // (Θ is NaN after the first correction: refresh then only if
+            // nothing is factored yet.)
+            let slow = theta.is_nan() || theta > 0.25;
+            refresh = slow && !(prev.is_nan() && (factored || use_frozen));
+            prev = size;
         }
-        let f = rates(&st);
-        Some(
-            (0..n)
-                .map(|k| y[k] + h * (0..m).map(|j| self.tab.b[j] * f[j * n + k]).sum::<f64>())
-                .collect(),
-        )
+        self.stage_rates(s, h, st, &mut ws.f);
+        for k in 0..n {
+            out[k] = y[k] + h * (0..m).map(|j| self.tab.b[j] * ws.f[j * n + k]).sum::<f64>();
+        }
+        true
     }
 
     /// Local error of every interval by step doubling from the converged
     /// node state: one step of width h against two of h/2, the difference
-    /// scaled by 1/(1 − 2^{−2m}) (the local error is O(h^{2m+1})).
-    fn local_errors(&self, x: &[f64]) -> Vec<f64> {
-        let (n, m) = (self.n, self.tab.m);
-        let sol = self.solution_parts(x);
+    /// scaled by 1/(1 − 2^{−2m}) (the local error is O(h^{2m+1})). The
+    /// full step starts from the converged stages (with `lin`'s factored
+    /// stage matrices when given), the half steps from the collocation
+    /// polynomial.
+    fn local_errors(&self, x: &[f64], lin: Option<&Linearization>) -> Vec<f64> {
+        let (n, m, p) = (self.n, self.tab.m, self.p);
+        let mn = m * n;
         let factor = 1.0 / (1.0 - 0.5f64.powi(2 * m as i32));
+        let lin = lin.filter(|l| l.valid);
+        // Lagrange weights on the nodes (0, c_1 … c_m) at the stage points of
+        // the two half steps, t = c_j / 2 and 1/2 + c_j / 2.
+        let (nodes, _) = interpolation_nodes(m);
+        let nodes = &nodes[..=m];
+        let weights: Vec<f64> = [0.0, 0.5]
+            .iter()
+            .flat_map(|&a| {
+                self.tab
+                    .c
+                    .iter()
+                    .flat_map(move |&c| (0..=m).map(move |q| lagrange(nodes, q, a + 0.5 * c)))
+            })
+            .collect();
+        let guess = |half: usize, y: &[f64], stv: &[f64], g: &mut [f64]| {
+            for j in 0..m {
+                let wj = &weights[(half * m + j) * (m + 1)..(half * m + j + 1) * (m + 1)];
+                for k in 0..n {
+                    let mut acc = wj[0] * y[k];
+                    for q in 1..=m {
+                        acc += wj[q] * stv[(q - 1) * n + k];
+                    }
+                    g[j * n + k] = acc;
+                }
+            }
+        };
+        let mut ws = Scratch::new(n, m);
+        let mut y0 = vec![0.0; n];
+        self.eq.initial_state(&x[..p], &mut y0);
+        let (mut st, mut a, mut mid, mut b) =
+            (vec![0.0; mn], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
         (0..self.intervals())
             .map(|i| {
                 let (s, h) = self.span(i);
-                let y = &sol.states[i];
-                let guess = |a: f64, w: f64| -> Vec<f64> {
-                    self.tab
-                        .c
-                        .iter()
-                        .flat_map(|c| sol.interpolate(a + c * w))
-                        .collect()
-                };
-                let full = self.local_step(s, h, y, guess(s, h));
-                let half = self
-                    .local_step(s, 0.5 * h, y, guess(s, 0.5 * h))
-                    .and_then(|mid| {
-                        self.local_step(s + 0.5 * h, 0.5 * h, &mid, guess(s + 0.5 * h, 0.5 * h))
-                    });
-                match (full, half) {
-                    (Some(a), Some(b)) => {
-                        factor
-                            * (0..n)
-                                .map(|k| ((a[k] - b[k]) * self.w[k]).abs())
-                                .fold(0.0, f64::max)
-                    }
-                    _ => f64::INFINITY,
+                let y = self.node_ref(x, &y0, i);
+                let stv = self.stages(x, i);
+                st.copy_from_slice(stv);
+                let frozen = lin.map(|l| {
+                    (
+                        &l.lu[i * mn * mn..(i + 1) * mn * mn],
+                        &l.piv[i * mn..(i + 1) * mn],
+                    )
+                });
+                let full = self.local_step(s, h, y, &mut st, &mut a, &mut ws, frozen);
+                guess(0, y, stv, &mut st);
+                let mut half = self.local_step(s, 0.5 * h, y, &mut st, &mut mid, &mut ws, None);
+                if half {
+                    guess(1, y, stv, &mut st);
+                    half =
+                        self.local_step(s + 0.5 * h, 0.5 * h, &mid, &mut st, &mut b, &mut ws, None);
+                }
+                if full && half {
+                    factor
+                        * (0..n)
+                            .map(|k| ((a[k] - b[k]) * self.w[k]).abs())
+                            .fold(0.0, f64::max)
+                } else {
+                    f64::INFINITY
                 }
             })
             .collect()
@@ -908,21 +1164,21 @@ impl<'a> Grid<'a> {
     }
 }
 
-/// The condensed stage block of one interval.
-struct Condensed {
-    lu: LU<f64, Dyn, Dyn>,
-    /// W⁻¹E: the stage corrections' response to δy_i.
-    z: DMatrix<f64>,
-    /// h b_j J_j.
-    hbj: Vec<DMatrix<f64>>,
-    /// The interval's propagator δy_i ↦ δy_{i+1}.
-    gamma: DMatrix<f64>,
-}
-
-/// The factored Newton matrix.
+/// The factored Newton matrix: per interval the condensed stage block, in
+/// flat storage reused across Newton iterations.
 struct Linearization {
-    blocks: Vec<Condensed>,
+    /// LU factors of the stage matrices W (mn × mn each, row-major).
+    lu: Vec<f64>,
+    /// Their row interchanges.
+    piv: Vec<usize>,
+    /// W⁻¹E (mn × n each, column-major): the stage corrections' response
+    /// to δy_i.
+    z: Vec<f64>,
+    /// h b_j J_j (m blocks of n × n each, column-major).
+    hbj: Vec<f64>,
     band: BandLu,
+    /// Whether the last `linearize` succeeded.
+    valid: bool,
 }
 
 struct NewtonOutcome {
@@ -931,6 +1187,8 @@ struct NewtonOutcome {
     history: Vec<f64>,
     damped_steps: usize,
     contraction: f64,
+    /// The last successful factorization (at x or the iterate before).
+    lin: Option<Linearization>,
 }
 
 fn max_norm(r: &[f64]) -> f64 {
@@ -964,9 +1222,11 @@ fn damped_newton(
             history,
         ));
     }
+    let mut lin = grid.new_linearization();
+    let mut ws = Scratch::new(grid.n, grid.tab.m);
     for iteration in 0..=opts.max_iterations {
         if *history.last().unwrap() <= opts.tolerance {
-            let mut out = polish(grid, x, f, history);
+            let mut out = polish(grid, x, f, history, lin, &mut ws);
             out.damped_steps = damped_steps;
             out.contraction = contraction;
             return Ok(out);
@@ -979,9 +1239,9 @@ fn damped_newton(
             intervals,
             history,
         };
-        let Some(lin) = grid.linearize(&x) else {
+        if !grid.linearize(&x, &mut lin, &mut ws) {
             return Err(singular(history));
-        };
+        }
         let step = grid.newton_correction(&lin, &f);
         if step.iter().any(|v| !v.is_finite()) {
             return Err(singular(history));
@@ -1034,10 +1294,19 @@ const POLISH_STEPS: usize = 2;
 /// They cost O(N) each and leave a solution that satisfies the discrete
 /// equations to round-off, so that what remains (e.g. the director drift)
 /// is discretization error rather than Newton's stopping point.
-fn polish(grid: &Grid, mut x: Vec<f64>, mut f: Vec<f64>, mut history: Vec<f64>) -> NewtonOutcome {
+fn polish(
+    grid: &Grid,
+    mut x: Vec<f64>,
+    mut f: Vec<f64>,
+    mut history: Vec<f64>,
+    mut lin: Linearization,
+    ws: &mut Scratch,
+) -> NewtonOutcome {
     let iterations = history.len() - 1;
     for _ in 0..POLISH_STEPS {
-        let Some(lin) = grid.linearize(&x) else { break };
+        if !grid.linearize(&x, &mut lin, ws) {
+            break;
+        }
         let step = grid.newton_correction(&lin, &f);
         let trial: Vec<f64> = x.iter().zip(&step).map(|(a, b)| a + b).collect();
         let f_try = grid.residual(&trial);
@@ -1054,6 +1323,150 @@ fn polish(grid: &Grid, mut x: Vec<f64>, mut f: Vec<f64>, mut history: Vec<f64>) 
         history,
         damped_steps: 0,
         contraction: 0.0,
+        lin: lin.valid.then_some(lin),
+    }
+}
+
+/// In-place LU with row partial pivoting (as nalgebra's `LU`) of the d × d
+/// row-major matrix `a`, interchanges in `piv`; false at a zero or
+/// non-finite pivot. The stage sizes m·n of the planar (n = 4) and spatial
+/// (n = 12) models are compiled for their size.
+fn dense_lu(a: &mut [f64], d: usize, piv: &mut [usize]) -> bool {
+    match d {
+        4 => lu_sized::<4>(a, piv),
+        8 => lu_sized::<8>(a, piv),
+        12 => lu_sized::<12>(a, piv),
+        24 => lu_sized::<24>(a, piv),
+        36 => lu_sized::<36>(a, piv),
+        _ => lu_any(a, d, piv),
+    }
+}
+
+/// Solves A x = b in place with the factors of [`dense_lu`].
+fn dense_solve(a: &[f64], d: usize, piv: &[usize], b: &mut [f64]) {
+    match d {
+        4 => solve_sized::<4>(a, piv, b),
+        8 => solve_sized::<8>(a, piv, b),
+        12 => solve_sized::<12>(a, piv, b),
+        24 => solve_sized::<24>(a, piv, b),
+        36 => solve_sized::<36>(a, piv, b),
+        _ => solve_any(a, d, piv, b),
+    }
+}
+
+/// [`dense_lu`] for a dimension known at compile time (unrolled loops).
+fn lu_sized<const D: usize>(a: &mut [f64], piv: &mut [usize]) -> bool {
+    let (d, a, piv) = (D, &mut a[..D * D], &mut piv[..D]);
+    for k in 0..d {
+        let (mut p, mut best) = (k, a[k * d + k].abs());
+        for i in k + 1..d {
+            let v = a[i * d + k].abs();
+            if v > best {
+                (p, best) = (i, v);
+            }
+        }
+        piv[k] = p;
+        if best == 0.0 || !best.is_finite() {
+            return false;
+        }
+        if p != k {
+            for c in 0..d {
+                a.swap(k * d + c, p * d + c);
+            }
+        }
+        let (upper, lower) = a.split_at_mut((k + 1) * d);
+        let row_k = &upper[k * d..];
+        let pivot = row_k[k];
+        for row in lower.chunks_exact_mut(d) {
+            let l = row[k] / pivot;
+            row[k] = l;
+            if l != 0.0 {
+                row[k + 1..]
+                    .iter_mut()
+                    .zip(&row_k[k + 1..])
+                    .for_each(|(v, u)| *v -= l * u);
+            }
+        }
+    }
+    true
+}
+
+/// [`dense_solve`] for a dimension known at compile time.
+fn solve_sized<const D: usize>(a: &[f64], piv: &[usize], b: &mut [f64]) {
+    let (d, a, piv, b) = (D, &a[..D * D], &piv[..D], &mut b[..D]);
+    for (k, &p) in piv.iter().enumerate() {
+        b.swap(k, p);
+    }
+    for i in 1..d {
+        let row = &a[i * d..i * d + i];
+        let acc: f64 = row.iter().zip(&b[..i]).map(|(l, v)| l * v).sum();
+        b[i] -= acc;
+    }
+    for i in (0..d).rev() {
+        let row = &a[i * d..(i + 1) * d];
+        let acc: f64 = row[i + 1..]
+            .iter()
+            .zip(&b[i + 1..])
+            .map(|(u, v)| u * v)
+            .sum();
+        b[i] = (b[i] - acc) / row[i];
+    }
+}
+
+/// [`dense_lu`] for any dimension.
+fn lu_any(a: &mut [f64], d: usize, piv: &mut [usize]) -> bool {
+    for k in 0..d {
+        let (mut p, mut best) = (k, a[k * d + k].abs());
+        for i in k + 1..d {
+            let v = a[i * d + k].abs();
+            if v > best {
+                (p, best) = (i, v);
+            }
+        }
+        piv[k] = p;
+        if best == 0.0 || !best.is_finite() {
+            return false;
+        }
+        if p != k {
+            for c in 0..d {
+                a.swap(k * d + c, p * d + c);
+            }
+        }
+        let (upper, lower) = a.split_at_mut((k + 1) * d);
+        let row_k = &upper[k * d..];
+        let pivot = row_k[k];
+        for row in lower.chunks_exact_mut(d) {
+            let l = row[k] / pivot;
+            row[k] = l;
+            if l != 0.0 {
+                row[k + 1..]
+                    .iter_mut()
+                    .zip(&row_k[k + 1..])
+                    .for_each(|(v, u)| *v -= l * u);
+            }
+        }
+    }
+    true
+}
+
+/// [`dense_solve`] for any dimension.
+fn solve_any(a: &[f64], d: usize, piv: &[usize], b: &mut [f64]) {
+    for (k, &p) in piv.iter().enumerate() {
+        b.swap(k, p);
+    }
+    for i in 1..d {
+        let row = &a[i * d..i * d + i];
+        let acc: f64 = row.iter().zip(&b[..i]).map(|(l, v)| l * v).sum();
+        b[i] -= acc;
+    }
+    for i in (0..d).rev() {
+        let row = &a[i * d..(i + 1) * d];
+        let acc: f64 = row[i + 1..]
+            .iter()
+            .zip(&b[i + 1..])
+            .map(|(u, v)| u * v)
+            .sum();
+        b[i] = (b[i] - acc) / row[i];
     }
 }
 
@@ -1090,6 +1503,11 @@ impl BandLu {
             "({i}, {j}) outside the band"
         );
         j * self.ld + self.kl + self.ku + i - j
+    }
+
+    /// Zeros the matrix for a new factorization.
+    fn clear(&mut self) {
+        self.data.fill(0.0);
     }
 
     fn add(&mut self, i: usize, j: usize, v: f64) {
@@ -1204,6 +1622,35 @@ mod tests {
             .map(|(a, b)| (a - b).abs())
             .fold(0.0, f64::max);
         assert!(err < 1e-10, "{err}");
+    }
+
+    /// The dense LU (compiled sizes and the general one) against nalgebra's.
+    #[test]
+    fn dense_lu_matches_nalgebra() {
+        let mut seed = 987u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        };
+        for d in [7, 12, 36] {
+            let a: Vec<f64> = (0..d * d).map(|_| rnd()).collect();
+            let b: Vec<f64> = (0..d).map(|_| rnd()).collect();
+            let exact = DMatrix::from_row_slice(d, d, &a)
+                .lu()
+                .solve(&DVector::from_column_slice(&b))
+                .unwrap();
+            let (mut f, mut piv, mut x) = (a.clone(), vec![0; d], b.clone());
+            assert!(dense_lu(&mut f, d, &mut piv));
+            dense_solve(&f, d, &piv, &mut x);
+            let err = x
+                .iter()
+                .zip(exact.iter())
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            assert!(err < 1e-10, "d {d}: {err}");
+        }
     }
 
     /// The tableau integrates polynomials of degree ≤ m − 1 exactly on
