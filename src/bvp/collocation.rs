@@ -1356,64 +1356,17 @@ fn dense_solve(a: &[f64], d: usize, piv: &[usize], b: &mut [f64]) {
 
 /// [`dense_lu`] for a dimension known at compile time (unrolled loops).
 fn lu_sized<const D: usize>(a: &mut [f64], piv: &mut [usize]) -> bool {
-    let (d, a, piv) = (D, &mut a[..D * D], &mut piv[..D]);
-    for k in 0..d {
-        let (mut p, mut best) = (k, a[k * d + k].abs());
-        for i in k + 1..d {
-            let v = a[i * d + k].abs();
-            if v > best {
-                (p, best) = (i, v);
-            }
-        }
-        piv[k] = p;
-        if best == 0.0 || !best.is_finite() {
-            return false;
-        }
-        if p != k {
-            for c in 0..d {
-                a.swap(k * d + c, p * d + c);
-            }
-        }
-        let (upper, lower) = a.split_at_mut((k + 1) * d);
-        let row_k = &upper[k * d..];
-        let pivot = row_k[k];
-        for row in lower.chunks_exact_mut(d) {
-            let l = row[k] / pivot;
-            row[k] = l;
-            if l != 0.0 {
-                row[k + 1..]
-                    .iter_mut()
-                    .zip(&row_k[k + 1..])
-                    .for_each(|(v, u)| *v -= l * u);
-            }
-        }
-    }
-    true
+    // Inlined with a constant dimension, so the loops unroll.
+    lu_any(&mut a[..D * D], D, &mut piv[..D])
 }
 
 /// [`dense_solve`] for a dimension known at compile time.
 fn solve_sized<const D: usize>(a: &[f64], piv: &[usize], b: &mut [f64]) {
-    let (d, a, piv, b) = (D, &a[..D * D], &piv[..D], &mut b[..D]);
-    for (k, &p) in piv.iter().enumerate() {
-        b.swap(k, p);
-    }
-    for i in 1..d {
-        let row = &a[i * d..i * d + i];
-        let acc: f64 = row.iter().zip(&b[..i]).map(|(l, v)| l * v).sum();
-        b[i] -= acc;
-    }
-    for i in (0..d).rev() {
-        let row = &a[i * d..(i + 1) * d];
-        let acc: f64 = row[i + 1..]
-            .iter()
-            .zip(&b[i + 1..])
-            .map(|(u, v)| u * v)
-            .sum();
-        b[i] = (b[i] - acc) / row[i];
-    }
+    solve_any(&a[..D * D], D, &piv[..D], &mut b[..D])
 }
 
 /// [`dense_lu`] for any dimension.
+#[inline(always)]
 fn lu_any(a: &mut [f64], d: usize, piv: &mut [usize]) -> bool {
     for k in 0..d {
         let (mut p, mut best) = (k, a[k * d + k].abs());
@@ -1450,6 +1403,7 @@ fn lu_any(a: &mut [f64], d: usize, piv: &mut [usize]) -> bool {
 }
 
 /// [`dense_solve`] for any dimension.
+#[inline(always)]
 fn solve_any(a: &[f64], d: usize, piv: &[usize], b: &mut [f64]) {
     for (k, &p) in piv.iter().enumerate() {
         b.swap(k, p);

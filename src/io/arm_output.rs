@@ -7,20 +7,11 @@
 
 use std::path::Path;
 
-use hdf5::types::VarLenUnicode;
-
-use super::hdf5_output::{write_atomically, OutputError};
+use super::hdf5_output::{array, string_attr, write_atomically, OutputError};
 use crate::optimize::{ArmOptimum, StraightArm};
 
 fn scalar(g: &hdf5::Group, name: &str, v: f64) -> hdf5::Result<()> {
     g.new_dataset::<f64>().create(name)?.write_scalar(&v)
-}
-
-fn vector(g: &hdf5::Group, name: &str, v: &[f64]) -> hdf5::Result<()> {
-    g.new_dataset::<f64>()
-        .shape([v.len()])
-        .create(name)?
-        .write_raw(v)
 }
 
 fn points(g: &hdf5::Group, name: &str, v: &[[f64; 3]]) -> hdf5::Result<()> {
@@ -40,24 +31,26 @@ pub fn write_arm(
     force: bool,
 ) -> Result<(), OutputError> {
     write_atomically(path, force, |file| {
-        let text: VarLenUnicode = problem
-            .parse()
-            .map_err(|e: hdf5::types::StringError| hdf5::Error::from(e.to_string().as_str()))?;
-        file.new_attr::<VarLenUnicode>()
-            .create("problem")?
-            .write_scalar(&text)?;
+        string_attr(file, "problem", problem)?;
         let g = file.create_group("optimum")?;
         scalar(&g, "reach", optimum.design.reach)?;
         scalar(&g, "gamma_crit", optimum.design.gamma)?;
-        vector(&g, "shape_coefficients", &optimum.design.shape_coefficients)?;
-        vector(
+        array(
             &g,
-            "curvature_coefficients",
-            &optimum.curvature_coefficients,
+            "shape_coefficients",
+            &[optimum.design.shape_coefficients.len()],
+            &optimum.design.shape_coefficients,
         )?;
+        let b = &optimum.curvature_coefficients;
+        array(&g, "curvature_coefficients", &[b.len()], b)?;
         points(&g, "loaded_shape", &optimum.loaded_shape)?;
         points(&g, "unloaded_shape", &optimum.unloaded_shape)?;
-        vector(&g, "intrinsic_curvature", &optimum.intrinsic_curvature)?;
+        array(
+            &g,
+            "intrinsic_curvature",
+            &[optimum.intrinsic_curvature.len()],
+            &optimum.intrinsic_curvature,
+        )?;
         g.new_attr::<u64>()
             .create("evaluations")?
             .write_scalar(&(optimum.evaluations as u64))?;

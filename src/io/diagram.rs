@@ -13,27 +13,8 @@ use std::path::Path;
 
 use hdf5::types::VarLenUnicode;
 
-use super::hdf5_output::{write_atomically, OutputError};
+use super::hdf5_output::{array, string_attr, text, write_atomically, OutputError};
 use crate::continuation::Diagram;
-
-fn text(s: &str) -> hdf5::Result<VarLenUnicode> {
-    s.parse::<VarLenUnicode>()
-        .map_err(|e| hdf5::Error::from(e.to_string().as_str()))
-}
-
-fn string_attr(loc: &hdf5::Location, name: &str, value: &str) -> hdf5::Result<()> {
-    loc.new_attr::<VarLenUnicode>()
-        .create(name)?
-        .write_scalar(&text(value)?)
-}
-
-fn array(group: &hdf5::Group, name: &str, shape: &[usize], data: &[f64]) -> hdf5::Result<()> {
-    group
-        .new_dataset::<f64>()
-        .shape(shape)
-        .create(name)?
-        .write_raw(data)
-}
 
 fn integers(group: &hdf5::Group, name: &str, data: &[u64]) -> hdf5::Result<()> {
     group

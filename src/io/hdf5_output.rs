@@ -125,12 +125,12 @@ fn temporary_path(path: &Path) -> PathBuf {
     path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
 }
 
-fn text(s: &str) -> hdf5::Result<VarLenUnicode> {
+pub(crate) fn text(s: &str) -> hdf5::Result<VarLenUnicode> {
     s.parse::<VarLenUnicode>()
         .map_err(|e| hdf5::Error::from(e.to_string().as_str()))
 }
 
-fn string_attr(loc: &hdf5::Location, name: &str, value: &str) -> hdf5::Result<()> {
+pub(crate) fn string_attr(loc: &hdf5::Location, name: &str, value: &str) -> hdf5::Result<()> {
     loc.new_attr::<VarLenUnicode>()
         .create(name)?
         .write_scalar(&text(value)?)
@@ -172,7 +172,12 @@ fn root_attributes(file: &hdf5::File, problem: &str) -> hdf5::Result<()> {
     )
 }
 
-fn array(group: &hdf5::Group, name: &str, shape: &[usize], data: &[f64]) -> hdf5::Result<()> {
+pub(crate) fn array(
+    group: &hdf5::Group,
+    name: &str,
+    shape: &[usize],
+    data: &[f64],
+) -> hdf5::Result<()> {
     group
         .new_dataset::<f64>()
         .shape(shape)
