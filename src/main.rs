@@ -84,6 +84,10 @@ enum Command {
         /// Write the optimum to this HDF5 file.
         #[arg(short, long)]
         output: Option<PathBuf>,
+        /// Also continue the designed arm in its load from unloaded to the
+        /// design load and write that diagram (HDF5, with a PNG beside it).
+        #[arg(long)]
+        loading_path: Option<PathBuf>,
         /// Override any key of the problem file.
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
@@ -142,9 +146,10 @@ fn main() -> ExitCode {
         Command::Optimize {
             problem,
             output,
+            loading_path,
             set,
             force,
-        } => optimize_command::run_optimize(problem, output, &set, force),
+        } => optimize_command::run_optimize(problem, output, loading_path, &set, force),
         Command::Plot {
             diagram,
             output,

@@ -12,6 +12,7 @@ use crate::fail;
 pub fn run_optimize(
     path: PathBuf,
     output: Option<PathBuf>,
+    loading_path: Option<PathBuf>,
     set: &[String],
     force: bool,
 ) -> ExitCode {
@@ -25,7 +26,7 @@ pub fn run_optimize(
             format!("{}: arm: the problem has no [arm] table", path.display()),
         );
     };
-    if let Some(out) = &output {
+    for out in output.iter().chain(&loading_path) {
         if let Err(e) = check_target(out, force) {
             return fail(2, e);
         }
@@ -91,5 +92,66 @@ pub fn run_optimize(
         }
         println!("written   {}", out.display());
     }
+    if let Some(out) = loading_path {
+        return write_loading_path(&problem, arm, &opt, &out, force);
+    }
+    ExitCode::SUCCESS
+}
+
+/// Continues the designed arm in its load from unloaded to the design load
+/// and writes the diagram (and a chart next to it).
+fn write_loading_path(
+    problem: &Problem,
+    arm: &cosserat::optimize::ArmProblem,
+    opt: &cosserat::optimize::ArmOptimum,
+    out: &std::path::Path,
+    force: bool,
+) -> ExitCode {
+    let t = Instant::now();
+    let diagram = match cosserat::optimize::loading_path(arm, &opt.design, 2001) {
+        Ok(d) => d,
+        Err(e) => return fail(2, format!("loading path: {e}")),
+    };
+    let Some(last) = diagram.branches.first().and_then(|b| b.points.last()) else {
+        return fail(2, "loading path: no point");
+    };
+    let designed = opt
+        .loaded_shape
+        .last()
+        .map(|r| r.map(|v| v / opt.design.gamma.sqrt()));
+    let miss = designed.map_or(f64::NAN, |d| {
+        ((last.tip.position[0] - d[0]).powi(2) + (last.tip.position[2] - d[2]).powi(2)).sqrt()
+    });
+    println!(
+        "loading   λ = {:.4}: tip ({:+.4}, {:+.4}), {} from the design tip, Morse index {} ({:.1} s)",
+        last.parameter,
+        last.tip.position[0],
+        last.tip.position[2],
+        format_args!("{miss:.2e}"),
+        last.morse_index,
+        t.elapsed().as_secs_f64()
+    );
+    for s in &diagram.special_points {
+        println!(
+            "          {} at λ = {:.6} ({} block)",
+            s.kind.name(),
+            s.point.parameter,
+            s.block.name()
+        );
+    }
+    if let Err(e) = cosserat::io::write_diagram(
+        out,
+        &problem.text,
+        "load factor λ (× γ_crit)",
+        &diagram,
+        force,
+    ) {
+        return fail(1, e);
+    }
+    let chart = out.with_extension("png");
+    if let Err(e) = crate::continue_command::plot_file(out, "tip_z", &chart) {
+        return fail(1, e);
+    }
+    println!("written   {}", out.display());
     ExitCode::SUCCESS
 }

@@ -72,3 +72,35 @@ fn curvature_beats_the_straight_arm() {
     );
     assert!(s.reach < 1.815, "R0 = {}", s.reach);
 }
+
+/// The loading path of the circular Fig. 5 arm: continued in its load from
+/// nearly unloaded with the design's intrinsic curvature and clamp angle,
+/// it must arrive at the designed shape at the design load (the design is
+/// an exact equilibrium there), and the design load must be marginal (the
+/// lowest eigenvalue vanishes: λ = 1 is γ_crit of the shape).
+#[test]
+fn circular_arm_loading_path_arrives_at_the_design() {
+    let p = problem(1.0, 2.0 / 3.0, vec![(-4.0, 4.0), (-2.0, 2.0), (-0.5, 0.5)]);
+    let o = p.optimize(&SearchOptions::default()).unwrap();
+    let d = cosserat::optimize::loading_path(&p, &o.design, 2001).unwrap();
+    let last = d.branches[0].points.last().unwrap();
+    assert_eq!(last.parameter, 1.0);
+    let designed = o
+        .loaded_shape
+        .last()
+        .unwrap()
+        .map(|v| v / o.design.gamma.sqrt());
+    let miss = ((last.tip.position[0] - designed[0]).powi(2)
+        + (last.tip.position[2] - designed[2]).powi(2))
+    .sqrt();
+    assert!(miss < 1e-8, "tip misses the design by {miss}");
+    let lowest = last
+        .eigenvalues
+        .iter()
+        .fold(f64::INFINITY, |a, b| a.min(b.abs()));
+    assert!(
+        lowest < 1e-4,
+        "the design load is not marginal: {:?}",
+        last.eigenvalues
+    );
+}

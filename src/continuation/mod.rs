@@ -453,6 +453,9 @@ impl<'a> Run<'a> {
         if point.parameter < lo || point.parameter > hi {
             return Some(format!("parameter {} left [{lo}, {hi}]", point.parameter));
         }
+        if count > 1 && (point.parameter == lo || point.parameter == hi) {
+            return Some(format!("reached the bound {}", point.parameter));
+        }
         if count >= self.opts.max_points {
             return Some(format!("{count} points"));
         }
@@ -464,6 +467,40 @@ impl<'a> Run<'a> {
             }
         }
         None
+    }
+
+    /// A step that leaves [min, max] is pulled back onto the bound it
+    /// crossed (Newton at fixed p from the linear interpolant), so that a
+    /// branch ends exactly at its bound — e.g. at the design load.
+    fn land_on_bound(
+        &self,
+        last: &Point,
+        x: Vec<f64>,
+        p: f64,
+        tangent: Vec<f64>,
+    ) -> (Vec<f64>, f64, Vec<f64>) {
+        let (lo, hi) = self.opts.bounds;
+        let bound = if p > hi && last.parameter <= hi {
+            hi
+        } else if p < lo && last.parameter >= lo {
+            lo
+        } else {
+            return (x, p, tangent);
+        };
+        let t = (bound - last.parameter) / (p - last.parameter);
+        let guess: Vec<f64> = last
+            .unknowns
+            .iter()
+            .zip(&x)
+            .map(|(a, b)| a + t * (b - a))
+            .collect();
+        match self.newton_at_fixed_p(guess, bound) {
+            Ok(xb) => match self.tangent(&xb, bound, &tangent) {
+                Ok(tb) => (xb, bound, tb),
+                Err(_) => (x, p, tangent),
+            },
+            Err(_) => (x, p, tangent),
+        }
     }
 
     /// Follows one branch from `start` in direction `sign`, appending its
@@ -514,6 +551,7 @@ impl<'a> Run<'a> {
                 }
                 Err(e) => return end(specials, format!("stopped: {e}"), false),
             };
+            let (x, p, tangent) = self.land_on_bound(&last, x, p, tangent);
             let next = match self.point(x, p, tangent) {
                 Ok(pt) => pt,
                 Err(e) => return end(specials, format!("stopped: {e}"), false),

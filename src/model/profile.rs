@@ -16,6 +16,14 @@ pub enum Profile {
     /// Piecewise-linear interpolation of (s_k, v_k), s strictly increasing;
     /// held constant outside the table.
     Table { s: Vec<f64>, values: Vec<f64> },
+    /// The natural cubic spline through (s_k, v_k) (C², so that equations
+    /// using the derivative stay continuous); build with [`Profile::spline`].
+    Spline {
+        s: Vec<f64>,
+        values: Vec<f64>,
+        /// Second derivatives at the knots.
+        curvature: Vec<f64>,
+    },
 }
 
 impl Default for Profile {
@@ -25,6 +33,42 @@ impl Default for Profile {
 }
 
 impl Profile {
+    /// The natural cubic spline through (s_k, v_k), s strictly increasing,
+    /// at least two knots (second derivatives from the tridiagonal system
+    /// with zero end curvature; de Boor, *A Practical Guide to Splines*,
+    /// ch. IV).
+    pub fn spline(s: Vec<f64>, values: Vec<f64>) -> Profile {
+        let n = s.len();
+        let mut curvature = vec![0.0; n];
+        if n > 2 {
+            let (mut diag, mut rhs) = (vec![0.0; n], vec![0.0; n]);
+            for i in 1..n - 1 {
+                let (h0, h1) = (s[i] - s[i - 1], s[i + 1] - s[i]);
+                diag[i] = (h0 + h1) / 3.0;
+                rhs[i] = (values[i + 1] - values[i]) / h1 - (values[i] - values[i - 1]) / h0;
+            }
+            // Thomas algorithm on rows 1..n−2 (off-diagonals h/6).
+            for i in 2..n - 1 {
+                let w = (s[i] - s[i - 1]) / 6.0 / diag[i - 1];
+                diag[i] -= w * (s[i] - s[i - 1]) / 6.0;
+                rhs[i] -= w * rhs[i - 1];
+            }
+            for i in (1..n - 1).rev() {
+                let upper = if i + 1 < n - 1 {
+                    (s[i + 1] - s[i]) / 6.0 * curvature[i + 1]
+                } else {
+                    0.0
+                };
+                curvature[i] = (rhs[i] - upper) / diag[i];
+            }
+        }
+        Profile::Spline {
+            s,
+            values,
+            curvature,
+        }
+    }
+
     /// The value at s.
     pub fn value(&self, s: f64) -> f64 {
         match self {
@@ -33,6 +77,19 @@ impl Profile {
             Profile::Table { s: knots, values } => {
                 let (k, t) = locate(knots, s);
                 values[k] + t * (values[k + 1] - values[k])
+            }
+            Profile::Spline {
+                s: knots,
+                values,
+                curvature,
+            } => {
+                let (k, t) = locate(knots, s);
+                let h = knots[k + 1] - knots[k];
+                let (a, b) = (1.0 - t, t);
+                a * values[k]
+                    + b * values[k + 1]
+                    + h * h / 6.0
+                        * ((a * a * a - a) * curvature[k] + (b * b * b - b) * curvature[k + 1])
             }
         }
     }
@@ -54,6 +111,19 @@ impl Profile {
                 let (k, _) = locate(knots, s);
                 (values[k + 1] - values[k]) / (knots[k + 1] - knots[k])
             }
+            Profile::Spline {
+                s: knots,
+                values,
+                curvature,
+            } => {
+                let (k, t) = locate(knots, s);
+                let h = knots[k + 1] - knots[k];
+                let (a, b) = (1.0 - t, t);
+                (values[k + 1] - values[k]) / h
+                    + h / 6.0
+                        * (-(3.0 * a * a - 1.0) * curvature[k]
+                            + (3.0 * b * b - 1.0) * curvature[k + 1])
+            }
         }
     }
 
@@ -62,7 +132,9 @@ impl Profile {
         match self {
             Profile::Constant(c) => *c == 0.0,
             Profile::Polynomial(c) => c.iter().all(|&x| x == 0.0),
-            Profile::Table { values, .. } => values.iter().all(|&x| x == 0.0),
+            Profile::Table { values, .. } | Profile::Spline { values, .. } => {
+                values.iter().all(|&x| x == 0.0)
+            }
         }
     }
 
@@ -81,7 +153,7 @@ impl Profile {
                 }
                 m
             }
-            Profile::Polynomial(_) => (0..=1000)
+            Profile::Polynomial(_) | Profile::Spline { .. } => (0..=1000)
                 .map(|i| self.value(length * i as f64 / 1000.0))
                 .fold(f64::INFINITY, f64::min),
         }
@@ -93,6 +165,15 @@ impl Profile {
             Profile::Constant(c) => c.is_finite(),
             Profile::Polynomial(c) => c.iter().all(|x| x.is_finite()),
             Profile::Table { s, values } => s.iter().chain(values).all(|x| x.is_finite()),
+            Profile::Spline {
+                s,
+                values,
+                curvature,
+            } => s
+                .iter()
+                .chain(values)
+                .chain(curvature)
+                .all(|x| x.is_finite()),
         }
     }
 }
@@ -123,6 +204,22 @@ mod tests {
         let p = Profile::Polynomial(vec![1.0, -2.0, 3.0]);
         assert_eq!(p.value(2.0), 1.0 - 4.0 + 12.0);
         assert_eq!(p.derivative(2.0), -2.0 + 12.0);
+    }
+
+    /// A natural spline reproduces a cubic's interior values to the order
+    /// of its end conditions and its derivative matches differences.
+    #[test]
+    fn spline_interpolates_smoothly() {
+        let f = |x: f64| (2.0 * x).sin();
+        let s: Vec<f64> = (0..=200).map(|i| i as f64 / 200.0).collect();
+        let p = Profile::spline(s.clone(), s.iter().map(|&x| f(x)).collect());
+        for x in [0.3, 0.5123, 0.77] {
+            assert!((p.value(x) - f(x)).abs() < 1e-7, "{x}");
+            let h = 1e-6;
+            let fd = (p.value(x + h) - p.value(x - h)) / (2.0 * h);
+            assert!((p.derivative(x) - fd).abs() < 1e-6);
+            assert!((p.derivative(x) - 2.0 * (2.0 * x).cos()).abs() < 1e-5);
+        }
     }
 
     #[test]

@@ -455,3 +455,71 @@ impl ArmProblem {
         })
     }
 }
+
+/// The loading path of a designed arm (paper Sec. 5 warns that loading need
+/// not reach the design): the rod with the design's intrinsic curvature
+/// (κ̄⁰2 as a natural cubic spline through `points` nodes, exact at the
+/// nodes) and clamp angle
+/// c1, continued in the load factor λ from nearly unloaded to λ = 1 (the
+/// design load γ_crit) with the Hessian tracked.
+pub fn loading_path(
+    problem: &ArmProblem,
+    design: &ArmDesign,
+    points: usize,
+) -> Result<crate::continuation::Diagram, crate::continuation::ContinuationError> {
+    use crate::continuation::{continuation, ContinuationOptions, Family, Parameter};
+    let rod0 = problem.rod();
+    let shape = FixedShape {
+        turning_angle: Profile::Polynomial(design.shape_coefficients.clone()),
+    };
+    let s: Vec<f64> = (0..points)
+        .map(|i| i as f64 / (points - 1) as f64)
+        .collect();
+    let c = &design.shape_coefficients;
+    let dphi: Vec<f64> = c
+        .iter()
+        .enumerate()
+        .skip(1)
+        .map(|(i, ci)| i as f64 * ci)
+        .collect();
+    let kappa0: Vec<f64> = shape
+        .samples(&rod0, &s)
+        .iter()
+        .map(|p| polynomial(&dphi, p.s) - design.gamma * p.moment[1])
+        .collect();
+    let mut rod = rod0.clone();
+    rod.energy = Arc::new(LinearElastic {
+        stiffness: [problem.b1, 1.0, problem.b3].map(Profile::Constant),
+        intrinsic_curvature: [
+            Profile::Constant(0.0),
+            Profile::spline(s, kappa0),
+            Profile::Constant(0.0),
+        ],
+    });
+    // The clamp turned by c1 (d3 towards d1), the design's tangent at s = 0.
+    let axis = nalgebra::Unit::new_normalize(rod.clamp.director(1));
+    rod.clamp.frame = nalgebra::Rotation3::from_axis_angle(&axis, c[0]).matrix() * rod.clamp.frame;
+    rod.loads = rod.loads.scaled(design.gamma);
+    let family = Family::new(
+        rod,
+        Parameter::LoadScale,
+        crate::model::ModelLevel::Planar,
+        32,
+        crate::bvp::integrator::Tolerances::default(),
+    );
+    let opts = ContinuationOptions {
+        start: 1e-3,
+        bounds: (0.0, 1.0),
+        step: 0.02,
+        max_step: 0.05,
+        switch_depth: 0,
+        max_points: 4000,
+        // The design's own discretization, so that λ = 1 is its γ_crit.
+        stability: StabilityOptions {
+            eigenvalues: 2,
+            ..problem.stability
+        },
+        ..Default::default()
+    };
+    continuation(&family, &opts, &mut |_, _| true)
+}
