@@ -267,9 +267,9 @@ pub fn load_case(path: &Path) -> Result<Case, InputError> {
     let text = std::fs::read_to_string(path).map_err(|e| bad(e.to_string()))?;
     let file: CaseFile = toml::from_str(&text).map_err(|e| bad(e.to_string()))?;
     let analysis = file.analysis.as_str();
-    if !["solve", "critical-load", "jacobian-singularity"].contains(&analysis) {
+    if !["solve", "critical-load", "jacobian-singularity", "optimize"].contains(&analysis) {
         return Err(bad(format!(
-            "analysis `{analysis}`: expected solve, critical-load or jacobian-singularity"
+            "analysis `{analysis}`: expected solve, critical-load, jacobian-singularity or optimize"
         )));
     }
     if analysis == "jacobian-singularity" {
@@ -298,6 +298,7 @@ pub fn load_case(path: &Path) -> Result<Case, InputError> {
         let known = match analysis {
             "solve" => &["tip_x", "tip_y", "tip_z", "tip_angle", "tip_chord"][..],
             "critical-load" => &["critical_load", "chi"][..],
+            "optimize" => &["reach", "straight_reach"][..],
             _ => &["branch_point"][..],
         };
         if !known.contains(&c.quantity.as_str()) {
@@ -513,6 +514,37 @@ fn run_analysis(
                     ),
                 }),
                 Err(e) => Err(e.to_string()),
+            }
+        }
+        "optimize" => {
+            let Some((arm, search, straight)) = &problem.arm else {
+                return Err(InputError(format!(
+                    "{}: optimize needs an [arm] in the problem",
+                    case.name
+                )));
+            };
+            match arm.optimize(search) {
+                None => Err(format!(
+                    "{}: no design with a finite critical load",
+                    case.name
+                )),
+                Some(optimum) => {
+                    let straight_reach = if *straight {
+                        arm.straight().map(|s| s.reach)
+                    } else {
+                        None
+                    };
+                    Ok(Outcome {
+                        values: [
+                            ("reach".to_string(), Some(optimum.design.reach)),
+                            ("straight_reach".to_string(), straight_reach),
+                        ]
+                        .into_iter()
+                        .collect(),
+                        time: 0.0,
+                        message: format!("{} evaluations", optimum.evaluations),
+                    })
+                }
             }
         }
         _ => {

@@ -140,6 +140,11 @@ pub fn cantilever_tip(k: f64) -> (f64, f64, f64) {
 /// source; every length is for L = 1, every load is F L²/B.
 pub const FORMULAS: &[(&str, &str, &str)] = &[
     (
+        "upward_reach_limit",
+        "",
+        "Rb = π/2: the tallest straight column under a top load, √(π²/4) (paper eq. (2))",
+    ),
+    (
         "cantilever_tip_x",
         "k",
         "deflection 1 − 2(E(p) − E(θ0, p))/√k (Bisshopp & Drucker 1945)",
@@ -226,6 +231,7 @@ pub fn evaluate(name: &str, params: &BTreeMap<String, f64>) -> Result<f64, Strin
         "cantilever_tip_z" => cantilever_tip(k()?).1,
         "cantilever_tip_angle" => cantilever_tip(k()?).2,
         "euler_clamped_free" => PI * PI / 4.0,
+        "upward_reach_limit" => PI / 2.0,
         "elastica_column_load" => ellip_f(FRAC_PI_2, modulus()?).powi(2),
         "elastica_column_tip_deflection" => {
             let p = modulus()?;
