@@ -34,7 +34,7 @@ enum Command {
         /// Write the solution to this HDF5 file.
         #[arg(short, long)]
         output: Option<PathBuf>,
-        /// Override the solver method ("shooting", "multiple-shooting").
+        /// Override the solver method: "shooting", "multiple-shooting" or "collocation".
         #[arg(long)]
         method: Option<String>,
         /// Override any key of the problem file, e.g. --set loads.tip_force=[5,0,0].
