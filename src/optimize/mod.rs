@@ -353,7 +353,7 @@ impl CostFunction for &ReachCost<'_> {
 pub struct StraightArm {
     /// R̂0 = √γ |tip|.
     pub reach: f64,
-    /// The critical γ.
+    /// The load γ of the farthest stable level equilibrium.
     pub gamma: f64,
     /// The clamp angle (rad, d3 turned towards d1).
     pub clamp_angle: f64,
@@ -372,16 +372,26 @@ impl ArmProblem {
         rod
     }
 
-    /// The equilibrium at (γ, θ) and its tip elevation error.
+    /// The equilibrium at (γ, θ), warm-started from a neighbouring one's
+    /// clamp curvature (so that the level family is followed, not whatever
+    /// branch a cold start from the straight rod falls onto), and its tip
+    /// elevation error.
     fn straight_equilibrium(
         &self,
         gamma: f64,
         theta: f64,
+        guess: Option<&[f64]>,
     ) -> Option<(crate::bvp::Equilibrium, f64)> {
         let rod = self.straight_rod(gamma, theta);
         let choice = crate::model::ModelChoice::for_rod(&rod);
         let opts = crate::bvp::SolverOptions {
-            method: crate::bvp::Method::MultipleShooting { segments: 8 },
+            method: crate::bvp::Method::Shooting,
+            strategy: if guess.is_some() {
+                crate::bvp::Strategy::Direct
+            } else {
+                crate::bvp::Strategy::Auto
+            },
+            initial_guess: guess.map(|g| g.to_vec()),
             output_points: 101,
             ..Default::default()
         };
@@ -391,51 +401,109 @@ impl ArmProblem {
         Some((eq, error))
     }
 
-    /// The clamp angle at load γ that puts the tip at elevation α.
-    fn level_clamp(&self, gamma: f64, guess: f64) -> Option<(f64, crate::bvp::Equilibrium)> {
-        let (mut t0, mut t1) = (guess, guess + 0.05);
-        let mut f0 = self.straight_equilibrium(gamma, t0)?.1;
+    /// The clamp curvature of an equilibrium as three body components.
+    fn clamp_curvature(eq: &crate::bvp::Equilibrium) -> Vec<f64> {
+        eq.samples[0].curvature.as_slice().to_vec()
+    }
+
+    /// The clamp angle at load γ that puts the tip at elevation α, by the
+    /// secant method from (θ, κ(0)) of a neighbouring level equilibrium.
+    fn level_clamp(
+        &self,
+        gamma: f64,
+        theta: f64,
+        guess: Option<&[f64]>,
+    ) -> Option<(f64, crate::bvp::Equilibrium)> {
+        let (eq0, mut f0) = self.straight_equilibrium(gamma, theta, guess)?;
+        let mut k = Self::clamp_curvature(&eq0);
+        let (mut t0, mut t1) = (theta, theta - 0.01 * f0.signum());
         for _ in 0..60 {
-            let (eq, f1) = self.straight_equilibrium(gamma, t1)?;
+            let (eq, f1) = self.straight_equilibrium(gamma, t1, Some(&k))?;
             if f1.abs() < 1e-12 {
                 return Some((t1, eq));
             }
+            k = Self::clamp_curvature(&eq);
             let next = t1 - f1 * (t1 - t0) / (f1 - f0);
-            (t0, f0, t1) = (t1, f1, next.clamp(t1 - 0.5, t1 + 0.5));
+            (t0, f0, t1) = (t1, f1, next.clamp(t1 - 0.1, t1 + 0.1));
         }
         None
     }
 
-    /// R̂0 of the intrinsically straight arm.
+    /// R̂0 of the intrinsically straight arm: the largest √γ |tip| over the
+    /// stable level equilibria. The level family is followed in γ with warm
+    /// starts (steps of 5 %) until its equilibrium loses stability or the
+    /// family ends (the limit then bisected); R̂ need not grow all the way,
+    /// so its largest value on the stable part is refined by golden-section
+    /// search around the best step.
     pub fn straight(&self) -> Option<StraightArm> {
         let opts = crate::bvp::SolverOptions::default();
-        let stable = |gamma: f64, guess: f64| -> Option<(bool, f64, crate::bvp::Equilibrium)> {
-            let (theta, eq) = self.level_clamp(gamma, guess)?;
+        type Level = (f64, Vec<f64>);
+        let reach =
+            |gamma: f64, eq: &crate::bvp::Equilibrium| gamma.sqrt() * eq.tip().position.norm();
+        let level = |gamma: f64, from: &Level| -> Option<(bool, Level, f64)> {
+            let (theta, eq) = self.level_clamp(gamma, from.0, Some(&from.1))?;
             let rod = self.straight_rod(gamma, theta);
             let st = crate::stability::analyze(&rod, &eq, &opts, &self.stability).ok()?;
-            Some((st.stable, theta, eq))
+            Some((
+                st.stable,
+                (theta, Self::clamp_curvature(&eq)),
+                reach(gamma, &eq),
+            ))
         };
-        // A load where no level equilibrium is found on the branch counts as
-        // beyond the limit, like an unstable one.
-        let (mut lo, mut hi, mut theta) = (0.0, 0.5, 0.0);
-        while let Some((true, t, _)) = stable(hi, theta) {
-            (lo, theta) = (hi, t);
-            hi *= 1.5;
+        let first = self.level_clamp(0.25, 0.0, None)?;
+        let mut state: Level = (first.0, Self::clamp_curvature(&first.1));
+        // (γ, state, R̂) of every stable step.
+        let mut marched: Vec<(f64, Level, f64)> =
+            vec![(0.25, state.clone(), reach(0.25, &first.1))];
+        let (mut lo, mut hi) = (0.25, 0.25 * 1.05);
+        // A load where no level equilibrium is found counts as beyond the
+        // limit, like an unstable one.
+        while let Some((true, next, r)) = level(hi, &state) {
+            marched.push((hi, next.clone(), r));
+            (lo, state) = (hi, next);
+            hi *= 1.05;
             if hi > 1e4 {
                 return None;
             }
         }
         for _ in 0..40 {
             let mid = 0.5 * (lo + hi);
-            match stable(mid, theta) {
-                Some((true, t, _)) => (lo, theta) = (mid, t),
+            match level(mid, &state) {
+                Some((true, next, r)) => {
+                    marched.push((mid, next.clone(), r));
+                    (lo, state) = (mid, next);
+                }
                 _ => hi = mid,
             }
             if hi - lo < 1e-10 * hi {
                 break;
             }
         }
-        let (theta, eq) = self.level_clamp(lo, theta)?;
+        let best = (0..marched.len()).max_by(|&a, &b| marched[a].2.total_cmp(&marched[b].2))?;
+        let (mut gamma, mut from) = (marched[best].0, marched[best].1.clone());
+        if best > 0 && best + 1 < marched.len() {
+            // Golden-section search for the largest R̂ between the neighbours.
+            let (mut a, mut b) = (marched[best - 1].0, marched[best + 1].0);
+            let g = 0.5 * (5f64.sqrt() - 1.0);
+            let f = |x: f64, from: &Level| level(x, from).map_or(f64::NEG_INFINITY, |l| l.2);
+            for _ in 0..60 {
+                let (c, d) = (b - g * (b - a), a + g * (b - a));
+                if f(c, &from) > f(d, &from) {
+                    b = d;
+                } else {
+                    a = c;
+                }
+                if b - a < 1e-9 * b {
+                    break;
+                }
+            }
+            gamma = 0.5 * (a + b);
+            if let Some((_, l, _)) = level(gamma, &from) {
+                from = l;
+            }
+        }
+        let lo = gamma;
+        let (theta, eq) = self.level_clamp(lo, from.0, Some(&from.1))?;
         let scale = lo.sqrt();
         Some(StraightArm {
             reach: scale * eq.tip().position.norm(),
