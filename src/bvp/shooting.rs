@@ -146,6 +146,31 @@ impl<'a> ShootingSystem<'a> {
         x
     }
 
+    /// The residual alone (no sensitivities, so the Kirchhoff model
+    /// integrates 12 instead of 48 equations): what finite differences in a
+    /// parameter need.
+    pub fn residual(&mut self, x: &[f64], r: &mut DVector<f64>) -> Result<(), IntegrationError> {
+        let (n, p, k) = (self.eq.dim(), self.eq.unknowns(), self.segments);
+        let none = DMatrix::zeros(n, 0);
+        for j in 0..k {
+            let start = self.node_state(x, j);
+            let (end, _) = self.segment(j, &start, &none)?;
+            if j + 1 < k {
+                let next = self.node_state(x, j + 1);
+                for i in 0..n {
+                    r[n * j + i] = (end[i] - next[i]) / self.scales[i];
+                }
+            } else {
+                let mut g = vec![0.0; p];
+                self.eq.tip_residual(&end, &mut g);
+                for i in 0..p {
+                    r[n * (k - 1) + i] = g[i] / self.moment_scale;
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// The free values u in the unknown vector.
     pub fn free_values<'x>(&self, x: &'x [f64]) -> &'x [f64] {
         &x[..self.eq.unknowns()]

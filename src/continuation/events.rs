@@ -190,7 +190,7 @@ impl Run<'_> {
         let mut tracker = self.tracker.clone();
         tracker.reset();
         let spectrum = tracker.measure(self.family, &x, p).ok()?;
-        let tip = self.family.tip(&x, p).ok()?;
+        let tip = spectrum.tip.clone();
         let tip_angle = super::tip_angle(&self.family.rod_at(p).ok()?.clamp.frame, &tip);
         let point = Point {
             parameter: p,
@@ -277,7 +277,7 @@ impl Run<'_> {
         for dir in [1.0, -1.0] {
             let t: Vec<f64> = phi.iter().map(|v| v * dir).collect();
             let pred: Vec<f64> = z.iter().zip(&t).map(|(a, b)| a + eps * b).collect();
-            let Ok(Some((zn, _))) = self.correct(&pred, &t) else {
+            let Ok(Some((zn, _, _))) = self.correct(&pred, &t) else {
                 continue;
             };
             let Ok(tangent) = self.tangent(&zn[..n], zn[n], &t) else {

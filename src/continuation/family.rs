@@ -222,10 +222,18 @@ impl Family {
         let n = x.len();
         let h = 1e-4 * p.abs().max(1.0);
         let (mut a, mut b) = (DVector::zeros(n), DVector::zeros(n));
-        let mut jac = DMatrix::zeros(n, n);
-        self.residual(x, p + h, &mut a, &mut jac)?;
-        self.residual(x, p - h, &mut b, &mut jac)?;
+        self.residual_only(x, p + h, &mut a)?;
+        self.residual_only(x, p - h, &mut b)?;
         Ok((a - b) / (2.0 * h))
+    }
+
+    /// F(x, p) without its Jacobian.
+    pub fn residual_only(&self, x: &[f64], p: f64, r: &mut DVector<f64>) -> Result<(), PointError> {
+        let rod = self.rod_at(p)?;
+        let eq = equations(&rod, self.level);
+        let mut sys = ShootingSystem::new(eq.as_ref(), self.segments, self.tolerances);
+        sys.residual(x, r)?;
+        Ok(())
     }
 
     /// Number of discrete unknowns.

@@ -265,6 +265,9 @@ fn bordered_solve(a: DMatrix<f64>, rhs: &DVector<f64>) -> Option<DVector<f64>> {
     svd.solve(rhs, tol).ok().filter(finite)
 }
 
+/// A converged corrector: (x, p), its iterations and F_x there.
+type Corrected = (Vec<f64>, usize, DMatrix<f64>);
+
 /// A corrected step: unknowns, parameter, tangent, corrector iterations.
 type Stepped = (Vec<f64>, f64, Vec<f64>, usize);
 
@@ -348,9 +351,21 @@ impl<'a> Run<'a> {
         let n = x.len();
         let (mut r, mut fx) = (DVector::zeros(n), DMatrix::zeros(n, n));
         self.family.residual(x, p, &mut r, &mut fx)?;
+        self.tangent_from(&fx, x, p, previous)
+    }
+
+    /// The tangent with F_x already known at (x, p).
+    fn tangent_from(
+        &self,
+        fx: &DMatrix<f64>,
+        x: &[f64],
+        p: f64,
+        previous: &[f64],
+    ) -> Result<Vec<f64>, PointError> {
+        let n = x.len();
         let fp = self.family.parameter_derivative(x, p)?;
         let mut a = DMatrix::zeros(n + 1, n + 1);
-        a.view_mut((0, 0), (n, n)).copy_from(&fx);
+        a.view_mut((0, 0), (n, n)).copy_from(fx);
         a.view_mut((0, n), (n, 1)).copy_from(&fp);
         for (k, v) in previous.iter().enumerate() {
             a[(n, k)] = *v;
@@ -363,11 +378,7 @@ impl<'a> Run<'a> {
     }
 
     /// Newton on F(x, p) = 0, τᵀ(z − z_pred) = 0 from the predictor.
-    fn correct(
-        &self,
-        pred: &[f64],
-        tangent: &[f64],
-    ) -> Result<Option<(Vec<f64>, usize)>, PointError> {
+    fn correct(&self, pred: &[f64], tangent: &[f64]) -> Result<Option<Corrected>, PointError> {
         let n = pred.len() - 1;
         let mut z = pred.to_vec();
         let (mut r, mut fx) = (DVector::zeros(n), DMatrix::zeros(n, n));
@@ -386,7 +397,7 @@ impl<'a> Run<'a> {
                 .map(|(t, (a, b))| t * (a - b))
                 .sum();
             if r.amax() <= self.opts.tolerance && arc.abs() <= 1e-13 {
-                return Ok(Some((z, it)));
+                return Ok(Some((z, it, fx)));
             }
             let mut a = DMatrix::zeros(n + 1, n + 1);
             a.view_mut((0, 0), (n, n)).copy_from(&fx);
@@ -413,7 +424,7 @@ impl<'a> Run<'a> {
         tangent: Vec<f64>,
     ) -> Result<Point, ContinuationError> {
         let spectrum = self.tracker.measure(self.family, &x, p)?;
-        let tip = self.family.tip(&x, p)?;
+        let tip = spectrum.tip.clone();
         let tip_angle = tip_angle(
             &self.family.rod_at(p).map_err(PointError::from)?.clamp.frame,
             &tip,
@@ -438,11 +449,11 @@ impl<'a> Run<'a> {
         let mut z = from.unknowns.clone();
         z.push(from.parameter);
         let pred: Vec<f64> = z.iter().zip(&t).map(|(a, b)| a + ds * b).collect();
-        let Some((z, iterations)) = self.correct(&pred, &t)? else {
+        let Some((z, iterations, fx)) = self.correct(&pred, &t)? else {
             return Ok(None);
         };
         let n = z.len() - 1;
-        let tangent = self.tangent(&z[..n], z[n], &t)?;
+        let tangent = self.tangent_from(&fx, &z[..n], z[n], &t)?;
         // Keep the stored tangent oriented along the travel direction.
         let stored: Vec<f64> = tangent.iter().map(|v| v * sign).collect();
         Ok(Some((z[..n].to_vec(), z[n], stored, iterations)))

@@ -8,6 +8,7 @@
 use nalgebra::Vector3;
 
 use super::family::{Family, PointError};
+use crate::equations::RodSample;
 use crate::stability::banded::SymmetricBanded;
 use crate::stability::eigen::{count_below, lowest_eigenpairs, lowest_eigenpairs_near};
 use crate::stability::{coefficients, Block, FiniteElements, StabilityOptions};
@@ -27,6 +28,8 @@ pub struct Spectrum {
     pub curvature_norm: f64,
     /// Positions at 21 equally spaced points.
     pub shape: Vec<Vector3<f64>>,
+    /// The tip sample.
+    pub tip: RodSample,
 }
 
 /// K and G of one block.
@@ -88,10 +91,27 @@ impl Tracker {
         family: &Family,
         x: &[f64],
         p: f64,
-    ) -> Result<(FiniteElements, Vec<BlockMatrices>, f64), PointError> {
+    ) -> Result<(FiniteElements, Vec<BlockMatrices>, f64, Vec<RodSample>), PointError> {
         let rod = family.rod_at(p)?;
         let fe = FiniteElements::new(rod.length, self.opts.elements, self.opts.order);
-        let samples = family.samples(x, p, &fe.quadrature_points())?;
+        // One integration for the quadrature points and the 21 shape points
+        // (the last is the tip).
+        let quadrature = fe.quadrature_points();
+        let grid: Vec<f64> = (0..21).map(|i| rod.length * i as f64 / 20.0).collect();
+        let mut all: Vec<(f64, bool)> = quadrature
+            .iter()
+            .map(|&s| (s, true))
+            .chain(grid.iter().map(|&s| (s, false)))
+            .collect();
+        all.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let points: Vec<f64> = all.iter().map(|a| a.0).collect();
+        let (samples, shape): (Vec<_>, Vec<_>) = family
+            .samples(x, p, &points)?
+            .into_iter()
+            .zip(&all)
+            .partition(|(_, tag)| tag.1);
+        let samples: Vec<RodSample> = samples.into_iter().map(|(s, _)| s).collect();
+        let shape: Vec<RodSample> = shape.into_iter().map(|(s, _)| s).collect();
         let norm = samples
             .iter()
             .zip(fe.quadrature_weights())
@@ -104,12 +124,12 @@ impl Tracker {
             .iter()
             .map(|&b| (fe.stiffness(&c, b), fe.mass(b)))
             .collect();
-        Ok((fe, mats, norm))
+        Ok((fe, mats, norm, shape))
     }
 
     /// The spectrum at (x, p), matched to the previous point's modes.
     pub fn measure(&mut self, family: &Family, x: &[f64], p: f64) -> Result<Spectrum, PointError> {
-        let (_, mats, norm) = self.matrices(family, x, p)?;
+        let (_, mats, norm, shape_samples) = self.matrices(family, x, p)?;
         let mut values = vec![];
         let mut vectors = vec![];
         let mut block_morse = vec![];
@@ -138,14 +158,9 @@ impl Tracker {
         self.previous = Some(vectors.clone());
         let k = self.opts.eigenvalues;
         self.previous_values = Some(values.chunks(k).map(|c| c.to_vec()).collect());
-        let l = family.rod_at(p)?.length;
-        let grid: Vec<f64> = (0..21).map(|i| l * i as f64 / 20.0).collect();
-        let shape = family
-            .samples(x, p, &grid)?
-            .iter()
-            .map(|s| s.position)
-            .collect();
+        let shape = shape_samples.iter().map(|s| s.position).collect();
         Ok(Spectrum {
+            tip: shape_samples.last().expect("21 shape points").clone(),
             values,
             vectors,
             morse_index: block_morse.iter().sum(),
@@ -164,7 +179,7 @@ impl Tracker {
         p: f64,
         block: Block,
     ) -> Result<(f64, Vec<Vector3<f64>>), PointError> {
-        let (fe, mats, _) = self.matrices(family, x, p)?;
+        let (fe, mats, _, _) = self.matrices(family, x, p)?;
         let bi = self
             .blocks
             .iter()
