@@ -382,3 +382,34 @@ fn interrupted_run_keeps_its_points() {
     assert_eq!(left.len(), 1, "{left:?}");
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// A kill (SIGKILL, no handler runs) loses at most the last 2 s: the
+/// checkpoint written while the run grew is a valid diagram file.
+#[test]
+fn killed_run_leaves_its_last_checkpoint() {
+    let dir = std::env::temp_dir().join(format!("cosserat-kill-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("slow.h5");
+    let file = format!("{}/problems/euler_column.toml", env!("CARGO_MANIFEST_DIR"));
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_cosserat"))
+        .args(["continue", &file, "-o", out.to_str().unwrap()])
+        .args([
+            "--set",
+            "continuation.step=0.0005",
+            "--set",
+            "continuation.max_step=0.0005",
+        ])
+        .args(["--set", "continuation.max_points=100000"])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(3500));
+    child.kill().unwrap();
+    let _ = child.wait();
+    let f = hdf5::File::open(&out).expect("the checkpoint is a valid HDF5 file");
+    let points = read_f64(&f.group("branches/0").unwrap(), "parameter");
+    assert!(points.len() > 5, "{} points kept", points.len());
+    assert!(points.windows(2).all(|w| w[1] > w[0]), "points in order");
+    std::fs::remove_dir_all(dir).unwrap();
+}

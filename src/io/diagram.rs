@@ -2,7 +2,8 @@
 //!
 //! Layout (a contract, see README.md): `/branches/<i>/parameter` (m),
 //! `tip_position` (m×3), `eigenvalues` (m×k), `stable` (m), `morse_index`
-//! (m), `norm` (m), `shapes` (m×21×3), attributes `parent` and
+//! (m), `norm` (m), `shapes` (m×21×3), `unknowns` (m×n) and `tangent`
+//! (m×(n+1)) of the discretization, attributes `parent` and
 //! `stop_reason`; `/special_points/kind` (strings), `branch`, `index`,
 //! `parameter`, `tip_position` (s×3), `block`, `symmetry_breaking`,
 //! `null_vectors` (s×nodes×3), `singularity` (s×2); the problem text as the
@@ -85,6 +86,12 @@ fn write_branches(file: &hdf5::File, d: &Diagram) -> hdf5::Result<()> {
         integers(&g, "morse_index", &morse)?;
         array(&g, "norm", &[m], &col(&|p| p.norm))?;
         array(&g, "tip_angle", &[m], &col(&|p| p.tip_angle))?;
+        // The discrete unknowns and tangents: enough to restart a branch.
+        let n = b.points.first().map_or(0, |p| p.unknowns.len());
+        let x: Vec<f64> = b.points.iter().flat_map(|p| p.unknowns.clone()).collect();
+        array(&g, "unknowns", &[m, n], &x)?;
+        let t: Vec<f64> = b.points.iter().flat_map(|p| p.tangent.clone()).collect();
+        array(&g, "tangent", &[m, n + 1], &t)?;
         let shapes: Vec<f64> = b
             .points
             .iter()
