@@ -117,7 +117,7 @@ pub fn lowest_eigenpairs_near(
             apply,
             g,
             |theta| sigma + 1.0 / theta,
-            |a, b| b.partial_cmp(&a).unwrap(),
+            |a, b| b.total_cmp(&a),
         )?;
         match verify(k, g, ritz) {
             Ok(pairs) => return Ok(pairs),
@@ -347,7 +347,7 @@ pub fn dense_pencil(
     let c = (&c + c.transpose()) * 0.5;
     let eig = c.symmetric_eigen();
     let mut idx: Vec<usize> = (0..k.nrows()).collect();
-    idx.sort_by(|&a, &b| eig.eigenvalues[a].partial_cmp(&eig.eigenvalues[b]).unwrap());
+    idx.sort_by(|&a, &b| eig.eigenvalues[a].total_cmp(&eig.eigenvalues[b]));
     let take: Vec<usize> = idx.into_iter().take(count).collect();
     Ok(Eigenpairs {
         values: take.iter().map(|&i| eig.eigenvalues[i]).collect(),
@@ -382,15 +382,7 @@ pub fn smallest_positive_load_factor(
             k1.matvec(x, y);
             f.solve_in_place(y);
         };
-        lanczos(
-            k0.size(),
-            1,
-            60,
-            apply,
-            k0,
-            |mu| mu,
-            |a, b| a.partial_cmp(&b).unwrap(),
-        )?
+        lanczos(k0.size(), 1, 60, apply, k0, |mu| mu, |a, b| a.total_cmp(&b))?
     };
     let mu = pairs.values[0];
     if mu >= 0.0 {
