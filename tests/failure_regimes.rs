@@ -131,6 +131,19 @@ fn long_rod_single_shooting_fails_others_recover() {
         let err = cantilever_error(&eq, length, force);
         eprintln!("direct single shooting: another equilibrium, relative tip distance {err:.2e}");
         assert!(err > 1e-2, "{err:e}");
+        // The framework notices: that equilibrium is unstable (what
+        // `cosserat solve` reports with a warning).
+        let st = cosserat::stability::analyze(
+            &rod,
+            &eq,
+            &SolverOptions::default(),
+            &cosserat::stability::StabilityOptions::default(),
+        )
+        .unwrap();
+        assert!(
+            !st.stable,
+            "the looped equilibrium should be flagged unstable"
+        );
     }
     for method in [
         Method::MultipleShooting { segments: 16 },
