@@ -9,7 +9,7 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use cosserat::continuation::{continuation, Diagram, Progress};
-use cosserat::io::{check_target, write_diagram, Problem, MEASURES};
+use cosserat::io::{check_target, read_saved, write_diagram, Problem, MEASURES};
 use cosserat::plot::{draw, read_diagram};
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -25,6 +25,7 @@ pub fn run_continue(
     plot: Option<PathBuf>,
     set: &[String],
     force: bool,
+    resume: bool,
 ) -> ExitCode {
     let problem = match Problem::from_path(&path, set) {
         Ok(p) => p,
@@ -39,9 +40,29 @@ pub fn run_continue(
             ),
         );
     };
-    if let Err(e) = check_target(&output, force) {
-        return fail(2, e);
-    }
+    let saved =
+        if resume && output.exists() {
+            match read_saved(&output) {
+                Ok((text, _)) if text != problem.text => return fail(
+                    2,
+                    format!(
+                        "{}: made from a different problem (or other --set values); cannot resume",
+                        output.display()
+                    ),
+                ),
+                Ok((_, saved)) if saved.stop_reason == "completed" => {
+                    println!("nothing to resume: {} is complete", output.display());
+                    return ExitCode::SUCCESS;
+                }
+                Ok((_, saved)) => Some(saved),
+                Err(e) => return fail(2, format!("{}: cannot resume: {e}", output.display())),
+            }
+        } else {
+            if let Err(e) = check_target(&output, force) {
+                return fail(2, e);
+            }
+            None
+        };
     let parameter_name = problem
         .text
         .lines()
@@ -95,7 +116,19 @@ pub fn run_continue(
         }
         !interrupted.load(Ordering::SeqCst)
     };
-    let diagram = match continuation(family, opts, &mut monitor) {
+    if let Some(saved) = &saved {
+        let points: usize = saved.branches.iter().map(|b| b.parameter.len()).sum();
+        println!(
+            "resume    {} branches, {points} points from {}",
+            saved.branches.len(),
+            output.display()
+        );
+    }
+    let outcome = match &saved {
+        Some(saved) => cosserat::continuation::resume(family, opts, saved, &mut monitor),
+        None => continuation(family, opts, &mut monitor),
+    };
+    let diagram = match outcome {
         Ok(d) => d,
         Err(e) => return fail(2, e),
     };

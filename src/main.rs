@@ -70,6 +70,9 @@ enum Command {
         /// Also draw the diagram (.png or .svg).
         #[arg(long)]
         plot: Option<PathBuf>,
+        /// Go on with an interrupted run saved in the output file.
+        #[arg(long)]
+        resume: bool,
         /// Override any key of the problem file.
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,
@@ -140,9 +143,10 @@ fn main() -> ExitCode {
             problem,
             output,
             plot,
+            resume,
             set,
             force,
-        } => continue_command::run_continue(problem, output, plot, &set, force),
+        } => continue_command::run_continue(problem, output, plot, &set, force, resume),
         Command::Optimize {
             problem,
             output,

@@ -413,3 +413,75 @@ fn killed_run_leaves_its_last_checkpoint() {
     assert!(points.windows(2).all(|w| w[1] > w[0]), "points in order");
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// Interrupt a run, resume it, and get the diagram an uninterrupted run
+/// draws: the same branches, points and special points.
+#[test]
+fn interrupted_run_resumes_to_the_same_diagram() {
+    let dir = std::env::temp_dir().join(format!("cosserat-resume-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (partial, full) = (dir.join("partial.h5"), dir.join("full.h5"));
+    let file = format!("{}/problems/euler_column.toml", env!("CARGO_MANIFEST_DIR"));
+    let sets = [
+        "--set",
+        "continuation.step=0.004",
+        "--set",
+        "continuation.max_step=0.004",
+        "--set",
+        "continuation.max_points=100000",
+    ];
+    let command = |out: &Path, extra: &[&str]| {
+        let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_cosserat"));
+        c.args(["continue", &file, "-o", out.to_str().unwrap()])
+            .args(sets)
+            .args(extra)
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null());
+        c
+    };
+    let mut child = command(&partial, &[]).spawn().unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let _ = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status();
+    assert_eq!(
+        child.wait().unwrap().code(),
+        Some(130),
+        "the run should still be going at 1.5 s"
+    );
+    assert!(command(&partial, &["--resume"]).status().unwrap().success());
+    assert!(command(&full, &[]).status().unwrap().success());
+    let (a, b) = (
+        hdf5::File::open(&partial).unwrap(),
+        hdf5::File::open(&full).unwrap(),
+    );
+    for f in [&a, &b] {
+        let reason = f
+            .attr("stop_reason")
+            .unwrap()
+            .read_scalar::<hdf5::types::VarLenUnicode>()
+            .unwrap();
+        assert_eq!(reason.as_str(), "completed");
+    }
+    for i in 0..3 {
+        let path = format!("branches/{i}");
+        let (pa, pb) = (
+            read_f64(&a.group(&path).unwrap(), "parameter"),
+            read_f64(&b.group(&path).unwrap(), "parameter"),
+        );
+        assert_eq!(pa.len(), pb.len(), "branch {i}");
+        assert!(
+            pa.iter()
+                .zip(&pb)
+                .all(|(x, y)| (x - y).abs() <= 1e-9 * y.abs().max(1.0)),
+            "branch {i}"
+        );
+    }
+    let (sa, sb) = (
+        read_f64(&a.group("special_points").unwrap(), "parameter"),
+        read_f64(&b.group("special_points").unwrap(), "parameter"),
+    );
+    assert_eq!(sa.len(), sb.len());
+    assert!(sa.iter().zip(&sb).all(|(x, y)| (x - y).abs() <= 1e-9));
+    std::fs::remove_dir_all(dir).unwrap();
+}

@@ -220,34 +220,58 @@ pub fn continuation(
         back.1 = -1.0;
         queue.push(back);
     }
-    while let Some((start, sign, parent, depth)) = queue.first().cloned() {
-        queue.remove(0);
+    drain(&mut run, &mut diagram, queue, monitor);
+    Ok(diagram)
+}
+
+/// A branch to follow: start point, direction, parent special point, depth.
+type Pending = (Point, f64, Option<usize>, usize);
+
+/// Follows queued branches, switching at their branch points to the
+/// configured depth, until the queue is empty or the monitor interrupts.
+fn drain(
+    run: &mut Run,
+    diagram: &mut Diagram,
+    mut queue: Vec<Pending>,
+    monitor: &mut dyn FnMut(Progress, &Diagram) -> bool,
+) {
+    while !queue.is_empty() {
+        let (start, sign, parent, depth) = queue.remove(0);
         let index = diagram.branches.len();
         diagram.branches.push(Branch {
             points: vec![],
             parent,
             stop_reason: "in progress".into(),
         });
-        let outcome = run.follow(start, sign, index, &mut diagram, monitor);
-        diagram.branches[index].stop_reason = outcome.stop_reason.clone();
         if let Some(sp) = parent {
             diagram.special_points[sp].children.push(index);
         }
+        let outcome = run.follow(start, sign, index, diagram, monitor);
+        diagram.branches[index].stop_reason = outcome.stop_reason.clone();
         if outcome.interrupted {
             diagram.stop_reason = "interrupted".into();
-            break;
+            return;
         }
-        if depth < opts.switch_depth {
-            for sp in outcome.special_points {
-                let special = diagram.special_points[sp].clone();
-                let neighbour = diagram.branches[index].points[special.index].clone();
-                for (point, dir) in run.switch(&special, &neighbour) {
-                    queue.push((point, dir, Some(sp), depth + 1));
-                }
+        queue.extend(run.switches(diagram, &outcome.special_points, depth));
+    }
+}
+
+impl Run<'_> {
+    /// New branches from the given special points, if `depth` allows.
+    fn switches(&mut self, diagram: &Diagram, specials: &[usize], depth: usize) -> Vec<Pending> {
+        if depth >= self.opts.switch_depth {
+            return vec![];
+        }
+        let mut out = vec![];
+        for &sp in specials {
+            let special = diagram.special_points[sp].clone();
+            let neighbour = diagram.branches[special.branch].points[special.index].clone();
+            for (point, dir) in self.switch(&special, &neighbour) {
+                out.push((point, dir, Some(sp), depth + 1));
             }
         }
+        out
     }
-    Ok(diagram)
 }
 
 /// Solves the bordered system by LU, or — where it is singular, exactly at
@@ -590,3 +614,6 @@ impl<'a> Run<'a> {
 }
 
 mod events;
+mod resume;
+
+pub use resume::{resume, SavedBranch, SavedDiagram, SavedSpecial};

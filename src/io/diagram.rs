@@ -15,7 +15,8 @@ use std::path::Path;
 use hdf5::types::VarLenUnicode;
 
 use super::hdf5_output::{array, string_attr, text, write_atomically, OutputError};
-use crate::continuation::Diagram;
+use crate::continuation::{Diagram, SavedBranch, SavedDiagram, SavedSpecial, SpecialKind};
+use crate::stability::Block;
 
 fn integers(group: &hdf5::Group, name: &str, data: &[u64]) -> hdf5::Result<()> {
     group
@@ -161,5 +162,88 @@ fn write_special_points(file: &hdf5::File, d: &Diagram) -> hdf5::Result<()> {
         })
         .collect();
     array(&g, "null_vectors", &[sp.len(), nodes, 3], &null)?;
-    array(&g, "nodes", &[nodes], &d.nodes)
+    array(&g, "nodes", &[nodes], &d.nodes)?;
+    let n = sp.first().map_or(0, |s| s.point.unknowns.len());
+    let x: Vec<f64> = sp.iter().flat_map(|s| s.point.unknowns.clone()).collect();
+    array(&g, "unknowns", &[sp.len(), n], &x)?;
+    let t: Vec<f64> = sp.iter().flat_map(|s| s.point.tangent.clone()).collect();
+    array(&g, "tangent", &[sp.len(), n + 1], &t)
+}
+
+fn rows(g: &hdf5::Group, name: &str) -> hdf5::Result<Vec<Vec<f64>>> {
+    let ds = g.dataset(name)?;
+    let width = ds.shape().get(1).copied().unwrap_or(0).max(1);
+    Ok(ds
+        .read_raw::<f64>()?
+        .chunks(width)
+        .map(<[f64]>::to_vec)
+        .collect())
+}
+
+fn read_string(loc: &hdf5::Location, name: &str) -> hdf5::Result<String> {
+    Ok(loc
+        .attr(name)?
+        .read_scalar::<VarLenUnicode>()?
+        .as_str()
+        .to_string())
+}
+
+/// The problem text and what a diagram file keeps of its run (for
+/// `cosserat continue --resume`).
+pub fn read_saved(path: &Path) -> hdf5::Result<(String, SavedDiagram)> {
+    let f = hdf5::File::open(path)?;
+    let problem = read_string(&f, "problem")?;
+    let root = f.group("branches")?;
+    let mut branches = vec![];
+    for i in 0.. {
+        let Ok(g) = root.group(&i.to_string()) else {
+            break;
+        };
+        let parent = g.attr("parent")?.read_scalar::<i64>()?;
+        branches.push(SavedBranch {
+            parameter: g.dataset("parameter")?.read_raw::<f64>()?,
+            unknowns: rows(&g, "unknowns")?,
+            tangent: rows(&g, "tangent")?,
+            parent: usize::try_from(parent).ok(),
+            stop_reason: read_string(&g, "stop_reason")?,
+        });
+    }
+    let g = f.group("special_points")?;
+    let kinds = g.dataset("kind")?.read_raw::<VarLenUnicode>()?;
+    let blocks = g.dataset("block")?.read_raw::<VarLenUnicode>()?;
+    let branch = g.dataset("branch")?.read_raw::<u64>()?;
+    let index = g.dataset("index")?.read_raw::<u64>()?;
+    let sym = g.dataset("symmetry_breaking")?.read_raw::<u64>()?;
+    let parameter = g.dataset("parameter")?.read_raw::<f64>()?;
+    let sing = rows(&g, "singularity")?;
+    let (x, t) = (rows(&g, "unknowns")?, rows(&g, "tangent")?);
+    let specials = (0..kinds.len())
+        .map(|i| SavedSpecial {
+            kind: if kinds[i].as_str() == "fold" {
+                SpecialKind::Fold
+            } else {
+                SpecialKind::BranchPoint
+            },
+            branch: branch[i] as usize,
+            index: index[i] as usize,
+            block: match blocks[i].as_str() {
+                "in_plane" => Block::InPlane,
+                "out_of_plane" => Block::OutOfPlane,
+                _ => Block::Full,
+            },
+            symmetry_breaking: sym[i] == 1,
+            singularity: (sing[i][0], sing[i][1]),
+            parameter: parameter[i],
+            unknowns: x[i].clone(),
+            tangent: t[i].clone(),
+        })
+        .collect();
+    Ok((
+        problem,
+        SavedDiagram {
+            branches,
+            specials,
+            stop_reason: read_string(&f, "stop_reason")?,
+        },
+    ))
 }

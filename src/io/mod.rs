@@ -11,7 +11,7 @@ mod problem;
 pub use arm_output::write_arm;
 pub use arm_section::ArmSection;
 pub use continuation_section::{ContinuationSection, MEASURES};
-pub use diagram::write_diagram;
+pub use diagram::{read_saved, write_diagram};
 pub use hdf5_output::{
     check_target, write_equilibrium, write_stability, OutputError, StabilityResult,
 };

@@ -1,0 +1,184 @@
+//! Resuming an interrupted continuation from what its diagram file kept:
+//! every saved point is rebuilt from its unknowns and tangent (tip,
+//! spectrum, Morse index recomputed), the interrupted branch goes on from
+//! its last point, and branch points not yet switched are switched.
+
+use super::{
+    drain, Branch, ContinuationError, Diagram, Pending, Point, Run, SpecialKind, SpecialPoint,
+};
+use super::{ContinuationOptions, Family};
+use crate::stability::Block;
+
+/// One saved branch.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SavedBranch {
+    /// Parameter values.
+    pub parameter: Vec<f64>,
+    /// Unknowns of each point.
+    pub unknowns: Vec<Vec<f64>>,
+    /// Tangents (x, p) of each point, oriented along the travel.
+    pub tangent: Vec<Vec<f64>>,
+    /// The special point it was switched from.
+    pub parent: Option<usize>,
+    /// Why it ended ("interrupted" and "in progress" are resumed).
+    pub stop_reason: String,
+}
+
+/// One saved special point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SavedSpecial {
+    /// Fold or branch point.
+    pub kind: SpecialKind,
+    /// Its branch.
+    pub branch: usize,
+    /// The point index before it.
+    pub index: usize,
+    /// The block whose eigenvalue vanishes.
+    pub block: Block,
+    /// Symmetry-breaking.
+    pub symmetry_breaking: bool,
+    /// Relative det F_x and eigenvalue there.
+    pub singularity: (f64, f64),
+    /// Parameter.
+    pub parameter: f64,
+    /// Unknowns.
+    pub unknowns: Vec<f64>,
+    /// Tangent.
+    pub tangent: Vec<f64>,
+}
+
+/// What a diagram file keeps of a run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SavedDiagram {
+    /// Branches.
+    pub branches: Vec<SavedBranch>,
+    /// Special points.
+    pub specials: Vec<SavedSpecial>,
+    /// Why the run ended.
+    pub stop_reason: String,
+}
+
+fn unfinished(reason: &str) -> bool {
+    reason == "interrupted" || reason == "in progress"
+}
+
+/// Continues a saved run to its end.
+pub fn resume(
+    family: &Family,
+    opts: &ContinuationOptions,
+    saved: &SavedDiagram,
+    monitor: &mut dyn FnMut(super::Progress, &Diagram) -> bool,
+) -> Result<Diagram, ContinuationError> {
+    let mut run = Run::new(family, opts);
+    let mut diagram = Diagram {
+        branches: vec![],
+        special_points: vec![],
+        eigenvalue_names: run.tracker.names(),
+        nodes: run.tracker.nodes(),
+        stop_reason: "completed".into(),
+    };
+    for b in &saved.branches {
+        run.tracker.reset();
+        let mut points = Vec::with_capacity(b.parameter.len());
+        for ((p, x), t) in b.parameter.iter().zip(&b.unknowns).zip(&b.tangent) {
+            points.push(run.point(x.clone(), *p, t.clone())?);
+        }
+        diagram.branches.push(Branch {
+            points,
+            parent: b.parent,
+            stop_reason: b.stop_reason.clone(),
+        });
+    }
+    for s in &saved.specials {
+        diagram.special_points.push(rebuild_special(&mut run, s)?);
+    }
+    for (i, b) in saved.branches.iter().enumerate() {
+        if let Some(sp) = b.parent {
+            diagram.special_points[sp].children.push(i);
+        }
+    }
+    // The interrupted branch goes on from its last point.
+    if let Some(last) = diagram.branches.len().checked_sub(1) {
+        if unfinished(&diagram.branches[last].stop_reason)
+            && !diagram.branches[last].points.is_empty()
+        {
+            let start = diagram.branches[last].points.pop().expect("non-empty");
+            let outcome = run.follow(start, 1.0, last, &mut diagram, monitor);
+            diagram.branches[last].stop_reason = outcome.stop_reason.clone();
+            if outcome.interrupted {
+                diagram.stop_reason = "interrupted".into();
+                return Ok(diagram);
+            }
+        }
+    }
+    // Branch points not switched yet, and the backward half of the start.
+    let mut queue: Vec<Pending> = vec![];
+    let roots = diagram
+        .branches
+        .iter()
+        .filter(|b| b.parent.is_none())
+        .count();
+    if opts.both_directions && roots == 1 {
+        if let Some(first) = diagram.branches.first().and_then(|b| b.points.first()) {
+            queue.push((first.clone(), -1.0, None, 0));
+        }
+    }
+    // Switches that did not run yet: each special point's new branches,
+    // less those whose first point a saved child already starts from.
+    for sp in 0..diagram.special_points.len() {
+        let d = depth(&diagram, diagram.special_points[sp].branch);
+        for start in run.switches(&diagram, &[sp], d) {
+            let covered = diagram.special_points[sp].children.iter().any(|&c| {
+                diagram.branches[c]
+                    .points
+                    .first()
+                    .is_some_and(|p| same_point(p, &start.0))
+            });
+            if !covered {
+                queue.push(start);
+            }
+        }
+    }
+    drain(&mut run, &mut diagram, queue, monitor);
+    Ok(diagram)
+}
+
+/// Two points within 1e-8 of each other in (x, p).
+fn same_point(a: &Point, b: &Point) -> bool {
+    let dx: f64 = a
+        .unknowns
+        .iter()
+        .zip(&b.unknowns)
+        .map(|(x, y)| (x - y).powi(2))
+        .sum();
+    (dx + (a.parameter - b.parameter).powi(2)).sqrt() <= 1e-8
+}
+
+/// How many switches led to `branch`.
+fn depth(diagram: &Diagram, mut branch: usize) -> usize {
+    let mut d = 0;
+    while let Some(sp) = diagram.branches[branch].parent {
+        branch = diagram.special_points[sp].branch;
+        d += 1;
+    }
+    d
+}
+
+fn rebuild_special(run: &mut Run, s: &SavedSpecial) -> Result<SpecialPoint, ContinuationError> {
+    run.tracker.reset();
+    let point: Point = run.point(s.unknowns.clone(), s.parameter, s.tangent.clone())?;
+    let (_, null_mode) = run
+        .tracker
+        .nearest_zero(run.family, &s.unknowns, s.parameter, s.block)?;
+    Ok(SpecialPoint {
+        kind: s.kind,
+        branch: s.branch,
+        index: s.index,
+        point,
+        block: s.block,
+        null_mode,
+        symmetry_breaking: s.symmetry_breaking,
+        children: vec![],
+        singularity: s.singularity,
+    })
+}
