@@ -40,29 +40,30 @@ pub fn run_continue(
             ),
         );
     };
-    let saved =
-        if resume && output.exists() {
-            match read_saved(&output) {
-                Ok((text, _)) if text != problem.text => return fail(
+    let saved = if resume && output.exists() {
+        match read_saved(&output) {
+            Ok((text, _)) if text != problem.text => {
+                return fail(
                     2,
                     format!(
                         "{}: made from a different problem (or other --set values); cannot resume",
                         output.display()
                     ),
-                ),
-                Ok((_, saved)) if saved.stop_reason == "completed" => {
-                    println!("nothing to resume: {} is complete", output.display());
-                    return ExitCode::SUCCESS;
-                }
-                Ok((_, saved)) => Some(saved),
-                Err(e) => return fail(2, format!("{}: cannot resume: {e}", output.display())),
+                )
             }
-        } else {
-            if let Err(e) = check_target(&output, force) {
-                return fail(2, e);
+            Ok((_, saved)) if saved.stop_reason == "completed" => {
+                println!("nothing to resume: {} is complete", output.display());
+                return ExitCode::SUCCESS;
             }
-            None
-        };
+            Ok((_, saved)) => Some(saved),
+            Err(e) => return fail(2, format!("{}: cannot resume: {e}", output.display())),
+        }
+    } else {
+        if let Err(e) = check_target(&output, force) {
+            return fail(2, e);
+        }
+        None
+    };
     let parameter_name = problem
         .text
         .lines()

@@ -8,6 +8,7 @@
 
 pub mod bench;
 pub mod bvp;
+pub mod cli;
 pub mod continuation;
 pub mod equations;
 pub mod io;

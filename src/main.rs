@@ -9,114 +9,11 @@ use std::process::ExitCode;
 mod continue_command;
 mod optimize_command;
 
-use clap::{Parser, Subcommand};
+use clap::Parser;
 use cosserat::bvp::{solve, Equilibrium};
+use cosserat::cli::{Cli, Command};
 use cosserat::io::{check_target, write_equilibrium, write_stability, Problem, StabilityResult};
 use cosserat::stability::{analyze, critical_load, CriticalLoad, Stability};
-
-#[derive(Parser)]
-#[command(
-    name = "cosserat",
-    version,
-    about = "Statics and stability of slender elastic rods"
-)]
-struct Cli {
-    #[command(subcommand)]
-    command: Command,
-}
-
-#[derive(Subcommand)]
-enum Command {
-    /// Solve for the equilibrium of a rod problem.
-    Solve {
-        /// The problem file (TOML).
-        problem: PathBuf,
-        /// Write the solution to this HDF5 file.
-        #[arg(short, long)]
-        output: Option<PathBuf>,
-        /// Override the solver method: "shooting", "multiple-shooting" or "collocation".
-        #[arg(long)]
-        method: Option<String>,
-        /// Override any key of the problem file, e.g. --set loads.tip_force=[5,0,0].
-        #[arg(long = "set", value_name = "KEY=VALUE")]
-        set: Vec<String>,
-        /// Overwrite an existing output file.
-        #[arg(long)]
-        force: bool,
-    },
-    /// Decide the stability of an equilibrium (lowest Hessian eigenvalues,
-    /// Morse index), or the critical load of a fixed loaded shape.
-    Stability {
-        /// The problem file (TOML).
-        problem: PathBuf,
-        /// Write the analysis to this HDF5 file.
-        #[arg(short, long)]
-        output: Option<PathBuf>,
-        /// Override any key of the problem file, e.g. --set stability.elements=400.
-        #[arg(long = "set", value_name = "KEY=VALUE")]
-        set: Vec<String>,
-        /// Overwrite an existing output file.
-        #[arg(long)]
-        force: bool,
-    },
-    /// Continue equilibria in a parameter ([continuation] table): branches,
-    /// tracked Hessian eigenvalues, folds, branch points, branch switching.
-    Continue {
-        /// The problem file (TOML).
-        problem: PathBuf,
-        /// The HDF5 bifurcation diagram to write.
-        #[arg(short, long)]
-        output: PathBuf,
-        /// Also draw the diagram (.png or .svg).
-        #[arg(long)]
-        plot: Option<PathBuf>,
-        /// Go on with an interrupted run saved in the output file.
-        #[arg(long)]
-        resume: bool,
-        /// Override any key of the problem file.
-        #[arg(long = "set", value_name = "KEY=VALUE")]
-        set: Vec<String>,
-        /// Overwrite an existing output file.
-        #[arg(long)]
-        force: bool,
-    },
-    /// The longest soft robotic arm of an [arm] table (paper Sec. 3–4).
-    Optimize {
-        /// The problem file (TOML).
-        problem: PathBuf,
-        /// Write the optimum to this HDF5 file.
-        #[arg(short, long)]
-        output: Option<PathBuf>,
-        /// Also continue the designed arm in its load from unloaded to the
-        /// design load and write that diagram (HDF5, with a PNG beside it).
-        #[arg(long)]
-        loading_path: Option<PathBuf>,
-        /// Override any key of the problem file.
-        #[arg(long = "set", value_name = "KEY=VALUE")]
-        set: Vec<String>,
-        /// Overwrite an existing output file.
-        #[arg(long)]
-        force: bool,
-    },
-    /// Draw a bifurcation diagram file.
-    Plot {
-        /// The HDF5 diagram from `cosserat continue`.
-        diagram: PathBuf,
-        /// The figure (.png or .svg).
-        #[arg(short, long, default_value = "diagram.png")]
-        output: PathBuf,
-        /// Vertical axis: tip_x, tip_y, tip_z, norm or tip_angle.
-        #[arg(long, default_value = "tip_x")]
-        measure: String,
-    },
-    /// Benchmarks: `cosserat bench work-precision [-o DIR]`.
-    Bench {
-        #[command(subcommand)]
-        which: cosserat::bench::BenchCommand,
-    },
-    /// Classical benchmarks against every method, with a Markdown report.
-    Validate(cosserat::validate::ValidateArgs),
-}
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
