@@ -41,13 +41,35 @@ pub fn run_optimize(
         arm.stability.elements,
         arm.stability.order
     );
+    let interrupted = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    {
+        let flag = interrupted.clone();
+        let _ = ctrlc::set_handler(move || flag.store(true, std::sync::atomic::Ordering::SeqCst));
+    }
     let t = Instant::now();
-    let Some(opt) = arm.optimize(search) else {
+    let stop = || interrupted.load(std::sync::atomic::Ordering::SeqCst);
+    let Some((opt, was_interrupted)) = arm.optimize_until(search, &stop) else {
         return fail(
             2,
             "no design with a finite critical load was found in the bounds",
         );
     };
+    if was_interrupted {
+        println!(
+            "interrupted: R* = {:.6} is the best design found so far",
+            opt.design.reach
+        );
+        if let Some(out) = &output {
+            if let Err(e) = write_arm(out, &problem.text, &opt, None, "interrupted", force) {
+                return fail(1, e);
+            }
+            eprintln!(
+                "interrupted: the best design so far is in {}",
+                out.display()
+            );
+        }
+        return ExitCode::from(130);
+    }
     let time = t.elapsed().as_secs_f64();
     let fmt = |v: &[f64]| {
         v.iter()
@@ -87,7 +109,14 @@ pub fn run_optimize(
         None
     };
     if let Some(out) = output {
-        if let Err(e) = write_arm(&out, &problem.text, &opt, straight_arm.as_ref(), force) {
+        if let Err(e) = write_arm(
+            &out,
+            &problem.text,
+            &opt,
+            straight_arm.as_ref(),
+            "completed",
+            force,
+        ) {
             return fail(1, e);
         }
         println!("written   {}", out.display());

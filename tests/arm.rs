@@ -114,3 +114,57 @@ fn circular_arm_loading_path_arrives_at_the_design() {
         last.eigenvalues
     );
 }
+
+/// Ctrl-C during `cosserat optimize` keeps the best design found so far in
+/// a valid file marked interrupted, and that design is what it claims.
+#[test]
+fn interrupted_optimization_keeps_its_best_design() {
+    let dir = std::env::temp_dir().join(format!("cosserat-opt-int-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = dir.join("arm.h5");
+    let file = format!("{}/problems/longest_arm.toml", env!("CARGO_MANIFEST_DIR"));
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_cosserat"))
+        .args([
+            "optimize",
+            &file,
+            "-o",
+            out.to_str().unwrap(),
+            "--set",
+            "arm.samples=20000",
+        ])
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let _ = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status();
+    assert_eq!(child.wait().unwrap().code(), Some(130));
+    let f = hdf5::File::open(&out).unwrap();
+    let reason = f
+        .attr("stop_reason")
+        .unwrap()
+        .read_scalar::<hdf5::types::VarLenUnicode>()
+        .unwrap();
+    assert_eq!(reason.as_str(), "interrupted");
+    let reach = f
+        .dataset("optimum/reach")
+        .unwrap()
+        .read_scalar::<f64>()
+        .unwrap();
+    let c = f
+        .dataset("optimum/shape_coefficients")
+        .unwrap()
+        .read_raw::<f64>()
+        .unwrap();
+    let p = cosserat::io::Problem::from_path(std::path::Path::new(&file), &[]).unwrap();
+    let (arm, _, _) = p.arm.unwrap();
+    let again = arm.design(&c[1..]).unwrap();
+    assert!(
+        (again.reach - reach).abs() < 1e-12 && reach > 1.0,
+        "{reach} vs {}",
+        again.reach
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}

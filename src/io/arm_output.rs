@@ -3,7 +3,8 @@
 //! `/optimum/loaded_shape` (n×3), `/optimum/unloaded_shape` (n×3),
 //! `/optimum/intrinsic_curvature` (n), `/straight/reach`, `/straight/gamma_crit`,
 //! `/straight/clamp_angle`, `/straight/loaded_shape`; the problem text as the
-//! root attribute `problem`.
+//! root attribute `problem`, and `stop_reason` (`completed` or
+//! `interrupted`: then /optimum is the best design found so far).
 
 use std::path::Path;
 
@@ -28,10 +29,12 @@ pub fn write_arm(
     problem: &str,
     optimum: &ArmOptimum,
     straight: Option<&StraightArm>,
+    stop_reason: &str,
     force: bool,
 ) -> Result<(), OutputError> {
     write_atomically(path, force, |file| {
         string_attr(file, "problem", problem)?;
+        string_attr(file, "stop_reason", stop_reason)?;
         let g = file.create_group("optimum")?;
         scalar(&g, "reach", optimum.design.reach)?;
         scalar(&g, "gamma_crit", optimum.design.gamma)?;

@@ -180,27 +180,44 @@ impl ArmProblem {
     /// The best design: Halton samples of the box, then Nelder–Mead from
     /// the best few.
     pub fn optimize(&self, opts: &SearchOptions) -> Option<ArmOptimum> {
+        self.optimize_until(opts, &|| false).map(|(o, _)| o)
+    }
+
+    /// As [`Self::optimize`], stopping early when `stop()` turns true (an
+    /// interrupt): then the best design found so far is returned, flagged.
+    pub fn optimize_until(
+        &self,
+        opts: &SearchOptions,
+        stop: &dyn Fn() -> bool,
+    ) -> Option<(ArmOptimum, bool)> {
         let dim = self.bounds.len();
         let mut evaluations = 0;
-        let mut sampled: Vec<(f64, Vec<f64>)> = (1..=opts.samples)
-            .filter_map(|i| {
-                let p: Vec<f64> = self
-                    .bounds
-                    .iter()
-                    .enumerate()
-                    .map(|(d, (lo, hi))| lo + (hi - lo) * halton(i, PRIMES[d % PRIMES.len()]))
-                    .collect();
-                evaluations += 1;
-                self.design(&p).map(|d| (d.reach, p))
-            })
-            .collect();
+        let mut sampled: Vec<(f64, Vec<f64>)> = vec![];
+        for i in 1..=opts.samples {
+            if stop() {
+                break;
+            }
+            let p: Vec<f64> = self
+                .bounds
+                .iter()
+                .enumerate()
+                .map(|(d, (lo, hi))| lo + (hi - lo) * halton(i, PRIMES[d % PRIMES.len()]))
+                .collect();
+            evaluations += 1;
+            if let Some(d) = self.design(&p) {
+                sampled.push((d.reach, p));
+            }
+        }
         if dim == 0 {
-            return self.finish(self.design(&[])?, evaluations);
+            return Some((self.finish(self.design(&[])?, evaluations)?, false));
         }
         sampled.sort_by(|a, b| b.0.total_cmp(&a.0));
-        let mut best: Option<ArmDesign> = None;
+        let mut best: Option<ArmDesign> = sampled.first().and_then(|(_, p)| self.design(p));
         for (_, start) in sampled.iter().take(opts.starts) {
-            let (design, used) = self.polish(start, opts.iterations);
+            if stop() {
+                break;
+            }
+            let (design, used) = self.polish(start, opts.iterations, stop);
             evaluations += used;
             if let Some(d) = design {
                 if best.as_ref().is_none_or(|b| d.reach > b.reach) {
@@ -208,11 +225,16 @@ impl ArmProblem {
                 }
             }
         }
-        self.finish(best?, evaluations)
+        Some((self.finish(best?, evaluations)?, stop()))
     }
 
     /// Nelder–Mead from `start` on −R̂ (projected into the bounds).
-    fn polish(&self, start: &[f64], iterations: u64) -> (Option<ArmDesign>, usize) {
+    fn polish(
+        &self,
+        start: &[f64],
+        iterations: u64,
+        stop: &dyn Fn() -> bool,
+    ) -> (Option<ArmDesign>, usize) {
         let simplex: Vec<Vec<f64>> = std::iter::once(start.to_vec())
             .chain((0..start.len()).map(|d| {
                 let mut p = start.to_vec();
@@ -228,6 +250,7 @@ impl ArmProblem {
             .collect();
         let cost = ReachCost {
             problem: self,
+            stop,
             calls: std::cell::Cell::new(0),
         };
         let Ok(solver) = NelderMead::new(simplex).with_sd_tolerance(1e-12) else {
@@ -329,6 +352,7 @@ fn halton(mut i: usize, b: usize) -> f64 {
 /// charged their squared distance.
 struct ReachCost<'a> {
     problem: &'a ArmProblem,
+    stop: &'a dyn Fn() -> bool,
     calls: std::cell::Cell<usize>,
 }
 
@@ -337,6 +361,9 @@ impl CostFunction for &ReachCost<'_> {
     type Output = f64;
 
     fn cost(&self, p: &Vec<f64>) -> Result<f64, ArgminError> {
+        if (self.stop)() {
+            return Err(ArgminError::msg("interrupted"));
+        }
         self.calls.set(self.calls.get() + 1);
         let q = self.problem.project(p);
         let outside: f64 = p.iter().zip(&q).map(|(a, b)| (a - b).powi(2)).sum();
