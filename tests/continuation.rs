@@ -339,31 +339,37 @@ fn cli_writes_the_diagram_contract_and_a_plot() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
+/// `cosserat continue` on the Euler column with the arclength step fixed
+/// at `step`, so that the run lasts long enough to be interrupted.
+fn slow_euler(out: &Path, step: &str, extra: &[&str]) -> std::process::Command {
+    let file = format!("{}/problems/euler_column.toml", env!("CARGO_MANIFEST_DIR"));
+    let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_cosserat"));
+    c.args(["continue", &file, "-o", out.to_str().unwrap()])
+        .args(["--set", &format!("continuation.step={step}")])
+        .args(["--set", &format!("continuation.max_step={step}")])
+        .args(["--set", "continuation.max_points=100000"])
+        .args(extra)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null());
+    c
+}
+
+/// Sends SIGINT after `ms` milliseconds and waits for the exit.
+fn interrupt_after(child: &mut std::process::Child, ms: u64) -> std::process::ExitStatus {
+    std::thread::sleep(std::time::Duration::from_millis(ms));
+    let _ = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status();
+    child.wait().unwrap()
+}
+
 #[test]
 fn interrupted_run_keeps_its_points() {
     let dir = std::env::temp_dir().join(format!("cosserat-int-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let out = dir.join("slow.h5");
-    let file = format!("{}/problems/euler_column.toml", env!("CARGO_MANIFEST_DIR"));
-    // Tiny steps make the run last long enough to be interrupted.
-    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_cosserat"))
-        .args(["continue", &file, "-o", out.to_str().unwrap()])
-        .args([
-            "--set",
-            "continuation.step=0.0005",
-            "--set",
-            "continuation.max_step=0.0005",
-        ])
-        .args(["--set", "continuation.max_points=100000"])
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
-    std::thread::sleep(std::time::Duration::from_millis(2600));
-    let _ = std::process::Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status();
-    let status = child.wait().unwrap();
+    let mut child = slow_euler(&out, "0.0005", &[]).spawn().unwrap();
+    let status = interrupt_after(&mut child, 2600);
     assert_eq!(status.code(), Some(130), "interrupted runs exit with 130");
     let f = hdf5::File::open(&out).unwrap();
     let reason = f
@@ -390,20 +396,7 @@ fn killed_run_leaves_its_last_checkpoint() {
     let dir = std::env::temp_dir().join(format!("cosserat-kill-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let out = dir.join("slow.h5");
-    let file = format!("{}/problems/euler_column.toml", env!("CARGO_MANIFEST_DIR"));
-    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_cosserat"))
-        .args(["continue", &file, "-o", out.to_str().unwrap()])
-        .args([
-            "--set",
-            "continuation.step=0.0005",
-            "--set",
-            "continuation.max_step=0.0005",
-        ])
-        .args(["--set", "continuation.max_points=100000"])
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
+    let mut child = slow_euler(&out, "0.0005", &[]).spawn().unwrap();
     std::thread::sleep(std::time::Duration::from_millis(3500));
     child.kill().unwrap();
     let _ = child.wait();
@@ -421,31 +414,11 @@ fn interrupted_run_resumes_to_the_same_diagram() {
     let dir = std::env::temp_dir().join(format!("cosserat-resume-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let (partial, full) = (dir.join("partial.h5"), dir.join("full.h5"));
-    let file = format!("{}/problems/euler_column.toml", env!("CARGO_MANIFEST_DIR"));
-    let sets = [
-        "--set",
-        "continuation.step=0.004",
-        "--set",
-        "continuation.max_step=0.004",
-        "--set",
-        "continuation.max_points=100000",
-    ];
-    let command = |out: &Path, extra: &[&str]| {
-        let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_cosserat"));
-        c.args(["continue", &file, "-o", out.to_str().unwrap()])
-            .args(sets)
-            .args(extra)
-            .stdout(std::process::Stdio::null())
-            .stderr(std::process::Stdio::null());
-        c
-    };
+    let command = |out: &Path, extra: &[&str]| slow_euler(out, "0.004", extra);
     let mut child = command(&partial, &[]).spawn().unwrap();
-    std::thread::sleep(std::time::Duration::from_millis(1500));
-    let _ = std::process::Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status();
+    let status = interrupt_after(&mut child, 1500);
     assert_eq!(
-        child.wait().unwrap().code(),
+        status.code(),
         Some(130),
         "the run should still be going at 1.5 s"
     );
