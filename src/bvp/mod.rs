@@ -244,6 +244,7 @@ pub fn equations(rod: &Rod, level: ModelLevel) -> Box<dyn RodEquations> {
     match level {
         ModelLevel::Planar => Box::new(PlanarEquations::new(rod.clone())),
         ModelLevel::Kirchhoff => Box::new(KirchhoffEquations::new(rod.clone())),
+        ModelLevel::Cosserat => Box::new(KirchhoffEquations::cosserat(rod.clone())),
     }
 }
 
@@ -486,7 +487,7 @@ fn guess_for_level(
     }
     Ok(match level {
         ModelLevel::Planar => vec![g[1]],
-        ModelLevel::Kirchhoff => {
+        ModelLevel::Kirchhoff | ModelLevel::Cosserat => {
             debug_assert_eq!(eq.unknowns(), 3);
             g.to_vec()
         }

@@ -72,7 +72,8 @@ impl Run<'_> {
     fn representable(&self, block: Block) -> bool {
         matches!(
             (self.family.level(), block),
-            (ModelLevel::Kirchhoff, _) | (ModelLevel::Planar, Block::InPlane)
+            (ModelLevel::Kirchhoff | ModelLevel::Cosserat, _)
+                | (ModelLevel::Planar, Block::InPlane)
         )
     }
 

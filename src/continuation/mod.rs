@@ -314,7 +314,7 @@ impl<'a> Run<'a> {
     fn new(family: &'a Family, opts: &'a ContinuationOptions) -> Self {
         let blocks = match family.level() {
             ModelLevel::Planar => vec![Block::InPlane, Block::OutOfPlane],
-            ModelLevel::Kirchhoff => vec![Block::Full],
+            ModelLevel::Kirchhoff | ModelLevel::Cosserat => vec![Block::Full],
         };
         Run {
             family,

@@ -12,6 +12,12 @@
 //!
 //! State y = (d1, d2, κ, r), 12 numbers; three unknowns κ(0); three tip
 //! conditions M_i(L) = C·d_i(L) (paper (22) with a tip couple C).
+//!
+//! The same equations carry the Cosserat level (shear and extension,
+//! [`crate::model::Shearable`]): with the compliance c = S⁻¹ the strain is
+//! ν = e3 + c∘N, the tangent r' = ν_i d_i and the moment balance
+//! m' + r' × n = 0 reads M' = M × κ + N × ν. With c = 0 this is the
+//! Kirchhoff rod exactly.
 
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
@@ -19,10 +25,13 @@ use super::planar::straight_rod_clamp_moment;
 use super::{RodEquations, RodSample};
 use crate::model::Rod;
 
-/// The 9-ODE Kirchhoff equations (12 with the position).
+/// The 9-ODE Kirchhoff equations (12 with the position), or the Cosserat
+/// ones when the compliance is non-zero.
 #[derive(Debug, Clone)]
 pub struct KirchhoffEquations {
     rod: Rod,
+    /// c = S⁻¹ (1/N): zero for the Kirchhoff rod.
+    compliance: Vector3<f64>,
 }
 
 /// The state unpacked.
@@ -58,12 +67,28 @@ struct Balance {
     rate: Vector3<f64>,
     /// n(s), global.
     n: Vector3<f64>,
+    /// The strain ν = e3 + c∘N (e3 for the Kirchhoff rod).
+    nu: Vector3<f64>,
 }
 
 impl KirchhoffEquations {
-    /// The spatial equations of a rod.
+    /// The spatial Kirchhoff equations of a rod (unshearable and
+    /// inextensible, whatever the energy's shear part).
     pub fn new(rod: Rod) -> Self {
-        KirchhoffEquations { rod }
+        KirchhoffEquations {
+            rod,
+            compliance: Vector3::zeros(),
+        }
+    }
+
+    /// The Cosserat equations: shear and extension from the energy's
+    /// stiffnesses S (Kirchhoff when the energy has none).
+    pub fn cosserat(rod: Rod) -> Self {
+        let compliance = rod
+            .energy
+            .shear_stiffness(0.0)
+            .map_or_else(Vector3::zeros, |s| s.map(|v| 1.0 / v));
+        KirchhoffEquations { rod, compliance }
     }
 
     fn balance(&self, s: f64, st: &State) -> Balance {
@@ -74,8 +99,9 @@ impl KirchhoffEquations {
             .unwrap_or_else(|| Matrix3::from_element(f64::NAN));
         let m = e.moment(s, &st.kappa);
         let n = self.rod.loads.internal_force(s, self.rod.length);
-        let body_n = Vector3::new(n.dot(&st.d1), n.dot(&st.d2), 0.0);
-        let q = m.cross(&st.kappa) + body_n.cross(&Vector3::z());
+        let body_n = Vector3::new(n.dot(&st.d1), n.dot(&st.d2), n.dot(&st.d3));
+        let nu = Vector3::z() + self.compliance.component_mul(&body_n);
+        let q = m.cross(&st.kappa) + body_n.cross(&nu);
         let rate = h_inv * (q - e.moment_rate(s, &st.kappa));
         Balance {
             h_inv,
@@ -83,17 +109,19 @@ impl KirchhoffEquations {
             m,
             rate,
             n,
+            nu,
         }
     }
 
-    fn write_rates(st: &State, rate: &Vector3<f64>, dy: &mut [f64]) {
+    fn write_rates(st: &State, b: &Balance, dy: &mut [f64]) {
         let k = st.kappa;
         let dd1 = st.d2 * k[2] - st.d3 * k[1];
         let dd2 = st.d3 * k[0] - st.d1 * k[2];
+        let dr = st.d1 * b.nu[0] + st.d2 * b.nu[1] + st.d3 * b.nu[2];
         dy[0..3].copy_from_slice(dd1.as_slice());
         dy[3..6].copy_from_slice(dd2.as_slice());
-        dy[6..9].copy_from_slice(rate.as_slice());
-        dy[9..12].copy_from_slice(st.d3.as_slice());
+        dy[6..9].copy_from_slice(b.rate.as_slice());
+        dy[9..12].copy_from_slice(dr.as_slice());
     }
 }
 
@@ -129,14 +157,14 @@ impl RodEquations for KirchhoffEquations {
     fn rhs(&self, s: f64, y: &[f64], dy: &mut [f64]) {
         let st = State::read(y);
         let b = self.balance(s, &st);
-        Self::write_rates(&st, &b.rate, dy);
+        Self::write_rates(&st, &b, dy);
     }
 
     /// The linearization along (δd1, δd2, δκ, δr):
     /// δd3 = δd1 × d2 + d1 × δd2, δd1' = δκ3 d2 + κ3 δd2 − δκ2 d3 − κ2 δd3,
-    /// δd2' = δκ1 d3 + κ1 δd3 − δκ3 d1 − κ3 δd1, δr' = δd3, and
-    /// δκ' = H⁻¹ (Hδκ × κ + M × δκ + δN × e3 − ∂sH δκ − ∂κ(Hκ')δκ),
-    /// δN_i = n·δd_i.
+    /// δd2' = δκ1 d3 + κ1 δd3 − δκ3 d1 − κ3 δd1, δr' = δ(ν_i d_i), and
+    /// δκ' = H⁻¹ (Hδκ × κ + M × δκ + δN × ν + N × δν − ∂sH δκ − ∂κ(Hκ')δκ),
+    /// δN_i = n·δd_i, δν = c∘δN.
     fn rhs_linearized(
         &self,
         s: f64,
@@ -148,7 +176,8 @@ impl RodEquations for KirchhoffEquations {
     ) {
         let st = State::read(y);
         let b = self.balance(s, &st);
-        Self::write_rates(&st, &b.rate, dy);
+        Self::write_rates(&st, &b, dy);
+        let body_n = Vector3::new(b.n.dot(&st.d1), b.n.dot(&st.d2), b.n.dot(&st.d3));
         let e = &self.rod.energy;
         let k = st.kappa;
         let kappa_jac = e.stiffness_rate(s, &k) + e.stiffness_derivative(s, &k, &b.rate);
@@ -161,13 +190,20 @@ impl RodEquations for KirchhoffEquations {
             let dd3 = dd1.cross(&st.d2) + st.d1.cross(&dd2);
             let r1 = st.d2 * dk[2] + dd2 * k[2] - st.d3 * dk[1] - dd3 * k[1];
             let r2 = st.d3 * dk[0] + dd3 * k[0] - st.d1 * dk[2] - dd1 * k[2];
-            let dn = Vector3::new(b.n.dot(&dd1), b.n.dot(&dd2), 0.0);
-            let dq = (b.h * dk).cross(&k) + b.m.cross(&dk) + dn.cross(&Vector3::z());
+            let dn = Vector3::new(b.n.dot(&dd1), b.n.dot(&dd2), b.n.dot(&dd3));
+            let dnu = self.compliance.component_mul(&dn);
+            let dq = (b.h * dk).cross(&k) + b.m.cross(&dk) + dn.cross(&b.nu) + body_n.cross(&dnu);
             let rk = b.h_inv * (dq - kappa_jac * dk);
+            let dr = dd1 * b.nu[0]
+                + dd2 * b.nu[1]
+                + dd3 * b.nu[2]
+                + st.d1 * dnu[0]
+                + st.d2 * dnu[1]
+                + st.d3 * dnu[2];
             out[0..3].copy_from_slice(r1.as_slice());
             out[3..6].copy_from_slice(r2.as_slice());
             out[6..9].copy_from_slice(rk.as_slice());
-            out[9..12].copy_from_slice(dd3.as_slice());
+            out[9..12].copy_from_slice(dr.as_slice());
         }
     }
 

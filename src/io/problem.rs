@@ -21,7 +21,7 @@ use crate::bvp::{Method, SolverOptions, Strategy};
 use crate::continuation::{ContinuationOptions, Family, Parameter};
 use crate::model::{
     Clamp, DeadLoads, LinearElastic, ModelChoice, ModelLevel, Profile, QuarticStiffening, Rod,
-    StoredEnergy,
+    Shearable, StoredEnergy,
 };
 use crate::optimize::{ArmProblem, SearchOptions};
 use crate::stability::{FixedShape, StabilityOptions};
@@ -147,6 +147,11 @@ pub struct EnergySection {
     /// C (N·m⁴) of the quartic energy.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub quartic: Option<f64>,
+    /// Shear and extension stiffnesses (k G A, k G A, E A) in N: a
+    /// shearable, extensible Cosserat rod. Absent: unshearable and
+    /// inextensible (Kirchhoff).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shear: Option<[f64; 3]>,
 }
 
 fn default_energy_kind() -> String {
@@ -390,7 +395,7 @@ impl Problem {
         let file: ProblemFile =
             toml::from_str(&text).map_err(|e| ProblemError::Parse(e.to_string()))?;
         let rod = build_rod(&file)?;
-        let model = choose_model(&rod, &file.solver.model)?;
+        let model = choose_model(&rod, &file.solver.model, file.energy.shear.is_some())?;
         let options = build_options(&file.solver)?;
         let shape = build_shape(&file)?;
         let stability = build_stability(&file.stability)?;
@@ -516,9 +521,22 @@ fn build_rod(file: &ProblemFile) -> Result<Rod, ProblemError> {
             format!("must be positive, got {length}"),
         ));
     }
+    let mut energy = build_energy(&file.energy, length)?;
+    if let Some(shear) = file.energy.shear {
+        // A level forced below Cosserat takes the unshearable limit.
+        if !matches!(
+            file.solver.model.as_str(),
+            "planar" | "kirchhoff" | "spatial"
+        ) {
+            energy = Arc::new(Shearable {
+                bending: energy,
+                shear: shear_stiffness(shear)?,
+            });
+        }
+    }
     Ok(Rod {
         length,
-        energy: build_energy(&file.energy, length)?,
+        energy,
         clamp: build_clamp(&file.clamp)?,
         loads: DeadLoads {
             tip_force: vector("loads.tip_force", file.loads.tip_force)?,
@@ -526,6 +544,18 @@ fn build_rod(file: &ProblemFile) -> Result<Rod, ProblemError> {
             distributed_force: vector("loads.distributed_force", file.loads.distributed_force)?,
         },
     })
+}
+
+/// S = (k G A, k G A, E A): positive and finite.
+fn shear_stiffness(shear: [f64; 3]) -> Result<nalgebra::Vector3<f64>, ProblemError> {
+    for (i, v) in shear.iter().enumerate() {
+        let field = format!("energy.shear[{i}]");
+        let v = finite(&field, *v)?;
+        if v <= 0.0 {
+            return Err(invalid(field, format!("must be positive, got {v}")));
+        }
+    }
+    Ok(nalgebra::Vector3::from(shear))
 }
 
 fn build_energy(e: &EnergySection, length: f64) -> Result<Arc<dyn StoredEnergy>, ProblemError> {
@@ -603,19 +633,30 @@ fn turned(clamp: &Clamp, angle: f64) -> nalgebra::Matrix3<f64> {
     nalgebra::Rotation3::from_axis_angle(&axis, angle).matrix() * clamp.frame
 }
 
-fn choose_model(rod: &Rod, model: &str) -> Result<ModelChoice, ProblemError> {
+/// The model level: automatic, or forced by `solver.model`. `sheared` says
+/// whether the file gave shear stiffnesses (dropped by `build_rod` when a
+/// lower level is forced, which the reason then says).
+fn choose_model(rod: &Rod, model: &str, sheared: bool) -> Result<ModelChoice, ProblemError> {
     let level = match model {
         "auto" => return Ok(ModelChoice::for_rod(rod)),
         "planar" => ModelLevel::Planar,
         "kirchhoff" | "spatial" => ModelLevel::Kirchhoff,
+        "cosserat" => ModelLevel::Cosserat,
         other => {
             return Err(invalid(
                 "solver.model",
-                format!("unknown model `{other}`; expected \"auto\", \"planar\" or \"kirchhoff\""),
+                format!(
+                    "unknown model `{other}`; expected \"auto\", \"planar\", \"kirchhoff\" \
+                     or \"cosserat\""
+                ),
             ))
         }
     };
-    ModelChoice::forced(rod, level).map_err(|m| invalid("solver.model", m))
+    let mut choice = ModelChoice::forced(rod, level).map_err(|m| invalid("solver.model", m))?;
+    if sheared && level != ModelLevel::Cosserat {
+        choice.reason += "; energy.shear ignored (the unshearable, inextensible limit)";
+    }
+    Ok(choice)
 }
 
 /// The family of a `[continuation]` table, discretized by the solver's

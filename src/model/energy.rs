@@ -39,6 +39,12 @@ pub trait StoredEnergy: std::fmt::Debug + Send + Sync {
     fn is_quadratic(&self) -> bool {
         false
     }
+    /// The stiffnesses S = (S1, S2, S3) of a quadratic shear and extension
+    /// energy ½ (ν − e3)ᵀ diag(S) (ν − e3) at s (see [`super::Shearable`]);
+    /// None for an unshearable, inextensible (Kirchhoff) rod.
+    fn shear_stiffness(&self, _s: f64) -> Option<Vector3<f64>> {
+        None
+    }
 }
 
 /// The linear-elastic energy with intrinsic curvature,

@@ -1,6 +1,7 @@
 //! The model level a scene needs: "model no more than a scene needs"
 //! (DESIGN.md). A planar scene runs the 4-ODE planar model, a spatial one the
-//! 9-ODE Kirchhoff model; the choice comes with its reason.
+//! 9-ODE Kirchhoff model, a shearable, extensible one the Cosserat model;
+//! the choice comes with its reason.
 
 use super::Rod;
 
@@ -11,6 +12,9 @@ pub enum ModelLevel {
     Planar,
     /// The spatial Kirchhoff rod: d1, d2, κ (9 ODEs) plus r by quadrature.
     Kirchhoff,
+    /// The Cosserat rod with shear and extension (ν = e3 + S⁻¹N): the same
+    /// 9 ODEs with r' = ν_i d_i and N × ν in the moment balance.
+    Cosserat,
 }
 
 impl ModelLevel {
@@ -19,6 +23,7 @@ impl ModelLevel {
         match self {
             ModelLevel::Planar => "planar",
             ModelLevel::Kirchhoff => "kirchhoff",
+            ModelLevel::Cosserat => "cosserat",
         }
     }
 }
@@ -36,10 +41,19 @@ pub struct ModelChoice {
 const PLANE_TOLERANCE: f64 = 1e-12;
 
 impl ModelChoice {
-    /// The least level that represents the scene exactly: planar when the
+    /// The least level that represents the scene exactly: Cosserat when the
+    /// energy has shear and extension stiffnesses; else planar when the
     /// energy admits planar bending about d2(0) and every load keeps the rod
     /// in the plane of d1(0), d3(0); Kirchhoff otherwise.
     pub fn for_rod(rod: &Rod) -> ModelChoice {
+        if rod.energy.shear_stiffness(0.0).is_some() {
+            return ModelChoice {
+                level: ModelLevel::Cosserat,
+                reason: "cosserat: the energy has finite shear and extension stiffnesses \
+                         (energy.shear)"
+                    .into(),
+            };
+        }
         match planar_obstruction(rod) {
             None => ModelChoice {
                 level: ModelLevel::Planar,
@@ -54,10 +68,21 @@ impl ModelChoice {
         }
     }
 
-    /// A level forced by the user; forcing planar on a spatial scene is an
-    /// error naming the obstruction.
+    /// A level forced by the user. Forcing planar on a spatial scene is an
+    /// error naming the obstruction; the Cosserat level needs shear and
+    /// extension stiffnesses, and a shearable rod needs the Cosserat level
+    /// (drop the shear part of the energy for the Kirchhoff limit).
     pub fn forced(rod: &Rod, level: ModelLevel) -> Result<ModelChoice, String> {
+        let shearable = rod.energy.shear_stiffness(0.0).is_some();
         match (level, planar_obstruction(rod)) {
+            (ModelLevel::Cosserat, _) if !shearable => Err(
+                "the Cosserat level needs shear and extension stiffnesses (energy.shear)".into(),
+            ),
+            (ModelLevel::Planar | ModelLevel::Kirchhoff, _) if shearable => Err(format!(
+                "the {} model is unshearable and inextensible, but the energy has \
+                 shear and extension stiffnesses (energy.shear)",
+                level.name()
+            )),
             (ModelLevel::Planar, Some(why)) => Err(format!(
                 "the planar model cannot represent this scene: {why}"
             )),

@@ -1,5 +1,5 @@
 //! What a rod is: its stored energy, its clamp, the dead loads on it, and the
-//! least model level (planar or spatial) that the scene needs.
+//! least model level (planar, Kirchhoff or Cosserat) that the scene needs.
 //!
 //! This stage knows nothing of how equilibria are computed.
 
@@ -8,9 +8,11 @@ mod level;
 mod loads;
 mod profile;
 mod rod;
+mod shear;
 
 pub use energy::{LinearElastic, QuarticStiffening, StoredEnergy};
 pub use level::{ModelChoice, ModelLevel};
 pub use loads::DeadLoads;
 pub use profile::Profile;
 pub use rod::{Clamp, Rod};
+pub use shear::Shearable;

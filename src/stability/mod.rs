@@ -87,7 +87,8 @@ pub struct Stability {
     pub nodes: Vec<f64>,
 }
 
-/// The quadratic-form coefficients at equilibrium samples.
+/// The quadratic-form coefficients at equilibrium samples (with the shear
+/// and extension terms when the energy has them: the Cosserat level).
 pub fn coefficients(rod: &Rod, samples: &[RodSample]) -> Vec<FormCoefficients> {
     samples
         .iter()
@@ -95,7 +96,11 @@ pub fn coefficients(rod: &Rod, samples: &[RodSample]) -> Vec<FormCoefficients> {
             let frame = nalgebra::Matrix3::from_columns(&p.directors);
             let body_force = frame.transpose() * p.force;
             let h = rod.energy.stiffness(p.s, &p.curvature);
-            FormCoefficients::at(&h, &p.curvature, &p.moment, &body_force)
+            let compliance = rod
+                .energy
+                .shear_stiffness(p.s)
+                .map_or_else(Vector3::zeros, |s| s.map(|v| 1.0 / v));
+            FormCoefficients::sheared(&h, &p.curvature, &p.moment, &body_force, &compliance)
         })
         .collect()
 }
@@ -147,7 +152,7 @@ pub fn analyze(
     let coeffs = coefficients(rod, &samples);
     let blocks = match eq.model.level {
         ModelLevel::Planar => vec![Block::InPlane, Block::OutOfPlane],
-        ModelLevel::Kirchhoff => vec![Block::Full],
+        ModelLevel::Kirchhoff | ModelLevel::Cosserat => vec![Block::Full],
     };
     let blocks = blocks
         .into_iter()

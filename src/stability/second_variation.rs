@@ -22,6 +22,20 @@
 //! H = ∂²W/∂κ², M = ∂W/∂κ. At an equilibrium this does not depend on how
 //! the second-order part of the perturbation is chosen.
 //!
+//! # Shear and extension (the Cosserat level)
+//!
+//! With W(κ, ν) = W_b(κ) + ½ (ν − e3)ᵀ S (ν − e3) the load term is
+//! −∫ N·ν ds with ν an independent field (r' = Rν, r(L) free). Along
+//! ν_ε = ν + εη the terms in η are ηᵀSη − 2 (N × ω)·η, and e3 becomes ν in
+//! the last term above. η enters without derivatives, so it is minimized
+//! out pointwise, η = S⁻¹(N × ω), leaving
+//!
+//!   δ²V = … − N·(ω×(ω×ν)) − (N × ω)ᵀ S⁻¹ (N × ω),
+//!
+//! a form in ω alone with the same structure. For a column under a thrust P
+//! this gives B (π/2L)² = P (1 − P/S3) + P²/S1: Haringx's critical load when
+//! S3 → ∞ (tests/cosserat.rs).
+//!
 //! For the linear energy at a planar equilibrium (κ = κ2 e2, M = M2 e2,
 //! N = (F cos φ, 0, F sin φ)) and ω = (ψ, ζ, χ) this is the paper's (45):
 //! B1(ψ' + κ2χ)² + B2ζ'² + B3(χ' − κ2ψ)² + F(−ψχ cos φ + (ζ² + ψ²) sin φ)
@@ -51,7 +65,8 @@ pub struct FormCoefficients {
     pub a: Matrix3<f64>,
     /// B = H[κ]× − ½[M]×.
     pub b: Matrix3<f64>,
-    /// C = [κ]×ᵀH[κ]× + sym(Mκᵀ) − (M·κ)I − sym(Ne3ᵀ) + N3 I.
+    /// C = [κ]×ᵀH[κ]× + sym(Mκᵀ) − (M·κ)I − sym(Nνᵀ) + (N·ν) I
+    ///     − [N]×ᵀ S⁻¹ [N]× (ν = e3 and S⁻¹ = 0 for the Kirchhoff rod).
     pub c: Matrix3<f64>,
 }
 
@@ -68,16 +83,30 @@ impl FormCoefficients {
         moment: &Vector3<f64>,
         force: &Vector3<f64>,
     ) -> Self {
+        Self::sheared(h, kappa, moment, force, &Vector3::zeros())
+    }
+
+    /// The same for a shearable, extensible rod with compliance
+    /// c = S⁻¹ = (1/S1, 1/S2, 1/S3): the strain is ν = e3 + c∘N.
+    pub fn sheared(
+        h: &Matrix3<f64>,
+        kappa: &Vector3<f64>,
+        moment: &Vector3<f64>,
+        force: &Vector3<f64>,
+        compliance: &Vector3<f64>,
+    ) -> Self {
         let k = kappa.cross_matrix();
-        let e3 = Vector3::z();
+        let nu = Vector3::z() + compliance.component_mul(force);
+        let nx = force.cross_matrix();
         let id = Matrix3::identity();
         FormCoefficients {
             a: *h,
             b: h * k - moment.cross_matrix() * 0.5,
             c: sym(k.transpose() * h * k) + sym(moment * kappa.transpose())
                 - id * moment.dot(kappa)
-                - sym(force * e3.transpose())
-                + id * force[2],
+                - sym(force * nu.transpose())
+                + id * force.dot(&nu)
+                - nx.transpose() * Matrix3::from_diagonal(compliance) * nx,
         }
     }
 
