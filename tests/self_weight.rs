@@ -93,7 +93,10 @@ fn large_deflection_converges_at_the_method_order() {
             ..Default::default()
         };
         let other = solve_with(&rod, opts).tip().position[0];
-        assert!((other - converged).abs() < 1e-8, "{method:?}: {other} vs {converged}");
+        assert!(
+            (other - converged).abs() < 1e-8,
+            "{method:?}: {other} vs {converged}"
+        );
     }
     // Large indeed: the tip has swung well past a third of the length.
     assert!(converged > 0.5, "{converged}");

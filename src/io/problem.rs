@@ -6,6 +6,7 @@
 //! go through exactly the same checks. The reference of every key is in
 //! docs/problem-files.md.
 
+use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -20,8 +21,8 @@ use crate::bvp::newton::NewtonOptions;
 use crate::bvp::{Method, SolverOptions, Strategy};
 use crate::continuation::{ContinuationOptions, Family, Parameter};
 use crate::model::{
-    Clamp, DeadLoads, LinearElastic, ModelChoice, ModelLevel, Profile, QuarticStiffening, Rod,
-    Shearable, StoredEnergy,
+    Clamp, DeadLoads, EnergyCatalog, EnergySpec, ModelChoice, ModelLevel, Profile, Rod, Shearable,
+    StoredEnergy,
 };
 use crate::optimize::{ArmProblem, SearchOptions};
 use crate::stability::{FixedShape, StabilityOptions};
@@ -136,7 +137,8 @@ pub struct RodSection {
 #[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct EnergySection {
-    /// "linear" or "quartic".
+    /// A name in the energy catalog: "linear", "quartic", or one a program
+    /// registered ([`EnergyCatalog::register`]).
     #[serde(default = "default_energy_kind")]
     pub kind: String,
     /// B1, B2, B3 (N·m²), each a profile.
@@ -144,9 +146,13 @@ pub struct EnergySection {
     /// κ⁰ body components (1/m), each a profile.
     #[serde(default)]
     pub intrinsic_curvature: [ProfileSpec; 3],
-    /// C (N·m⁴) of the quartic energy.
+    /// C (N·m⁴) of the quartic energy (shorthand for
+    /// `parameters.quartic`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub quartic: Option<f64>,
+    /// Further numbers of a registered energy (`[energy.parameters]`).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub parameters: BTreeMap<String, f64>,
     /// Shear and extension stiffnesses (k G A, k G A, E A) in N: a
     /// shearable, extensible Cosserat rod. Absent: unshearable and
     /// inextensible (Kirchhoff).
@@ -382,19 +388,38 @@ pub struct Problem {
 impl Problem {
     /// Reads a problem file and applies `key=value` overrides.
     pub fn from_path(path: &Path, overrides: &[String]) -> Result<Problem, ProblemError> {
+        Problem::from_path_in(path, overrides, &EnergyCatalog::standard())
+    }
+
+    /// [`Problem::from_path`] with the energies of `catalog` (a program's
+    /// own energies by name: examples/custom_energy.rs).
+    pub fn from_path_in(
+        path: &Path,
+        overrides: &[String],
+        catalog: &EnergyCatalog,
+    ) -> Result<Problem, ProblemError> {
         let text = std::fs::read_to_string(path).map_err(|source| ProblemError::Read {
             path: path.display().to_string(),
             source,
         })?;
-        Problem::from_str_with(&text, overrides)
+        Problem::from_str_in(&text, overrides, catalog)
     }
 
     /// Reads a problem from TOML text and applies `key=value` overrides.
     pub fn from_str_with(text: &str, overrides: &[String]) -> Result<Problem, ProblemError> {
+        Problem::from_str_in(text, overrides, &EnergyCatalog::standard())
+    }
+
+    /// [`Problem::from_str_with`] with the energies of `catalog`.
+    pub fn from_str_in(
+        text: &str,
+        overrides: &[String],
+        catalog: &EnergyCatalog,
+    ) -> Result<Problem, ProblemError> {
         let text = apply_overrides(text, overrides)?;
         let file: ProblemFile =
             toml::from_str(&text).map_err(|e| ProblemError::Parse(e.to_string()))?;
-        let rod = build_rod(&file)?;
+        let rod = build_rod(&file, catalog)?;
         let model = choose_model(&rod, &file.solver.model, file.energy.shear.is_some())?;
         let options = build_options(&file.solver)?;
         let shape = build_shape(&file)?;
@@ -513,7 +538,7 @@ fn profile(field: &str, spec: &ProfileSpec) -> Result<Profile, ProblemError> {
     Ok(p)
 }
 
-fn build_rod(file: &ProblemFile) -> Result<Rod, ProblemError> {
+fn build_rod(file: &ProblemFile, catalog: &EnergyCatalog) -> Result<Rod, ProblemError> {
     let length = finite("rod.length", file.rod.length)?;
     if length <= 0.0 {
         return Err(invalid(
@@ -521,7 +546,7 @@ fn build_rod(file: &ProblemFile) -> Result<Rod, ProblemError> {
             format!("must be positive, got {length}"),
         ));
     }
-    let mut energy = build_energy(&file.energy, length)?;
+    let mut energy = build_energy(&file.energy, length, catalog)?;
     if let Some(shear) = file.energy.shear {
         // A level forced below Cosserat takes the unshearable limit.
         if !matches!(
@@ -558,42 +583,65 @@ fn shear_stiffness(shear: [f64; 3]) -> Result<nalgebra::Vector3<f64>, ProblemErr
     Ok(nalgebra::Vector3::from(shear))
 }
 
-fn build_energy(e: &EnergySection, length: f64) -> Result<Arc<dyn StoredEnergy>, ProblemError> {
-    let mut stiffness: [Profile; 3] = Default::default();
-    let mut kappa0: [Profile; 3] = Default::default();
+/// The energy named by `energy.kind` in `catalog`, from the validated
+/// profiles and parameters (`energy.quartic` is a shorthand for
+/// `energy.parameters.quartic`).
+fn build_energy(
+    e: &EnergySection,
+    length: f64,
+    catalog: &EnergyCatalog,
+) -> Result<Arc<dyn StoredEnergy>, ProblemError> {
+    let mut spec = EnergySpec {
+        stiffness: Default::default(),
+        intrinsic_curvature: Default::default(),
+        parameters: Default::default(),
+    };
     for i in 0..3 {
         let field = format!("energy.stiffness[{i}]");
-        stiffness[i] = profile(&field, &e.stiffness[i])?;
-        let min = stiffness[i].minimum_on(length);
+        spec.stiffness[i] = profile(&field, &e.stiffness[i])?;
+        let min = spec.stiffness[i].minimum_on(length);
         if min.is_nan() || min <= 0.0 {
             return Err(invalid(
                 field,
                 format!("must be positive on [0, L], minimum {min}"),
             ));
         }
-        kappa0[i] = profile(
+        spec.intrinsic_curvature[i] = profile(
             &format!("energy.intrinsic_curvature[{i}]"),
             &e.intrinsic_curvature[i],
         )?;
     }
-    let linear = LinearElastic {
-        stiffness,
-        intrinsic_curvature: kappa0,
-    };
-    match (e.kind.as_str(), e.quartic) {
-        ("linear", None) => Ok(Arc::new(linear)),
-        ("linear", Some(_)) => Err(invalid("energy.quartic", "only for kind = \"quartic\"")),
-        ("quartic", Some(c)) => {
-            let c = finite("energy.quartic", c)?;
-            if c < 0.0 {
-                return Err(invalid("energy.quartic", format!("must be ≥ 0, got {c}")));
-            }
-            Ok(Arc::new(QuarticStiffening { linear, quartic: c }))
+    for (name, value) in &e.parameters {
+        let v = finite(&format!("energy.parameters.{name}"), *value)?;
+        spec.parameters.insert(name.clone(), v);
+    }
+    if let Some(c) = e.quartic {
+        let c = finite("energy.quartic", c)?;
+        if spec.parameters.insert("quartic".into(), c).is_some() {
+            return Err(invalid(
+                "energy.quartic",
+                "given twice (also as energy.parameters.quartic)",
+            ));
         }
-        ("quartic", None) => Err(invalid("energy.quartic", "required for kind = \"quartic\"")),
-        (other, _) => Err(invalid(
+    }
+    let shorthand = e.quartic.is_some();
+    match catalog.build(&e.kind, &spec) {
+        Some(Ok(energy)) => Ok(energy),
+        Some(Err(err)) => {
+            let field = if shorthand && err.field == "energy.parameters.quartic" {
+                "energy.quartic".to_owned()
+            } else {
+                err.field
+            };
+            Err(invalid(field, err.message))
+        }
+        None => Err(invalid(
             "energy.kind",
-            format!("unknown energy `{other}`; expected \"linear\" or \"quartic\""),
+            format!(
+                "unknown energy `{}`; registered: {}",
+                e.kind,
+                catalog.names().join(", ")
+            ),
         )),
     }
 }

@@ -3,6 +3,7 @@
 //!
 //! This stage knows nothing of how equilibria are computed.
 
+mod catalog;
 mod energy;
 mod level;
 mod loads;
@@ -10,6 +11,7 @@ mod profile;
 mod rod;
 mod shear;
 
+pub use catalog::{EnergyBuilder, EnergyCatalog, EnergySpec, EnergySpecError};
 pub use energy::{LinearElastic, QuarticStiffening, StoredEnergy};
 pub use level::{ModelChoice, ModelLevel};
 pub use loads::DeadLoads;

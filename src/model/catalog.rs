@@ -1,0 +1,152 @@
+//! Stored energies by name: what `energy.kind` in a problem file refers to.
+//!
+//! A catalog maps a name to a builder that turns the `[energy]` table (the
+//! stiffness and intrinsic-curvature profiles and the named parameters of
+//! `[energy.parameters]`) into a [`StoredEnergy`]. The standard catalog
+//! holds "linear" and "quartic"; a program adds its own energy with
+//! [`EnergyCatalog::register`] and reads problem files through
+//! `io::Problem::from_path_in` — see examples/custom_energy.rs.
+
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+use super::{LinearElastic, Profile, QuarticStiffening, StoredEnergy};
+
+/// The `[energy]` table of a problem file, validated.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EnergySpec {
+    /// B1, B2, B3 as profiles of s, positive on [0, L].
+    pub stiffness: [Profile; 3],
+    /// κ⁰ as profiles of s.
+    pub intrinsic_curvature: [Profile; 3],
+    /// `[energy.parameters]`: further numbers an energy needs, finite.
+    pub parameters: BTreeMap<String, f64>,
+}
+
+/// A problem in an energy specification: the parameter (the key under
+/// `energy.parameters`, or a field of `[energy]`) and what is wrong.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EnergySpecError {
+    /// The field, e.g. "energy.parameters.quartic".
+    pub field: String,
+    /// What is wrong with it.
+    pub message: String,
+}
+
+impl EnergySpec {
+    /// The linear-elastic energy of the profiles (paper (17)).
+    pub fn linear(&self) -> LinearElastic {
+        LinearElastic {
+            stiffness: self.stiffness.clone(),
+            intrinsic_curvature: self.intrinsic_curvature.clone(),
+        }
+    }
+
+    /// A required parameter.
+    pub fn parameter(&self, name: &str) -> Result<f64, EnergySpecError> {
+        self.parameters
+            .get(name)
+            .copied()
+            .ok_or_else(|| EnergySpecError {
+                field: format!("energy.parameters.{name}"),
+                message: "required by this energy".into(),
+            })
+    }
+
+    /// Rejects parameters the energy does not know (typos would otherwise
+    /// pass silently).
+    pub fn only(&self, known: &[&str]) -> Result<(), EnergySpecError> {
+        match self
+            .parameters
+            .keys()
+            .find(|k| !known.contains(&k.as_str()))
+        {
+            None => Ok(()),
+            Some(k) => Err(EnergySpecError {
+                field: format!("energy.parameters.{k}"),
+                message: if known.is_empty() {
+                    "this energy takes no parameters".into()
+                } else {
+                    format!("unknown; this energy takes {}", known.join(", "))
+                },
+            }),
+        }
+    }
+}
+
+/// Builds an energy from its specification.
+pub type EnergyBuilder =
+    dyn Fn(&EnergySpec) -> Result<Arc<dyn StoredEnergy>, EnergySpecError> + Send + Sync;
+
+/// Named energy builders.
+pub struct EnergyCatalog {
+    builders: BTreeMap<String, Box<EnergyBuilder>>,
+}
+
+impl std::fmt::Debug for EnergyCatalog {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_list().entries(self.builders.keys()).finish()
+    }
+}
+
+impl Default for EnergyCatalog {
+    fn default() -> Self {
+        Self::standard()
+    }
+}
+
+impl EnergyCatalog {
+    /// The energies every problem file can name: "linear" (paper (17)) and
+    /// "quartic" (`QuarticStiffening`, parameter `quartic` = C ≥ 0).
+    pub fn standard() -> Self {
+        let mut c = EnergyCatalog {
+            builders: BTreeMap::new(),
+        };
+        c.register("linear", |spec| {
+            spec.only(&[])?;
+            Ok(Arc::new(spec.linear()))
+        });
+        c.register("quartic", |spec| {
+            spec.only(&["quartic"])?;
+            let quartic = spec.parameter("quartic")?;
+            if quartic < 0.0 {
+                return Err(EnergySpecError {
+                    field: "energy.parameters.quartic".into(),
+                    message: format!("must be ≥ 0, got {quartic}"),
+                });
+            }
+            Ok(Arc::new(QuarticStiffening {
+                linear: spec.linear(),
+                quartic,
+            }))
+        });
+        c
+    }
+
+    /// Adds (or replaces) the energy called `name`.
+    pub fn register(
+        &mut self,
+        name: &str,
+        builder: impl Fn(&EnergySpec) -> Result<Arc<dyn StoredEnergy>, EnergySpecError>
+            + Send
+            + Sync
+            + 'static,
+    ) {
+        self.builders.insert(name.to_owned(), Box::new(builder));
+    }
+
+    /// The registered names.
+    pub fn names(&self) -> Vec<&str> {
+        self.builders.keys().map(String::as_str).collect()
+    }
+
+    /// The energy `name` of a specification; None when no energy has that
+    /// name.
+    pub fn build(
+        &self,
+        name: &str,
+        spec: &EnergySpec,
+    ) -> Option<Result<Arc<dyn StoredEnergy>, EnergySpecError>> {
+        self.builders.get(name).map(|b| b(spec))
+    }
+}
