@@ -43,6 +43,7 @@ fn main() {
             tip_force: Vector3::new(3.0, 0.0, 0.0),
             ..Default::default()
         },
+        support: None,
     };
     let opts = SolverOptions::default();
     let eq = solve(&rod, &ModelChoice::for_rod(&rod), &opts).unwrap();
@@ -90,6 +91,7 @@ fn main() {
             tip_force: Vector3::new(1.0, 0.0, 0.0),
             ..Default::default()
         },
+        support: None,
     };
     let shape = FixedShape {
         turning_angle: Profile::Constant(0.0),

@@ -84,6 +84,7 @@ pub fn scenes() -> Vec<Scene> {
                 tip_force: Vector3::new(k, 0.0, 0.0),
                 ..Default::default()
             },
+            support: None,
         };
         let (x, z) = cantilever_tip(k);
         (rod, Vector3::new(x, 0.0, z))
@@ -96,6 +97,7 @@ pub fn scenes() -> Vec<Scene> {
         energy: Arc::new(LinearElastic::uniform([1.0, 2.0, 0.8], kappa0.into())),
         clamp: Clamp::new(Vector3::zeros(), Vector3::x(), Vector3::z()),
         loads: DeadLoads::default(),
+        support: None,
     };
     vec![
         Scene {

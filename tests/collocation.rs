@@ -27,6 +27,7 @@ fn cantilever(k: f64) -> Rod {
             tip_force: Vector3::new(k, 0.0, 0.0),
             ..Default::default()
         },
+        support: None,
     }
 }
 

@@ -34,6 +34,7 @@ fn rod(shear: [f64; 3], force: Vector3<f64>) -> Rod {
             tip_force: force,
             ..Default::default()
         },
+        support: None,
     }
 }
 

@@ -24,6 +24,7 @@ fn cantilever(k: f64) -> Rod {
             tip_force: Vector3::new(k, 0.0, 0.0),
             ..Default::default()
         },
+        support: None,
     }
 }
 
@@ -140,6 +141,7 @@ fn unloaded_rod_with_constant_intrinsic_curvature_is_a_helix() {
         energy: Arc::new(LinearElastic::uniform([1.0, 2.0, 0.8], kappa0.into())),
         clamp: Clamp::new(Vector3::zeros(), Vector3::x(), Vector3::z()),
         loads: DeadLoads::default(),
+        support: None,
     };
     let choice = ModelChoice::for_rod(&rod);
     assert_eq!(choice.level, ModelLevel::Kirchhoff, "{}", choice.reason);
@@ -191,6 +193,7 @@ fn single_and_multiple_shooting_agree() {
                 tip_couple: Vector3::new(0.0, 0.1, 0.2),
                 distributed_force: Vector3::new(0.3, 0.0, 0.0),
             },
+            support: None,
         };
         let single = solve_with(&rod, ModelLevel::Kirchhoff, Method::Shooting);
         let multi = solve_with(&rod, ModelLevel::Kirchhoff, METHODS[1]);

@@ -30,6 +30,7 @@ fn cantilever(length: f64, force: f64) -> Rod {
             tip_force: Vector3::new(force, 0.0, 0.0),
             ..Default::default()
         },
+        support: None,
     }
 }
 

@@ -19,6 +19,7 @@ fn hanging(q: f64) -> Rod {
             distributed_force: Vector3::new(q, 0.0, 0.0),
             ..Default::default()
         },
+        support: None,
     }
 }
 

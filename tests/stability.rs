@@ -112,6 +112,7 @@ fn helix_scene(energy: Arc<dyn StoredEnergy>) -> Rod {
             distributed_force: Vector3::new(0.4, 0.0, 0.1),
             ..Default::default()
         },
+        support: None,
     }
 }
 
@@ -213,6 +214,7 @@ fn zero_eigenvalue_is_where_the_shooting_jacobian_is_singular_on_a_bent_rod() {
             tip_force: Vector3::new(load, 0.0, 0.0),
             ..Default::default()
         },
+        support: None,
     };
     let det = |load: f64| {
         solve_level(&rod(load), ModelLevel::Kirchhoff)
@@ -267,6 +269,7 @@ fn zero_eigenvalue_is_where_the_shooting_jacobian_is_singular_on_straight_rods()
             tip_force: Vector3::new(0.0, 0.0, -load),
             ..Default::default()
         },
+        support: None,
     };
     // The shooting Jacobian is as accurate as the integration; its
     // singularity is located to about the integrator's tolerance.
@@ -323,6 +326,7 @@ fn zero_eigenvalue_is_where_the_shooting_jacobian_is_singular_on_straight_rods()
             tip_force: Vector3::new(load, 0.0, 0.0),
             ..Default::default()
         },
+        support: None,
     };
     let det = |load: f64| {
         let r = ltb(load);
@@ -366,6 +370,7 @@ fn eigenvalues_converge_at_order_two_p() {
             tip_force: Vector3::new(0.0, 0.0, -force),
             ..Default::default()
         },
+        support: None,
     };
     let eq = solve_level(&rod, ModelLevel::Planar);
     let exact = PI * PI / 4.0 - force;
@@ -452,6 +457,7 @@ fn banded_lanczos_agrees_with_the_dense_solver() {
             tip_force: Vector3::new(3.0, 0.0, 0.0),
             ..Default::default()
         },
+        support: None,
     };
     let eq = solve_level(&rod, ModelLevel::Planar);
     let fe = FiniteElements::new(1.0, 200, 2);
@@ -491,6 +497,7 @@ fn morse_index_counts_the_unstable_modes() {
                 tip_force: Vector3::new(0.0, 0.0, -load),
                 ..Default::default()
             },
+            support: None,
         };
         let choice = ModelChoice::for_rod(&rod);
         let eq = solve(&rod, &choice, &direct).unwrap();

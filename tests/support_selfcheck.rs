@@ -38,3 +38,17 @@ fn bessel_zeros_match_tabulated_values() {
     assert!((first_zero(0.0, 1.0, 3.0) - 2.404_825_557_695_773).abs() < 1e-13);
     assert!((first_zero(1.0, 3.0, 4.5) - 3.831_705_970_207_512).abs() < 1e-13);
 }
+
+#[test]
+fn column_references_match_their_classical_limits() {
+    use support::columns::{clamped_pinned, greenhill_clamped};
+    // tan x = x: x = 4.493409457909064 (A&S Table 4.19).
+    assert!((clamped_pinned() - 4.493_409_457_909_064f64.powi(2)).abs() < 1e-12);
+    // No torque: the clamped–guided column, 4π² B/L².
+    let p = greenhill_clamped(0.0, 1.0, 1.0);
+    assert!((p - 4.0 * std::f64::consts::PI.powi(2)).abs() < 1e-9, "{p}");
+    // The torque lowers the thrust; scaling B and L as P L²/B, M L/B.
+    assert!(greenhill_clamped(5.0, 1.0, 1.0) < greenhill_clamped(2.0, 1.0, 1.0));
+    let scaled = greenhill_clamped(4.0, 2.0, 1.0) / 2.0;
+    assert!((scaled - greenhill_clamped(2.0, 1.0, 1.0)).abs() < 1e-9);
+}

@@ -485,13 +485,14 @@ fn guess_for_level(
             "initial_curvature needs three components".into(),
         ));
     }
-    Ok(match level {
+    // The curvature components the level carries, then a zero reaction
+    // when the tip support holds the position.
+    let mut u = match level {
         ModelLevel::Planar => vec![g[1]],
-        ModelLevel::Kirchhoff | ModelLevel::Cosserat => {
-            debug_assert_eq!(eq.unknowns(), 3);
-            g.to_vec()
-        }
-    })
+        ModelLevel::Kirchhoff | ModelLevel::Cosserat => g.to_vec(),
+    };
+    u.resize(eq.unknowns(), 0.0);
+    Ok(u)
 }
 
 /// The loads' moment over the stiffness moment B_min/L: the size of the

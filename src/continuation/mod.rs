@@ -204,6 +204,11 @@ pub fn continuation(
     opts: &ContinuationOptions,
     monitor: &mut dyn FnMut(Progress, &Diagram) -> bool,
 ) -> Result<Diagram, ContinuationError> {
+    let start = family.rod_at(opts.start).map_err(PointError::from)?;
+    crate::stability::check_conservative(&start).map_err(|e| ContinuationError::Start {
+        p: opts.start,
+        message: e.to_string(),
+    })?;
     let mut run = Run::new(family, opts);
     let first = run.start_point()?;
     let mut diagram = Diagram {

@@ -10,8 +10,12 @@ use nalgebra::Vector3;
 use super::family::{Family, PointError};
 use crate::equations::RodSample;
 use crate::stability::banded::SymmetricBanded;
-use crate::stability::eigen::{count_below, lowest_eigenpairs, lowest_eigenpairs_near};
-use crate::stability::{coefficients, Block, FiniteElements, StabilityOptions};
+use crate::stability::constrained::{
+    count_below_constrained, lowest_eigenpairs_constrained, Constraints,
+};
+use crate::stability::{
+    coefficients, support_constraints, Block, FiniteElements, StabilityOptions,
+};
 
 /// The measured spectrum at one point.
 #[derive(Debug, Clone, PartialEq)]
@@ -33,7 +37,7 @@ pub struct Spectrum {
 }
 
 /// K and G of one block.
-type BlockMatrices = (SymmetricBanded, SymmetricBanded);
+type BlockMatrices = (SymmetricBanded, SymmetricBanded, Constraints);
 
 /// Measures spectra and keeps the last eigenvectors for matching.
 #[derive(Debug, Clone)]
@@ -119,10 +123,14 @@ impl Tracker {
             .sum::<f64>()
             .sqrt();
         let c = coefficients(&rod, &samples);
+        let tip = shape.last().expect("21 shape points");
         let mats = self
             .blocks
             .iter()
-            .map(|&b| (fe.stiffness(&c, b), fe.mass(b)))
+            .map(|&b| {
+                let constraints = support_constraints(&rod, &fe, b, &samples, tip);
+                (fe.stiffness(&c, b), fe.mass(b), constraints)
+            })
             .collect();
         Ok((fe, mats, norm, shape))
     }
@@ -133,15 +141,16 @@ impl Tracker {
         let mut values = vec![];
         let mut vectors = vec![];
         let mut block_morse = vec![];
-        for (bi, (k, g)) in mats.iter().enumerate() {
+        for (bi, (k, g, constraints)) in mats.iter().enumerate() {
             // The previous point's lowest two eigenvalues place the shift.
             let near = self.previous_values.as_ref().map(|v| {
                 let mut b: Vec<f64> = v[bi].clone();
                 b.sort_by(|x, y| x.total_cmp(y));
                 (b[0], *b.get(1).unwrap_or(&b[0]))
             });
-            let pairs = lowest_eigenpairs_near(k, g, self.opts.eigenvalues, near)
-                .map_err(|e| PointError::Eigen(e.to_string()))?;
+            let pairs =
+                lowest_eigenpairs_constrained(k, g, constraints, self.opts.eigenvalues, near)
+                    .map_err(|e| PointError::Eigen(e.to_string()))?;
             let order = match &self.previous {
                 Some(prev) => match_modes(&prev[bi], &pairs.vectors, g),
                 None => (0..pairs.values.len()).collect(),
@@ -153,7 +162,7 @@ impl Tracker {
                     .map(|&i| pairs.vectors[i].clone())
                     .collect::<Vec<_>>(),
             );
-            block_morse.push(count_below(k, g, 0.0));
+            block_morse.push(count_below_constrained(k, g, constraints, 0.0));
         }
         self.previous = Some(vectors.clone());
         let k = self.opts.eigenvalues;
@@ -185,8 +194,8 @@ impl Tracker {
             .iter()
             .position(|&b| b == block)
             .expect("a tracked block");
-        let (k, g) = &mats[bi];
-        let pairs = lowest_eigenpairs(k, g, self.opts.eigenvalues)
+        let (k, g, constraints) = &mats[bi];
+        let pairs = lowest_eigenpairs_constrained(k, g, constraints, self.opts.eigenvalues, None)
             .map_err(|e| PointError::Eigen(e.to_string()))?;
         let i = (0..pairs.values.len())
             .min_by(|&a, &b| pairs.values[a].abs().total_cmp(&pairs.values[b].abs()))

@@ -22,8 +22,9 @@
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
 use super::planar::straight_rod_clamp_moment;
+use super::tip::{conditions, TipState};
 use super::{RodEquations, RodSample};
-use crate::model::Rod;
+use crate::model::{Rod, TipSupport};
 
 /// The 9-ODE Kirchhoff equations (12 with the position), or the Cosserat
 /// ones when the compliance is non-zero.
@@ -40,6 +41,9 @@ struct State {
     d2: Vector3<f64>,
     d3: Vector3<f64>,
     kappa: Vector3<f64>,
+    /// The tip reaction R (states 12..15 when the support holds the tip's
+    /// position; zero otherwise).
+    reaction: Vector3<f64>,
 }
 
 impl State {
@@ -51,6 +55,11 @@ impl State {
             d2,
             d3: d1.cross(&d2),
             kappa: Vector3::new(y[6], y[7], y[8]),
+            reaction: if y.len() > 12 {
+                Vector3::new(y[12], y[13], y[14])
+            } else {
+                Vector3::zeros()
+            },
         }
     }
 }
@@ -98,7 +107,7 @@ impl KirchhoffEquations {
             .try_inverse()
             .unwrap_or_else(|| Matrix3::from_element(f64::NAN));
         let m = e.moment(s, &st.kappa);
-        let n = self.rod.loads.internal_force(s, self.rod.length);
+        let n = self.rod.loads.internal_force(s, self.rod.length) + st.reaction;
         let body_n = Vector3::new(n.dot(&st.d1), n.dot(&st.d2), n.dot(&st.d3));
         let nu = Vector3::z() + self.compliance.component_mul(&body_n);
         let q = m.cross(&st.kappa) + body_n.cross(&nu);
@@ -113,6 +122,15 @@ impl KirchhoffEquations {
         }
     }
 
+    /// Whether the support holds the tip's position, so that the reaction R
+    /// is carried as three constant states (R' = 0) with R(0) unknown.
+    fn reacts(&self) -> bool {
+        self.rod
+            .support
+            .as_ref()
+            .is_some_and(|s| s.holds_position())
+    }
+
     fn write_rates(st: &State, b: &Balance, dy: &mut [f64]) {
         let k = st.kappa;
         let dd1 = st.d2 * k[2] - st.d3 * k[1];
@@ -122,16 +140,38 @@ impl KirchhoffEquations {
         dy[3..6].copy_from_slice(dd2.as_slice());
         dy[6..9].copy_from_slice(b.rate.as_slice());
         dy[9..12].copy_from_slice(dr.as_slice());
+        dy[12..].fill(0.0);
+    }
+}
+
+impl KirchhoffEquations {
+    /// The residuals and Jacobian of a supported tip ([`super::tip`]).
+    fn supported_tip(&self, support: &TipSupport, y: &[f64]) -> (Vec<f64>, DMatrix<f64>) {
+        let st = State::read(y);
+        let l = self.rod.length;
+        let tip = TipState {
+            d: [st.d1, st.d2, st.d3],
+            r: Vector3::new(y[9], y[10], y[11]),
+            m: self.rod.energy.moment(l, &st.kappa),
+            h: self.rod.energy.stiffness(l, &st.kappa),
+            reaction: st.reaction,
+            couple: &self.rod.loads.tip_couple,
+        };
+        conditions(support, &tip, self.moment_scale(), l, self.dim())
     }
 }
 
 impl RodEquations for KirchhoffEquations {
     fn dim(&self) -> usize {
-        12
+        if self.reacts() {
+            15
+        } else {
+            12
+        }
     }
 
     fn unknowns(&self) -> usize {
-        3
+        self.dim() - 9
     }
 
     fn length(&self) -> f64 {
@@ -142,14 +182,20 @@ impl RodEquations for KirchhoffEquations {
         let c = &self.rod.clamp;
         y0[0..3].copy_from_slice(c.director(0).as_slice());
         y0[3..6].copy_from_slice(c.director(1).as_slice());
-        y0[6..9].copy_from_slice(u);
+        y0[6..9].copy_from_slice(&u[..3]);
         y0[9..12].copy_from_slice(c.position.as_slice());
+        if self.reacts() {
+            y0[12..15].copy_from_slice(&u[3..6]);
+        }
     }
 
     fn initial_sensitivity(&self) -> DMatrix<f64> {
-        let mut m = DMatrix::zeros(12, 3);
+        let mut m = DMatrix::zeros(self.dim(), self.unknowns());
         for i in 0..3 {
             m[(6 + i, i)] = 1.0;
+            if self.reacts() {
+                m[(12 + i, 3 + i)] = 1.0;
+            }
         }
         m
     }
@@ -164,7 +210,7 @@ impl RodEquations for KirchhoffEquations {
     /// δd3 = δd1 × d2 + d1 × δd2, δd1' = δκ3 d2 + κ3 δd2 − δκ2 d3 − κ2 δd3,
     /// δd2' = δκ1 d3 + κ1 δd3 − δκ3 d1 − κ3 δd1, δr' = δ(ν_i d_i), and
     /// δκ' = H⁻¹ (Hδκ × κ + M × δκ + δN × ν + N × δν − ∂sH δκ − ∂κ(Hκ')δκ),
-    /// δN_i = n·δd_i, δν = c∘δN.
+    /// δN_i = n·δd_i + δR·d_i, δν = c∘δN, δR' = 0.
     fn rhs_linearized(
         &self,
         s: f64,
@@ -181,16 +227,26 @@ impl RodEquations for KirchhoffEquations {
         let e = &self.rod.energy;
         let k = st.kappa;
         let kappa_jac = e.stiffness_rate(s, &k) + e.stiffness_derivative(s, &k, &b.rate);
+        let n = self.dim();
         for c in 0..cols {
-            let v = &phi[12 * c..12 * c + 12];
-            let out = &mut dphi[12 * c..12 * c + 12];
+            let v = &phi[n * c..n * (c + 1)];
+            let out = &mut dphi[n * c..n * (c + 1)];
+            let dreaction = if n > 12 {
+                Vector3::new(v[12], v[13], v[14])
+            } else {
+                Vector3::zeros()
+            };
             let dd1 = Vector3::new(v[0], v[1], v[2]);
             let dd2 = Vector3::new(v[3], v[4], v[5]);
             let dk = Vector3::new(v[6], v[7], v[8]);
             let dd3 = dd1.cross(&st.d2) + st.d1.cross(&dd2);
             let r1 = st.d2 * dk[2] + dd2 * k[2] - st.d3 * dk[1] - dd3 * k[1];
             let r2 = st.d3 * dk[0] + dd3 * k[0] - st.d1 * dk[2] - dd1 * k[2];
-            let dn = Vector3::new(b.n.dot(&dd1), b.n.dot(&dd2), b.n.dot(&dd3));
+            let dn = Vector3::new(
+                b.n.dot(&dd1) + dreaction.dot(&st.d1),
+                b.n.dot(&dd2) + dreaction.dot(&st.d2),
+                b.n.dot(&dd3) + dreaction.dot(&st.d3),
+            );
             let dnu = self.compliance.component_mul(&dn);
             let dq = (b.h * dk).cross(&k) + b.m.cross(&dk) + dn.cross(&b.nu) + body_n.cross(&dnu);
             let rk = b.h_inv * (dq - kappa_jac * dk);
@@ -204,10 +260,15 @@ impl RodEquations for KirchhoffEquations {
             out[3..6].copy_from_slice(r2.as_slice());
             out[6..9].copy_from_slice(rk.as_slice());
             out[9..12].copy_from_slice(dr.as_slice());
+            out[12..].fill(0.0);
         }
     }
 
     fn tip_residual(&self, y: &[f64], r: &mut [f64]) {
+        if let Some(support) = &self.rod.support {
+            r.copy_from_slice(&self.supported_tip(support, y).0);
+            return;
+        }
         let st = State::read(y);
         let m = self.rod.energy.moment(self.rod.length, &st.kappa);
         let c = self.rod.loads.tip_couple;
@@ -218,6 +279,9 @@ impl RodEquations for KirchhoffEquations {
 
     /// ∂/∂κ = H(L); ∂(C·d3)/∂d1 = d2 × C, ∂(C·d3)/∂d2 = C × d1.
     fn tip_residual_jacobian(&self, y: &[f64]) -> DMatrix<f64> {
+        if let Some(support) = &self.rod.support {
+            return self.supported_tip(support, y).1;
+        }
         let st = State::read(y);
         let c = self.rod.loads.tip_couple;
         let h = self.rod.energy.stiffness(self.rod.length, &st.kappa);
@@ -264,11 +328,15 @@ impl RodEquations for KirchhoffEquations {
                 break;
             }
         }
-        k.as_slice().to_vec()
+        let mut u = k.as_slice().to_vec();
+        u.resize(self.unknowns(), 0.0);
+        u
     }
 
     fn unknowns_of(&self, y0: &[f64]) -> Vec<f64> {
-        y0[6..9].to_vec()
+        let mut u = y0[6..9].to_vec();
+        u.extend_from_slice(&y0[12..]);
+        u
     }
 
     fn sample(&self, s: f64, y: &[f64]) -> RodSample {
@@ -279,14 +347,14 @@ impl RodEquations for KirchhoffEquations {
             directors: [st.d1, st.d2, st.d3],
             curvature: st.kappa,
             moment: self.rod.energy.moment(s, &st.kappa),
-            force: self.rod.loads.internal_force(s, self.rod.length),
+            force: self.rod.loads.internal_force(s, self.rod.length) + st.reaction,
         }
     }
 
     fn straight_state(&self, s: f64) -> Vec<f64> {
         let c = &self.rod.clamp;
-        let mut y = vec![0.0; 12];
-        self.initial_state(&[0.0; 3], &mut y);
+        let mut y = vec![0.0; self.dim()];
+        self.initial_state(&vec![0.0; self.unknowns()], &mut y);
         let r = c.position + c.director(2) * s;
         y[9..12].copy_from_slice(r.as_slice());
         y
@@ -298,9 +366,10 @@ impl RodEquations for KirchhoffEquations {
 
     fn state_scales(&self) -> Vec<f64> {
         let l = self.rod.length;
-        let mut scales = vec![1.0; 12];
+        let mut scales = vec![1.0; self.dim()];
         scales[6..9].fill(1.0 / l);
         scales[9..12].fill(l);
+        scales[12..].fill(self.moment_scale() / l);
         scales
     }
 }

@@ -9,6 +9,7 @@
 
 mod kirchhoff;
 mod planar;
+mod tip;
 
 pub use kirchhoff::KirchhoffEquations;
 pub use planar::PlanarEquations;

@@ -8,11 +8,17 @@
 //! where N1 = n·d1 = n_x cos φ − n_z sin φ and M2 = ∂W/∂κ2 (0, κ2, 0), so
 //! κ2' = (−N1 − ∂sM2)/H22. State y = (x, z, φ, κ2); one unknown κ2(0); one
 //! tip condition M2(L) = C·d2.
+//!
+//! A support that holds the tip's position adds the in-plane reaction
+//! (R_x, R_z) as two constant states with unknown initial values, and its
+//! conditions replace the natural one: the position (or its component
+//! across the sliding axis, with R·a = 0) and the tip angle φ(L) when the
+//! rotation is held.
 
 use nalgebra::{DMatrix, Vector3};
 
 use super::{RodEquations, RodSample};
-use crate::model::Rod;
+use crate::model::{Freedom, Rod, TipSupport};
 
 /// The 4-ODE planar equations of a rod.
 #[derive(Debug, Clone)]
@@ -31,20 +37,36 @@ impl PlanarEquations {
         Vector3::new(0.0, k2, 0.0)
     }
 
-    /// (n_x, n_z): the internal force in the clamp frame's plane.
-    fn force_in_plane(&self, s: f64) -> (f64, f64) {
+    /// Whether the support holds the tip's position (reaction states).
+    fn reacts(&self) -> bool {
+        self.rod
+            .support
+            .as_ref()
+            .is_some_and(|s| s.holds_position())
+    }
+
+    /// (n_x, n_z): the internal force in the clamp frame's plane, with the
+    /// reaction of a held tip.
+    fn force_in_plane(&self, s: f64, y: &[f64]) -> (f64, f64) {
         let n = self.rod.loads.internal_force(s, self.rod.length);
+        let (rx, rz) = if y.len() > 4 {
+            (y[4], y[5])
+        } else {
+            (0.0, 0.0)
+        };
         (
-            n.dot(&self.rod.clamp.director(0)),
-            n.dot(&self.rod.clamp.director(2)),
+            n.dot(&self.rod.clamp.director(0)) + rx,
+            n.dot(&self.rod.clamp.director(2)) + rz,
         )
     }
 
-    /// (κ2', ∂κ2'/∂φ, ∂κ2'/∂κ2) at (s, φ, κ2).
-    fn curvature_rate(&self, s: f64, phi: f64, k2: f64) -> (f64, f64, f64) {
+    /// (κ2', ∂κ2'/∂φ, ∂κ2'/∂κ2) at (s, y); ∂κ2'/∂(R_x, R_z) =
+    /// (−cos φ, sin φ)/H22.
+    fn curvature_rate(&self, s: f64, y: &[f64]) -> (f64, f64, f64) {
+        let (phi, k2) = (y[2], y[3]);
         let e = &self.rod.energy;
         let kappa = Self::kappa(k2);
-        let (nx, nz) = self.force_in_plane(s);
+        let (nx, nz) = self.force_in_plane(s, y);
         let (sin, cos) = phi.sin_cos();
         let n1 = nx * cos - nz * sin;
         let h22 = e.stiffness(s, &kappa)[(1, 1)];
@@ -56,13 +78,69 @@ impl PlanarEquations {
     }
 }
 
+impl PlanarEquations {
+    /// The residuals (3) and Jacobian (3 × dim) of a supported tip, as
+    /// moments (positions × M_s/L, angles × M_s, forces × L). The support
+    /// is planar (see [`crate::model::ModelChoice`]): targets in the plane,
+    /// axes in the plane or, for rotation, along d2 (then free in-plane).
+    fn supported_tip(&self, support: &TipSupport, y: &[f64]) -> (Vec<f64>, DMatrix<f64>) {
+        let n = self.dim();
+        let (l, ms) = (self.rod.length, self.moment_scale());
+        let c = &self.rod.clamp;
+        let (ex, ez) = (c.director(0), c.director(2));
+        let target = support.position - c.position;
+        let (px, pz) = (target.dot(&ex), target.dot(&ez));
+        let mut r = Vec::with_capacity(3);
+        let mut g = DMatrix::zeros(3, n);
+        match support.translation {
+            Freedom::Free => {}
+            Freedom::Fixed => {
+                r.push(ms / l * (y[0] - px));
+                g[(0, 0)] = ms / l;
+                r.push(ms / l * (y[1] - pz));
+                g[(1, 1)] = ms / l;
+            }
+            Freedom::Axial(a) => {
+                let (ax, az) = (a.dot(&ex), a.dot(&ez));
+                r.push(ms / l * (-(y[0] - px) * az + (y[1] - pz) * ax));
+                g[(0, 0)] = -ms / l * az;
+                g[(0, 1)] = ms / l * ax;
+                r.push(l * (y[4] * ax + y[5] * az));
+                g[(1, 4)] = l * ax;
+                g[(1, 5)] = l * az;
+            }
+        }
+        let row = r.len();
+        match support.rotation {
+            Freedom::Fixed => {
+                let d3 = support.frame.column(2);
+                let target = d3.dot(&ex).atan2(d3.dot(&ez));
+                r.push(ms * (y[2] - target));
+                g[(row, 2)] = ms;
+            }
+            Freedom::Free | Freedom::Axial(_) => {
+                let kappa = Self::kappa(y[3]);
+                let e = &self.rod.energy;
+                r.push(e.moment(l, &kappa)[1] - self.rod.loads.tip_couple.dot(&c.director(1)));
+                g[(row, 3)] = e.stiffness(l, &kappa)[(1, 1)];
+            }
+        }
+        g = g.rows(0, r.len()).into_owned();
+        (r, g)
+    }
+}
+
 impl RodEquations for PlanarEquations {
     fn dim(&self) -> usize {
-        4
+        if self.reacts() {
+            6
+        } else {
+            4
+        }
     }
 
     fn unknowns(&self) -> usize {
-        1
+        self.dim() - 3
     }
 
     fn length(&self) -> f64 {
@@ -70,11 +148,13 @@ impl RodEquations for PlanarEquations {
     }
 
     fn initial_state(&self, u: &[f64], y0: &mut [f64]) {
-        y0.copy_from_slice(&[0.0, 0.0, 0.0, u[0]]);
+        y0[..3].fill(0.0);
+        y0[3..].copy_from_slice(u);
     }
 
     fn initial_sensitivity(&self) -> DMatrix<f64> {
-        DMatrix::from_column_slice(4, 1, &[0.0, 0.0, 0.0, 1.0])
+        let n = self.dim();
+        DMatrix::from_fn(n, n - 3, |i, j| if i == j + 3 { 1.0 } else { 0.0 })
     }
 
     fn rhs(&self, s: f64, y: &[f64], dy: &mut [f64]) {
@@ -82,7 +162,8 @@ impl RodEquations for PlanarEquations {
         dy[0] = sin;
         dy[1] = cos;
         dy[2] = y[3];
-        dy[3] = self.curvature_rate(s, y[2], y[3]).0;
+        dy[3] = self.curvature_rate(s, y).0;
+        dy[4..].fill(0.0);
     }
 
     fn rhs_linearized(
@@ -95,24 +176,38 @@ impl RodEquations for PlanarEquations {
         dphi: &mut [f64],
     ) {
         let (sin, cos) = y[2].sin_cos();
-        let (rate, d_phi, d_k2) = self.curvature_rate(s, y[2], y[3]);
-        dy.copy_from_slice(&[sin, cos, y[3], rate]);
+        let (rate, d_phi, d_k2) = self.curvature_rate(s, y);
+        dy[..4].copy_from_slice(&[sin, cos, y[3], rate]);
+        dy[4..].fill(0.0);
+        let n = self.dim();
+        let h22 = self.rod.energy.stiffness(s, &Self::kappa(y[3]))[(1, 1)];
         for c in 0..cols {
-            let v = &phi[4 * c..4 * c + 4];
-            let out = &mut dphi[4 * c..4 * c + 4];
+            let v = &phi[n * c..n * (c + 1)];
+            let out = &mut dphi[n * c..n * (c + 1)];
             out[0] = cos * v[2];
             out[1] = -sin * v[2];
             out[2] = v[3];
             out[3] = d_phi * v[2] + d_k2 * v[3];
+            if n > 4 {
+                out[3] += (-cos * v[4] + sin * v[5]) / h22;
+                out[4..].fill(0.0);
+            }
         }
     }
 
     fn tip_residual(&self, y: &[f64], r: &mut [f64]) {
+        if let Some(support) = &self.rod.support {
+            r.copy_from_slice(&self.supported_tip(support, y).0);
+            return;
+        }
         let m2 = self.rod.energy.moment(self.rod.length, &Self::kappa(y[3]))[1];
         r[0] = m2 - self.rod.loads.tip_couple.dot(&self.rod.clamp.director(1));
     }
 
     fn tip_residual_jacobian(&self, y: &[f64]) -> DMatrix<f64> {
+        if let Some(support) = &self.rod.support {
+            return self.supported_tip(support, y).1;
+        }
         let h22 = self
             .rod
             .energy
@@ -138,11 +233,13 @@ impl RodEquations for PlanarEquations {
                 break;
             }
         }
-        vec![k2]
+        let mut u = vec![k2];
+        u.resize(self.unknowns(), 0.0);
+        u
     }
 
     fn unknowns_of(&self, y0: &[f64]) -> Vec<f64> {
-        vec![y0[3]]
+        y0[3..].to_vec()
     }
 
     fn sample(&self, s: f64, y: &[f64]) -> RodSample {
@@ -156,12 +253,19 @@ impl RodEquations for PlanarEquations {
             directors: [ex * cos - ez * sin, ey, ex * sin + ez * cos],
             curvature: kappa,
             moment: self.rod.energy.moment(s, &kappa),
-            force: self.rod.loads.internal_force(s, self.rod.length),
+            force: self.rod.loads.internal_force(s, self.rod.length)
+                + if y.len() > 4 {
+                    ex * y[4] + ez * y[5]
+                } else {
+                    Vector3::zeros()
+                },
         }
     }
 
     fn straight_state(&self, s: f64) -> Vec<f64> {
-        vec![0.0, s, 0.0, 0.0]
+        let mut y = vec![0.0; self.dim()];
+        y[1] = s;
+        y
     }
 
     fn moment_scale(&self) -> f64 {
@@ -170,7 +274,9 @@ impl RodEquations for PlanarEquations {
 
     fn state_scales(&self) -> Vec<f64> {
         let l = self.rod.length;
-        vec![l, l, 1.0, 1.0 / l]
+        let mut scales = vec![l, l, 1.0, 1.0 / l];
+        scales.resize(self.dim(), self.moment_scale() / l);
+        scales
     }
 }
 

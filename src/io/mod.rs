@@ -7,6 +7,7 @@ mod continuation_section;
 mod diagram;
 mod hdf5_output;
 mod problem;
+mod support_section;
 
 pub use arm_output::write_arm;
 pub use arm_section::ArmSection;
@@ -16,3 +17,4 @@ pub use hdf5_output::{
     check_target, write_equilibrium, write_stability, OutputError, StabilityResult,
 };
 pub use problem::{Problem, ProblemError, ProblemFile, ProfileSpec};
+pub use support_section::SupportSection;

@@ -16,6 +16,7 @@ use serde::{Deserialize, Deserializer, Serialize};
 
 use super::arm_section::ArmSection;
 use super::continuation_section::ContinuationSection;
+use super::SupportSection;
 use crate::bvp::integrator::Tolerances;
 use crate::bvp::newton::NewtonOptions;
 use crate::bvp::{Method, SolverOptions, Strategy};
@@ -68,6 +69,9 @@ pub struct ProblemFile {
     /// Dead loads.
     #[serde(default)]
     pub loads: LoadSection,
+    /// What holds the tip (absent: a free tip).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub support: Option<SupportSection>,
     /// How to solve.
     #[serde(default)]
     pub solver: SolverSection,
@@ -559,15 +563,22 @@ fn build_rod(file: &ProblemFile, catalog: &EnergyCatalog) -> Result<Rod, Problem
             });
         }
     }
+    let clamp = build_clamp(&file.clamp)?;
+    let support = file
+        .support
+        .as_ref()
+        .map(|s| s.build(&clamp, length))
+        .transpose()?;
     Ok(Rod {
         length,
         energy,
-        clamp: build_clamp(&file.clamp)?,
+        clamp,
         loads: DeadLoads {
             tip_force: vector("loads.tip_force", file.loads.tip_force)?,
             tip_couple: vector("loads.tip_couple", file.loads.tip_couple)?,
             distributed_force: vector("loads.distributed_force", file.loads.distributed_force)?,
         },
+        support,
     })
 }
 

@@ -3,7 +3,9 @@
 //! 9-ODE Kirchhoff model, a shearable, extensible one the Cosserat model;
 //! the choice comes with its reason.
 
-use super::Rod;
+use nalgebra::Vector3;
+
+use super::{Freedom, Rod, TipSupport};
 
 /// How much model the equations carry.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -113,5 +115,33 @@ fn planar_obstruction(rod: &Rod) -> Option<String> {
     if c.norm() > PLANE_TOLERANCE * scale {
         return Some("the tip couple is not along d2(0)".into());
     }
-    None
+    rod.support
+        .as_ref()
+        .and_then(|support| support_obstruction(rod, support))
+}
+
+/// Why a tip support is not planar: a target off the plane of d1(0), d3(0),
+/// a sliding axis out of it, a spin axis other than d2(0), or a prescribed
+/// tip frame whose d2 is not d2(0).
+fn support_obstruction(rod: &Rod, support: &TipSupport) -> Option<String> {
+    let normal = rod.clamp.director(1);
+    let off = |v: &Vector3<f64>| v.dot(&normal).abs() > 1e-9 * v.norm().max(1.0);
+    let held = support.holds_position();
+    if held && off(&((support.position - rod.clamp.position) / rod.length)) {
+        return Some("the tip support's position is off the plane of d1(0), d3(0)".into());
+    }
+    if let Freedom::Axial(a) = support.translation {
+        if off(&a) {
+            return Some("the tip's sliding axis is not in the plane of d1(0), d3(0)".into());
+        }
+    }
+    match support.rotation {
+        Freedom::Axial(a) if (a.cross(&normal)).norm() > 1e-9 => {
+            Some("the tip's spin axis is not along d2(0)".into())
+        }
+        Freedom::Fixed if (support.frame.column(1) - normal).norm() > 1e-9 => {
+            Some("the prescribed tip frame turns out of the plane".into())
+        }
+        _ => None,
+    }
 }

@@ -10,6 +10,7 @@ mod loads;
 mod profile;
 mod rod;
 mod shear;
+mod support;
 
 pub use catalog::{EnergyBuilder, EnergyCatalog, EnergySpec, EnergySpecError};
 pub use energy::{LinearElastic, QuarticStiffening, StoredEnergy};
@@ -18,3 +19,4 @@ pub use loads::DeadLoads;
 pub use profile::Profile;
 pub use rod::{Clamp, Rod};
 pub use shear::Shearable;
+pub use support::{across, Freedom, TipSupport};

@@ -4,7 +4,7 @@ use std::sync::Arc;
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::{DeadLoads, StoredEnergy};
+use super::{DeadLoads, StoredEnergy, TipSupport};
 
 /// The clamp at s = 0: position and the directors d1(0), d2(0), d3(0).
 #[derive(Debug, Clone, PartialEq)]
@@ -38,7 +38,8 @@ impl Clamp {
     }
 }
 
-/// A Kirchhoff rod clamped at s = 0 and free at s = L under dead loads.
+/// A rod clamped at s = 0 under dead loads, free at s = L or held there by
+/// a [`TipSupport`].
 #[derive(Debug, Clone)]
 pub struct Rod {
     /// Reference length L (m).
@@ -49,6 +50,8 @@ pub struct Rod {
     pub clamp: Clamp,
     /// Dead loads.
     pub loads: DeadLoads,
+    /// The support at s = L; None for a free tip (a cantilever).
+    pub support: Option<TipSupport>,
 }
 
 impl Rod {

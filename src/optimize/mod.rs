@@ -135,6 +135,7 @@ impl ArmProblem {
                 tip_force: Vector3::new(1.0, 0.0, 0.0),
                 ..Default::default()
             },
+            support: None,
         }
     }
 

@@ -221,7 +221,7 @@ fn row_sum_norm(a: &SymmetricBanded) -> f64 {
 /// Lanczos on an operator self-adjoint in the `metric` inner product, with
 /// full reorthogonalization; Ritz values θ are mapped by `to_lambda` and the
 /// `count` best (by `order` on θ) are returned, sorted by λ.
-fn lanczos(
+pub(super) fn lanczos(
     n: usize,
     count: usize,
     steps: usize,

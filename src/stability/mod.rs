@@ -6,6 +6,7 @@
 //! factor and λ_crit is a generalized eigenvalue (no root finder).
 
 pub mod banded;
+pub mod constrained;
 pub mod eigen;
 mod fixed_shape;
 mod second_variation;
@@ -17,8 +18,9 @@ use nalgebra::Vector3;
 
 use crate::bvp::{Equilibrium, SolveError, SolverOptions};
 use crate::equations::RodSample;
-use crate::model::{ModelLevel, Rod};
-use eigen::{count_below, lowest_eigenpairs, EigenError};
+use crate::model::{Freedom, ModelLevel, Rod};
+use constrained::{count_below_constrained, lowest_eigenpairs_constrained, Constraints};
+use eigen::EigenError;
 
 /// How the second variation is discretized and how much of its spectrum is
 /// computed.
@@ -58,6 +60,9 @@ pub enum StabilityError {
     /// A fixed-shape scene the method does not cover.
     #[error("fixed shape: {0}")]
     FixedShape(String),
+    /// A scene the second variation is not implemented for.
+    #[error("not implemented: {0}")]
+    Unsupported(String),
 }
 
 /// The spectrum of one block of K.
@@ -105,16 +110,18 @@ pub fn coefficients(rod: &Rod, samples: &[RodSample]) -> Vec<FormCoefficients> {
         .collect()
 }
 
-/// The spectrum and inertia of K for one block.
+/// The spectrum and inertia of K for one block, on the null space of the
+/// tip support's constraints.
 pub fn block_spectrum(
     fe: &FiniteElements,
     coeffs: &[FormCoefficients],
     block: Block,
     count: usize,
+    constraints: &Constraints,
 ) -> Result<BlockSpectrum, StabilityError> {
     let k = fe.stiffness(coeffs, block);
     let g = fe.mass(block);
-    let pairs = lowest_eigenpairs(&k, &g, count)?;
+    let pairs = lowest_eigenpairs_constrained(&k, &g, constraints, count, None)?;
     Ok(BlockSpectrum {
         block,
         eigenvalues: pairs.values,
@@ -123,20 +130,53 @@ pub fn block_spectrum(
             .iter()
             .map(|v| fe.nodal_rotations(block, v))
             .collect(),
-        morse_index: count_below(&k, &g, 0.0),
+        morse_index: count_below_constrained(&k, &g, constraints, 0.0),
     })
 }
 
-/// Rejects loads without a potential: a dead couple on a spatial rod.
-fn check_conservative(rod: &Rod) -> Result<(), StabilityError> {
-    if rod.loads.tip_couple.norm() > 0.0 {
+/// Rejects loads without a potential: a dead couple on a spatial rod,
+/// unless the tip support holds every rotation it could do work in.
+/// Rejects, too, the shear-strain elimination under a held position (the
+/// constraint would couple the strain across the rod).
+pub fn check_conservative(rod: &Rod) -> Result<(), StabilityError> {
+    let couple = rod.loads.tip_couple;
+    let held = match rod.support.as_ref().map(|s| s.rotation) {
+        Some(Freedom::Fixed) => true,
+        Some(Freedom::Axial(a)) => (couple - a * couple.dot(&a)).norm() <= 1e-12 * couple.norm(),
+        _ => false,
+    };
+    if couple.norm() > 0.0 && !held {
         return Err(StabilityError::NonConservative(
             "a dead tip couple has no potential for spatial rotations, so the second \
-             variation does not decide stability; remove loads.tip_couple"
+             variation does not decide stability; remove loads.tip_couple, or hold the tip's \
+             rotation (support.rotation = \"fixed\", or \"axial\" about the couple)"
+                .into(),
+        ));
+    }
+    let shear = rod.energy.shear_stiffness(0.0).is_some();
+    if shear && rod.support.as_ref().is_some_and(|s| s.holds_position()) {
+        return Err(StabilityError::Unsupported(
+            "the stability of a shearable rod with a held tip position is not implemented \
+             (the shear strain can no longer be minimized out pointwise)"
                 .into(),
         ));
     }
     Ok(())
+}
+
+/// The constraints of `rod`'s tip support on a block (none for a free
+/// tip); `samples` at the quadrature points, `tip` at s = L.
+pub fn support_constraints(
+    rod: &Rod,
+    fe: &FiniteElements,
+    block: Block,
+    samples: &[RodSample],
+    tip: &RodSample,
+) -> Constraints {
+    match &rod.support {
+        Some(support) => fe.support_constraints(block, support, samples, tip),
+        None => Constraints::none(fe.size(block)),
+    }
 }
 
 /// The stability of an equilibrium of `rod` (from [`crate::bvp::solve`]).
@@ -148,7 +188,10 @@ pub fn analyze(
 ) -> Result<Stability, StabilityError> {
     check_conservative(rod)?;
     let fe = FiniteElements::new(rod.length, opts.elements, opts.order);
-    let samples = eq.resample(rod, solver, &fe.quadrature_points())?;
+    let mut points = fe.quadrature_points();
+    points.push(rod.length);
+    let mut samples = eq.resample(rod, solver, &points)?;
+    let tip = samples.pop().expect("the tip sample");
     let coeffs = coefficients(rod, &samples);
     let blocks = match eq.model.level {
         ModelLevel::Planar => vec![Block::InPlane, Block::OutOfPlane],
@@ -156,7 +199,10 @@ pub fn analyze(
     };
     let blocks = blocks
         .into_iter()
-        .map(|b| block_spectrum(&fe, &coeffs, b, opts.eigenvalues))
+        .map(|b| {
+            let c = support_constraints(rod, &fe, b, &samples, &tip);
+            block_spectrum(&fe, &coeffs, b, opts.eigenvalues, &c)
+        })
         .collect::<Result<Vec<_>, _>>()?;
     let morse_index = blocks.iter().map(|b| b.morse_index).sum();
     Ok(Stability {

@@ -53,9 +53,12 @@
 //! the eigenvalues of K v = λ G v converge to those of the continuous form
 //! (at order 2p).
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{DVector, Matrix3, Vector3};
 
 use super::banded::SymmetricBanded;
+use super::constrained::Constraints;
+use crate::equations::RodSample;
+use crate::model::{across, Freedom, TipSupport};
 
 /// The coefficients of the quadratic form at one point:
 /// q(ω, ω') = ω'ᵀAω' + 2ω'ᵀBω + ωᵀCω.
@@ -340,6 +343,70 @@ impl FiniteElements {
             }
         }
         out
+    }
+
+    /// The linear constraints a tip support puts on ω: a position held
+    /// along a is a·δr(L) = ∫ a·R(ω × e3) ds = Σ_c ∫ ω_c a·(d_c × d3) ds = 0
+    /// (δd3 = R(ω × e3)); a frame held about b is b·R(L)ω(L) = 0. `samples`
+    /// are at the quadrature points, `tip` at s = L. Constraints that the
+    /// block does not see (zero rows) are dropped.
+    pub fn support_constraints(
+        &self,
+        block: Block,
+        support: &TipSupport,
+        samples: &[RodSample],
+        tip: &RodSample,
+    ) -> Constraints {
+        let n = self.size(block);
+        let mut rows = Vec::new();
+        let positions: Vec<Vector3<f64>> = match support.translation {
+            Freedom::Free => vec![],
+            Freedom::Fixed => (0..3).map(|j| Vector3::ith(j, 1.0)).collect(),
+            Freedom::Axial(a) => across(&a).to_vec(),
+        };
+        for a in positions {
+            rows.push(self.position_row(block, &a, samples));
+        }
+        let frame = nalgebra::Matrix3::from_columns(&tip.directors);
+        let turns: Vec<Vector3<f64>> = match support.rotation {
+            Freedom::Free => vec![],
+            Freedom::Fixed => (0..3).map(|j| Vector3::ith(j, 1.0)).collect(),
+            Freedom::Axial(a) => across(&a).map(|b| frame.transpose() * b).to_vec(),
+        };
+        let last = self.elements * self.order;
+        for v in turns {
+            let mut row = DVector::zeros(n);
+            for (x, &c) in block.components().iter().enumerate() {
+                row[(last - 1) * block.components().len() + x] = v[c];
+            }
+            rows.push(row);
+        }
+        Constraints::from_rows(&rows, n)
+    }
+
+    /// Σ_q w_q φ_node(s_q) a·(d_c × d3)(s_q) for every unknown.
+    fn position_row(&self, block: Block, a: &Vector3<f64>, samples: &[RodSample]) -> DVector<f64> {
+        let comps = block.components();
+        let p = self.order;
+        let (xs, ws) = gauss(p + 1);
+        let h = self.h();
+        let mut row = DVector::zeros(self.size(block));
+        for e in 0..self.elements {
+            for (g, (&x, w)) in xs.iter().zip(&ws).enumerate() {
+                let sample = &samples[e * (p + 1) + g];
+                let d = &sample.directors;
+                let (val, _) = self.shape(x);
+                for (local, phi) in val.iter().enumerate() {
+                    let Some(node) = (e * p + local).checked_sub(1) else {
+                        continue;
+                    };
+                    for (i, &c) in comps.iter().enumerate() {
+                        row[node * comps.len() + i] += w * h * phi * a.dot(&d[c].cross(&d[2]));
+                    }
+                }
+            }
+        }
+        row
     }
 
     /// Nodal values of ω (3 components, zero at the clamp) from a vector of

@@ -64,7 +64,8 @@ pub struct CaseFile {
     pub title: String,
     /// The problem file, relative to the case file.
     pub problem: String,
-    /// `solve`, `critical-load` or `jacobian-singularity`.
+    /// `solve`, `critical-load`, `jacobian-singularity`, `stability-loss` or
+    /// `optimize`.
     pub analysis: String,
     /// The methods the case applies to (see [`METHODS`]).
     pub methods: Vec<String>,
@@ -82,7 +83,7 @@ pub struct CaseFile {
     /// What the reader should know: conventions, what is left out and why.
     #[serde(default)]
     pub note: String,
-    /// The parameter scan of `jacobian-singularity`.
+    /// The parameter scan of `jacobian-singularity` and `stability-loss`.
     #[serde(default)]
     pub scan: Option<Scan>,
     /// The points (parameter sets) of the case.
@@ -130,7 +131,8 @@ pub struct Point {
 #[serde(deny_unknown_fields)]
 pub struct Check {
     /// tip_x, tip_y, tip_z, tip_angle, tip_chord (solve); critical_load,
-    /// chi (critical-load); branch_point (jacobian-singularity).
+    /// chi (critical-load); branch_point (jacobian-singularity,
+    /// stability-loss).
     pub quantity: String,
     /// The reference value.
     pub reference: Reference,
@@ -267,19 +269,23 @@ pub fn load_case(path: &Path) -> Result<Case, InputError> {
     let text = std::fs::read_to_string(path).map_err(|e| bad(e.to_string()))?;
     let file: CaseFile = toml::from_str(&text).map_err(|e| bad(e.to_string()))?;
     let analysis = file.analysis.as_str();
-    if !["solve", "critical-load", "jacobian-singularity", "optimize"].contains(&analysis) {
+    const ANALYSES: [&str; 5] = [
+        "solve",
+        "critical-load",
+        "jacobian-singularity",
+        "stability-loss",
+        "optimize",
+    ];
+    if !ANALYSES.contains(&analysis) {
         return Err(bad(format!(
-            "analysis `{analysis}`: expected solve, critical-load, jacobian-singularity or optimize"
+            "analysis `{analysis}`: expected one of {}",
+            ANALYSES.join(", ")
         )));
     }
-    if analysis == "jacobian-singularity" {
+    if ["jacobian-singularity", "stability-loss"].contains(&analysis) {
         match &file.scan {
             Some(s) if s.lo < s.hi && s.steps >= 1 => {}
-            _ => {
-                return Err(bad(
-                    "jacobian-singularity needs a [scan] with lo < hi".into()
-                ))
-            }
+            _ => return Err(bad(format!("{analysis} needs a [scan] with lo < hi"))),
         }
     }
     for m in &file.methods {
@@ -547,6 +553,20 @@ fn run_analysis(
                 }
             }
         }
+        "stability-loss" => {
+            let scan = case.file.scan.as_ref().expect("checked on load");
+            let lowest = |x: f64| -> Result<f64, String> {
+                let mut params = params.clone();
+                params.insert(scan.parameter.clone(), x);
+                let problem = build(&params).map_err(|e| e.0)?;
+                lowest_eigenvalue(&problem).map_err(|e| format!("{} = {x}: {e}", scan.parameter))
+            };
+            singularity(scan, lowest).map(|(found, message)| Outcome {
+                values: [("branch_point".to_string(), found)].into_iter().collect(),
+                time: 0.0,
+                message: message.replace("det J", "the lowest eigenvalue of δ²V"),
+            })
+        }
         _ => {
             let scan = case.file.scan.as_ref().expect("checked on load");
             let det = |x: f64| -> Result<f64, String> {
@@ -568,7 +588,23 @@ fn run_analysis(
     Ok(outcome.map(|o| Outcome { time, ..o }))
 }
 
-/// The first sign change of det J over the scan, bisected to round-off.
+/// The lowest eigenvalue of the second variation (every block, on the
+/// tip support's constraints) at the problem's equilibrium: it crosses zero
+/// where stability is lost, also where the BVP Jacobian's determinant only
+/// touches zero (a pair of buckling modes, as in Greenhill's problem).
+fn lowest_eigenvalue(problem: &Problem) -> Result<f64, String> {
+    let eq = solve(&problem.rod, &problem.model, &problem.options).map_err(|e| e.to_string())?;
+    let st = crate::stability::analyze(&problem.rod, &eq, &problem.options, &problem.stability)
+        .map_err(|e| e.to_string())?;
+    Ok(st
+        .blocks
+        .iter()
+        .flat_map(|b| b.eigenvalues.iter().copied())
+        .fold(f64::INFINITY, f64::min))
+}
+
+/// The first sign change of `f` (det J or an eigenvalue) over the scan,
+/// bisected to round-off.
 fn singularity(
     scan: &Scan,
     det: impl Fn(f64) -> Result<f64, String>,

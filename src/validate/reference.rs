@@ -161,6 +161,17 @@ pub const FORMULAS: &[(&str, &str, &str)] = &[
     ),
     ("euler_clamped_free", "", "F L²/B = π²/4 (Euler 1744)"),
     (
+        "clamped_guided",
+        "",
+        "F L²/B = 4π²: a column clamped at both ends, one sliding (Timoshenko & Gere 1961, Sec. 2.3)",
+    ),
+    (
+        "greenhill_clamped",
+        "twist",
+        "smallest P L²/B with a nontrivial w of B w'''' − i M w''' + P w'' = 0, w = w' = 0 at both \
+         ends (Greenhill 1883; Ziegler 1968, Sec. 2.7), M L/B = twist",
+    ),
+    (
         "elastica_column_load",
         "alpha_deg",
         "F L²/B = K(sin(α/2))² (clamped–free elastica)",
@@ -220,6 +231,56 @@ fn param(params: &BTreeMap<String, f64>, name: &str, formula: &str) -> Result<f6
         .ok_or_else(|| format!("formula `{formula}` needs the parameter `{name}`"))
 }
 
+/// Greenhill's twisted column with clamped ends (B = L = 1, torque τ): the
+/// lateral deflection w = a + b s + c e^{i k1 s} + d e^{i k2 s},
+/// k = (τ ± √(τ² + 4P))/2, meets w(0) = w'(0) = w(1) = w'(1) = 0 where the
+/// 4 × 4 determinant vanishes; det · e^{−iτ/2} is imaginary, and its
+/// imaginary part is scanned from P = 0.01 and bisected.
+pub fn greenhill_clamped(tau: f64) -> f64 {
+    use nalgebra::{Complex, Matrix4};
+    let f = |p: f64| {
+        let r = (tau * tau + 4.0 * p).sqrt();
+        let (k1, k2) = ((tau + r) / 2.0, (tau - r) / 2.0);
+        let i = Complex::new(0.0, 1.0);
+        let (one, zero) = (Complex::new(1.0, 0.0), Complex::new(0.0, 0.0));
+        let (e1, e2) = ((i * k1).exp(), (i * k2).exp());
+        let a = Matrix4::new(
+            one,
+            zero,
+            one,
+            one, //
+            zero,
+            one,
+            i * k1,
+            i * k2, //
+            one,
+            one,
+            e1,
+            e2, //
+            zero,
+            one,
+            i * k1 * e1,
+            i * k2 * e2,
+        );
+        (a.determinant() * (-i * tau / 2.0).exp()).im
+    };
+    let step = 0.01;
+    let mut lo = step;
+    while f(lo) * f(lo + step) > 0.0 && lo < 100.0 {
+        lo += step;
+    }
+    let mut hi = lo + step;
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if f(lo) * f(mid) <= 0.0 {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
 /// Evaluates the formula `name` with the point's parameters.
 pub fn evaluate(name: &str, params: &BTreeMap<String, f64>) -> Result<f64, String> {
     let k = || param(params, "k", name);
@@ -259,6 +320,8 @@ pub fn evaluate(name: &str, params: &BTreeMap<String, f64>) -> Result<f64, Strin
             2.0 * (m / 2.0).sin().abs() / m
         }
         "none" => f64::NAN,
+        "greenhill_clamped" => greenhill_clamped(param(params, "twist", name)?),
+        "clamped_guided" => 4.0 * PI * PI,
         "timoshenko_ltb" => 2.0 * j(),
         "timoshenko_chi" => (2.0 * j()).sqrt(),
         other => {

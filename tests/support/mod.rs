@@ -3,5 +3,6 @@
 #![allow(dead_code)]
 
 pub mod bessel;
+pub mod columns;
 pub mod elliptic;
 pub mod references;

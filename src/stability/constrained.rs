@@ -1,0 +1,289 @@
+//! The pencil (K, G) restricted to the null space of a few linear
+//! constraints C v = 0: the second variation of a rod whose tip is held
+//! (a position held in some directions is ∫ R(ω × e3) ds = 0 along them, a
+//! held frame is ω(L) = 0 in some directions).
+//!
+//! With m ≪ n constraints nothing dense of size n is formed. For a shift σ
+//! and A = K − σG (banded LDLᵀ), Z = A⁻¹Cᵀ and S = C Z (m × m):
+//!
+//! * inertia: by Haynsworth's formula on the bordered matrix
+//!   [A Cᵀ; C 0] and In([A Cᵀ; C 0]) = In(A|null C) + (m, m, 0)
+//!   (Gould, Math. Prog. 32 (1985)), the number of eigenvalues of the
+//!   constrained pencil below σ is neg(A) + pos(S) − m;
+//! * shift-invert: T = (A⁻¹ − Z S⁻¹ Zᵀ) G solves the bordered system; it
+//!   is G-self-adjoint, maps into null C, and on null C its eigenvalues are
+//!   1/(λ − σ), so the Lanczos of [`super::eigen`] applies unchanged.
+//!
+//! Each solve costs m + 1 banded solves: still O(n) per eigenvalue.
+
+use nalgebra::{DMatrix, DVector};
+
+use super::banded::{BandedLdlt, SymmetricBanded};
+use super::eigen::{
+    count_below, dense_pencil, lanczos, lowest_eigenpairs_near, EigenError, Eigenpairs, DENSE_LIMIT,
+};
+
+/// Linear constraints C v = 0 with orthonormal rows (m × n).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Constraints {
+    rows: DMatrix<f64>,
+}
+
+impl Constraints {
+    /// No constraints on vectors of size n.
+    pub fn none(n: usize) -> Self {
+        Constraints {
+            rows: DMatrix::zeros(0, n),
+        }
+    }
+
+    /// From rows that may be dependent or zero: Gram–Schmidt keeps an
+    /// orthonormal basis of their span (rows below 1e-10 of the largest
+    /// are dropped).
+    pub fn from_rows(rows: &[DVector<f64>], n: usize) -> Self {
+        let scale = rows.iter().map(|r| r.norm()).fold(0.0, f64::max);
+        let mut basis: Vec<DVector<f64>> = Vec::new();
+        for r in rows {
+            let mut v = r.clone();
+            for _ in 0..2 {
+                for b in &basis {
+                    v -= b * b.dot(&v);
+                }
+            }
+            let norm = v.norm();
+            if norm > 1e-10 * scale {
+                basis.push(v / norm);
+            }
+        }
+        let mut m = DMatrix::zeros(basis.len(), n);
+        for (i, b) in basis.iter().enumerate() {
+            m.set_row(i, &b.transpose());
+        }
+        Constraints { rows: m }
+    }
+
+    /// The number of independent constraints.
+    pub fn count(&self) -> usize {
+        self.rows.nrows()
+    }
+
+    /// C v.
+    fn apply(&self, v: &[f64]) -> DVector<f64> {
+        &self.rows * DVector::from_column_slice(v)
+    }
+}
+
+/// A = K − σG factored, with Z = A⁻¹Cᵀ and S = C Z.
+struct Bordered {
+    a: BandedLdlt,
+    z: DMatrix<f64>,
+    s: DMatrix<f64>,
+}
+
+impl Bordered {
+    fn new(k: &SymmetricBanded, g: &SymmetricBanded, c: &Constraints, sigma: f64) -> Option<Self> {
+        let a = k.combine(1.0, g, -sigma).ldlt().ok()?;
+        let (m, n) = (c.count(), k.size());
+        let mut z = DMatrix::zeros(n, m);
+        for j in 0..m {
+            let mut col: Vec<f64> = c.rows.row(j).iter().copied().collect();
+            a.solve_in_place(&mut col);
+            z.set_column(j, &DVector::from_vec(col));
+        }
+        let s = &c.rows * &z;
+        Some(Bordered {
+            s: (&s + s.transpose()) * 0.5,
+            a,
+            z,
+        })
+    }
+
+    /// neg(A) + pos(S) − m.
+    fn count_below(&self) -> usize {
+        let pos = self
+            .s
+            .symmetric_eigenvalues()
+            .iter()
+            .filter(|&&v| v > 0.0)
+            .count();
+        (self.a.negative_pivots() + pos).saturating_sub(self.s.nrows())
+    }
+
+    /// y = (A⁻¹ − Z S⁻¹ Zᵀ) b.
+    fn solve(&self, s_inv: &DMatrix<f64>, b: &mut [f64]) {
+        let zt_b = self.z.transpose() * DVector::from_column_slice(b);
+        self.a.solve_in_place(b);
+        let corr = &self.z * (s_inv * zt_b);
+        b.iter_mut().zip(corr.iter()).for_each(|(y, c)| *y -= c);
+    }
+}
+
+/// The number of eigenvalues below σ of (K, G) on null C.
+pub fn count_below_constrained(
+    k: &SymmetricBanded,
+    g: &SymmetricBanded,
+    c: &Constraints,
+    sigma: f64,
+) -> usize {
+    if c.count() == 0 {
+        return count_below(k, g, sigma);
+    }
+    let mut s = sigma;
+    for _ in 0..8 {
+        if let Some(b) = Bordered::new(k, g, c, s) {
+            return b.count_below();
+        }
+        s += 1e-12 * s.abs().max(1e-300);
+    }
+    0
+}
+
+/// The `count` lowest eigenpairs of (K, G) on null C; `previous` as in
+/// [`lowest_eigenpairs_near`].
+pub fn lowest_eigenpairs_constrained(
+    k: &SymmetricBanded,
+    g: &SymmetricBanded,
+    c: &Constraints,
+    count: usize,
+    previous: Option<(f64, f64)>,
+) -> Result<Eigenpairs, EigenError> {
+    if c.count() == 0 {
+        return lowest_eigenpairs_near(k, g, count, previous);
+    }
+    let count = count.min(k.size().saturating_sub(c.count()));
+    if k.size() <= DENSE_LIMIT {
+        return dense_constrained(k, g, c, count);
+    }
+    let sigma = shift_below(k, g, c);
+    let bordered = Bordered::new(k, g, c, sigma)
+        .ok_or_else(|| EigenError::NotDefinite(format!("K − σG is singular at σ = {sigma}")))?;
+    let s_inv = bordered
+        .s
+        .clone()
+        .try_inverse()
+        .ok_or_else(|| EigenError::NotDefinite("the constraints are degenerate".into()))?;
+    let apply = |x: &[f64], y: &mut [f64]| {
+        g.matvec(x, y);
+        bordered.solve(&s_inv, y);
+    };
+    let mut steps = 3 * count + 40;
+    loop {
+        let ritz = lanczos(
+            k.size(),
+            count,
+            steps,
+            apply,
+            g,
+            |theta| sigma + 1.0 / theta,
+            |a, b| b.total_cmp(&a),
+        )?;
+        match verify(k, g, c, ritz) {
+            Ok(pairs) => return Ok(pairs),
+            Err(_) if steps < k.size() => steps = (2 * steps).min(k.size()),
+            Err(e) => return Err(e),
+        }
+    }
+}
+
+/// A shift below the constrained spectrum by Sturm bisection on the
+/// constrained count, kept a relative 1e-8 away from λ_1.
+fn shift_below(k: &SymmetricBanded, g: &SymmetricBanded, c: &Constraints) -> f64 {
+    let scale = (0..k.size())
+        .map(|i| (k.get(i, i) / g.get(i, i)).abs())
+        .fold(1e-12, f64::max);
+    let below = |s: f64| count_below_constrained(k, g, c, s);
+    let mut lo = -1e-6 * scale;
+    while below(lo) > 0 && lo > -1e6 * scale {
+        lo *= 4.0;
+    }
+    let mut hi = 1e-6 * scale;
+    while below(hi) == 0 && hi < 1e6 * scale {
+        hi *= 4.0;
+    }
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if below(mid) == 0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+        if hi - lo <= (0.05 * (hi.abs() + lo.abs())).max(1e-8 * scale) {
+            break;
+        }
+    }
+    lo - (0.05 * (hi - lo)).max(1e-8 * scale)
+}
+
+/// Backward error of K v − λ G v projected off the constraint normals, and
+/// C v = 0, both to 1e-8.
+fn verify(
+    k: &SymmetricBanded,
+    g: &SymmetricBanded,
+    c: &Constraints,
+    pairs: Eigenpairs,
+) -> Result<Eigenpairs, EigenError> {
+    let n = k.size();
+    let (mut kv, mut gv) = (vec![0.0; n], vec![0.0; n]);
+    for (lambda, v) in pairs.values.iter().zip(&pairs.vectors) {
+        k.matvec(v, &mut kv);
+        g.matvec(v, &mut gv);
+        let r = DVector::from_iterator(n, kv.iter().zip(&gv).map(|(a, b)| a - lambda * b));
+        let r = &r - c.rows.transpose() * (&c.rows * &r);
+        let v_norm = DVector::from_column_slice(v).norm();
+        let scale = (kv.iter().map(|x| x.abs()).fold(0.0, f64::max)
+            + lambda.abs() * gv.iter().map(|x| x.abs()).fold(0.0, f64::max))
+        .max(f64::MIN_POSITIVE);
+        let backward = r.norm() / scale / (n as f64).sqrt();
+        if backward > 1e-8 || c.apply(v).norm() > 1e-8 * v_norm {
+            return Err(EigenError::NoConvergence {
+                residual: backward,
+                steps: 0,
+            });
+        }
+    }
+    Ok(pairs)
+}
+
+/// Small problems: an orthonormal basis N of null C (Gram–Schmidt on the
+/// columns of I − CᵀC, C having orthonormal rows), the dense pencil
+/// (NᵀKN, NᵀGN), and v = N u.
+fn dense_constrained(
+    k: &SymmetricBanded,
+    g: &SymmetricBanded,
+    c: &Constraints,
+    count: usize,
+) -> Result<Eigenpairs, EigenError> {
+    let n = k.size();
+    let dim = n - c.count();
+    let projector = DMatrix::identity(n, n) - c.rows.transpose() * &c.rows;
+    let mut basis = DMatrix::zeros(n, dim);
+    let mut found = 0;
+    for j in 0..n {
+        if found == dim {
+            break;
+        }
+        let mut v = projector.column(j).into_owned();
+        for _ in 0..2 {
+            for i in 0..found {
+                let b = basis.column(i).into_owned();
+                v -= &b * b.dot(&v);
+            }
+        }
+        let norm = v.norm();
+        if norm > 1e-8 {
+            basis.set_column(found, &(v / norm));
+            found += 1;
+        }
+    }
+    let kr = basis.transpose() * k.to_dense() * &basis;
+    let gr = basis.transpose() * g.to_dense() * &basis;
+    let pairs = dense_pencil(&kr, &gr, count)?;
+    Ok(Eigenpairs {
+        values: pairs.values,
+        vectors: pairs
+            .vectors
+            .iter()
+            .map(|u| (&basis * DVector::from_column_slice(u)).as_slice().to_vec())
+            .collect(),
+    })
+}
