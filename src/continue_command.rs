@@ -142,18 +142,12 @@ pub fn run_continue(
     }
     println!("written   {}", output.display());
     if let Some(png) = plot {
-        let measure = problem
-            .text
-            .lines()
-            .find(|l| l.trim_start().starts_with("measure"))
-            .map_or("tip_x", |l| {
-                let v = l.split('=').nth(1).unwrap_or("").trim().trim_matches('"');
-                MEASURES
-                    .iter()
-                    .find(|m| **m == v)
-                    .copied()
-                    .unwrap_or("tip_x")
-            });
+        // The validated `[continuation] measure` of the problem text.
+        let table: Option<toml::Table> = toml::from_str(&problem.text).ok();
+        let measure = table
+            .as_ref()
+            .and_then(|t| t.get("continuation")?.get("measure")?.as_str())
+            .unwrap_or("tip_x");
         if let Err(e) = plot_file(&output, measure, &png) {
             return fail(1, e);
         }

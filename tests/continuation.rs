@@ -16,12 +16,13 @@ use cosserat::io::Problem;
 use cosserat::model::ModelLevel;
 use cosserat::stability::Block;
 use nalgebra::{DMatrix, DVector};
-use support::elliptic::ellip_f;
+use support::elliptic::{ellip_e, ellip_f};
 
-const FILES: [&str; 3] = [
+const FILES: [&str; 4] = [
     "euler_column",
     "planar_clamp_angle",
     "lateral_torsional_buckling",
+    "guided_column",
 ];
 
 fn problem(name: &str) -> Problem {
@@ -87,31 +88,46 @@ fn euler_branch_point_and_the_elastica() {
 
 /// The smallest singular value of the 9-ODE shooting Jacobian at a point
 /// of a family, relative to the largest (planar points are lifted to
-/// κ(0) = (0, κ2(0), 0)).
+/// κ(0) = (0, κ2(0), 0) and a planar tip reaction (R_x, R_z) to
+/// R_x d1(0) + R_z d3(0)).
 fn kirchhoff_singularity(f: &Family, x: &[f64], p: f64) -> f64 {
     let rod = f.rod_at(p).unwrap();
     let eq = equations(&rod, ModelLevel::Kirchhoff);
     let mut sys = ShootingSystem::new(eq.as_ref(), 1, Tolerances::default());
-    let u = if x.len() == 1 {
-        vec![0.0, x[0], 0.0]
+    let n = eq.unknowns();
+    let u = if f.level() == ModelLevel::Planar {
+        let mut u = vec![0.0, x[0], 0.0];
+        if x.len() == 3 {
+            let r = rod.clamp.director(0) * x[1] + rod.clamp.director(2) * x[2];
+            u.extend_from_slice(r.as_slice());
+        }
+        u
     } else {
-        x[..3].to_vec()
+        x[..n].to_vec()
     };
-    let (mut r, mut j) = (DVector::zeros(3), DMatrix::zeros(3, 3));
+    let (mut r, mut j) = (DVector::zeros(n), DMatrix::zeros(n, n));
     sys.evaluate(&u, &mut r, &mut j).unwrap();
     let sv = j.singular_values();
     sv.min() / sv.max()
 }
 
-/// The eigenvalue nearest zero of `block` at (x, p) on 160 elements of
-/// order 2.
+/// The eigenvalue nearest zero of `block` at (x, p) on 480 elements of
+/// order 2 (on the tip support's constraints): converged to ≈ 1e-7 also on
+/// the looped post-buckled columns.
 fn fine_eigenvalue(f: &Family, x: &[f64], p: f64, block: Block) -> f64 {
-    use cosserat::stability::{coefficients, eigen::lowest_eigenpairs, FiniteElements};
+    use cosserat::stability::constrained::lowest_eigenpairs_constrained;
+    use cosserat::stability::{coefficients, support_constraints, FiniteElements};
     let rod = f.rod_at(p).unwrap();
-    let fe = FiniteElements::new(rod.length, 160, 2);
-    let samples = f.samples(x, p, &fe.quadrature_points()).unwrap();
+    let fe = FiniteElements::new(rod.length, 480, 2);
+    let mut points = fe.quadrature_points();
+    points.push(rod.length);
+    let mut samples = f.samples(x, p, &points).unwrap();
+    let tip = samples.pop().unwrap();
     let c = coefficients(&rod, &samples);
-    let pairs = lowest_eigenpairs(&fe.stiffness(&c, block), &fe.mass(block), 4).unwrap();
+    let constraints = support_constraints(&rod, &fe, block, &samples, &tip);
+    let (k, g) = (fe.stiffness(&c, block), fe.mass(block));
+    let pairs = lowest_eigenpairs_constrained(&k, &g, &constraints, 4, None)
+        .unwrap_or_else(|e| panic!("p = {p}, {block:?}: {e}"));
     pairs
         .values
         .into_iter()
@@ -125,7 +141,7 @@ fn hessian_and_bvp_jacobian_are_singular_at_every_special_point() {
         let (p, d) = diagram(name);
         assert!(!d.special_points.is_empty(), "{name}: no special points");
         for s in &d.special_points {
-            // The Hessian on a mesh 8× finer than the tracking one, so that
+            // The Hessian on a mesh much finer than the tracking one, so that
             // what is checked is the second variation, not its mesh.
             let eigenvalue =
                 fine_eigenvalue(family(p), &s.point.unknowns, s.point.parameter, s.block);
@@ -237,7 +253,11 @@ fn natural_parameter_stepping_fails_at_a_fold() {
 
 #[test]
 fn branch_switching_lands_on_new_branches() {
-    for name in ["euler_column", "lateral_torsional_buckling"] {
+    for name in [
+        "euler_column",
+        "lateral_torsional_buckling",
+        "guided_column",
+    ] {
         let (_, d) = diagram(name);
         let switched: Vec<_> = d
             .special_points
@@ -256,6 +276,7 @@ fn branch_switching_lands_on_new_branches() {
                 // branch is straight (Euler) or planar (lateral-torsional).
                 let off = child.points.iter().skip(2).map(|p| match name {
                     "euler_column" => p.tip.position[0].abs(),
+                    "guided_column" => (1.0 - p.tip.position[2]).abs(),
                     _ => p.tip.position[1].abs(),
                 });
                 assert!(
@@ -263,6 +284,40 @@ fn branch_switching_lands_on_new_branches() {
                     "{name}: child {c} back on the parent"
                 );
             }
+        }
+    }
+}
+
+/// The clamped–guided column: the branch point at 4π² and the buckled
+/// branch as four clamped–free quarters, P L²/B = 16 K(k)² and
+/// z(L)/L = 2E(k)/K(k) − 1 (Timoshenko & Gere, Sec. 2.7), k from P.
+#[test]
+fn guided_column_branch_point_and_its_elastica() {
+    let (_, d) = diagram("guided_column");
+    let bp = &d.special_points[0];
+    let exact = 4.0 * PI * PI;
+    assert!((bp.point.parameter - exact).abs() <= 1e-8 * exact);
+    assert_eq!(bp.children.len(), 2);
+    for &child in &bp.children {
+        for p in d.branches[child].points.iter().skip(1) {
+            // Bisection for k with 16 K(k)² = P.
+            let (mut lo, mut hi) = (0.0, 1.0 - 1e-15);
+            for _ in 0..100 {
+                let mid = 0.5 * (lo + hi);
+                if 16.0 * ellip_f(PI / 2.0, mid).powi(2) < p.parameter {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            let k = 0.5 * (lo + hi);
+            let z = 2.0 * ellip_e(PI / 2.0, k) / ellip_f(PI / 2.0, k) - 1.0;
+            assert!(
+                (p.tip.position[2] - z).abs() < 1e-8,
+                "P = {}: z = {} vs {z}",
+                p.parameter,
+                p.tip.position[2]
+            );
         }
     }
 }

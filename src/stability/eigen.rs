@@ -39,17 +39,29 @@ pub enum EigenError {
 pub const DENSE_LIMIT: usize = 48;
 
 /// The number of eigenvalues of (K, G) below σ, from the inertia of K − σG
-/// (a zero pivot nudges σ by a relative 1e-12).
+/// (a zero pivot nudges σ up by a relative 1e-10 of the spectrum's scale;
+/// should every nudge break down too, the count is reported as 0).
 pub fn count_below(k: &SymmetricBanded, g: &SymmetricBanded, sigma: f64) -> usize {
+    try_count_below(k, g, sigma).unwrap_or(0)
+}
+
+/// [`count_below`], or None when K − σG has a zero pivot at σ and at every
+/// nudge: callers that must stay below the spectrum treat that as "not
+/// below" no longer.
+pub(super) fn try_count_below(
+    k: &SymmetricBanded,
+    g: &SymmetricBanded,
+    sigma: f64,
+) -> Option<usize> {
+    let nudge = 1e-10 * diagonal_ratio(k, g);
     let mut s = sigma;
     for _ in 0..8 {
         match k.combine(1.0, g, -s).ldlt() {
-            Ok(f) => return f.negative_pivots(),
-            Err(PivotBreakdown { .. }) => s += 1e-12 * s.abs().max(1e-300),
+            Ok(f) => return Some(f.negative_pivots()),
+            Err(PivotBreakdown { .. }) => s += nudge,
         }
     }
-    // A persistent zero pivot: count it as not below.
-    0
+    None
 }
 
 /// The `count` lowest eigenpairs of K v = λ G v.
@@ -144,17 +156,20 @@ fn diagonal_ratio(k: &SymmetricBanded, g: &SymmetricBanded) -> f64 {
 
 fn shift_below_spectrum(k: &SymmetricBanded, g: &SymmetricBanded) -> f64 {
     let scale = diagonal_ratio(k, g);
+    // An undecidable count (persistent zero pivots) counts as "below", so
+    // that the shift errs on the safe side, under the spectrum.
+    let none_below = |s: f64| try_count_below(k, g, s) == Some(0);
     let mut lo = -1e-6 * scale;
-    while count_below(k, g, lo) > 0 && lo > -1e6 * scale {
+    while !none_below(lo) && lo > -1e6 * scale {
         lo *= 4.0;
     }
     let mut hi = 1e-6 * scale;
-    while count_below(k, g, hi) == 0 && hi < 1e6 * scale {
+    while none_below(hi) && hi < 1e6 * scale {
         hi *= 4.0;
     }
     for _ in 0..60 {
         let mid = 0.5 * (lo + hi);
-        if count_below(k, g, mid) == 0 {
+        if none_below(mid) {
             lo = mid;
         } else {
             hi = mid;
@@ -206,7 +221,7 @@ fn verify(
     Ok(pairs)
 }
 
-fn row_sum_norm(a: &SymmetricBanded) -> f64 {
+pub(super) fn row_sum_norm(a: &SymmetricBanded) -> f64 {
     let n = a.size();
     let bw = a.bandwidth();
     (0..n)
