@@ -20,6 +20,10 @@ use crate::model::{ModelLevel, Profile, Rod};
 pub enum Parameter {
     /// All loads multiplied by p.
     LoadScale,
+    /// All loads and the intrinsic curvature κ⁰(s) multiplied by p
+    /// together: the control path of a designed arm, on which the
+    /// actuators raise κ⁰ as the load is applied (paper Sec. 5).
+    ControlScale,
     /// Component i of the tip force.
     TipForce(usize),
     /// Component i of the tip couple.
@@ -39,7 +43,7 @@ pub enum Parameter {
 impl Parameter {
     /// The parameter named by a problem-file key: `load_scale`,
     /// `loads.tip_force[i]`, `loads.tip_couple[i]`,
-    /// `loads.distributed_force[i]`, `rod.length`, `energy.stiffness[i]`,
+    /// `loads.distributed_force[i]`, `control_scale`, `rod.length`, `energy.stiffness[i]`,
     /// `energy.intrinsic_curvature[i]`, `clamp.angle`.
     pub fn from_key(key: &str) -> Option<Parameter> {
         let indexed = |prefix: &str| -> Option<usize> {
@@ -51,6 +55,7 @@ impl Parameter {
         };
         Some(match key {
             "load_scale" => Parameter::LoadScale,
+            "control_scale" => Parameter::ControlScale,
             "rod.length" => Parameter::Length,
             "clamp.angle" => Parameter::ClampAngle,
             _ => {
@@ -87,7 +92,8 @@ pub struct Family {
 pub enum FamilyError {
     /// The parameter needs a linear energy with constant profiles.
     #[error(
-        "parameter {0:?} needs the linear energy with constant stiffness and intrinsic curvature"
+        "parameter {0:?} needs the linear energy (with constant stiffness and intrinsic curvature \
+         for a stiffness or curvature parameter)"
     )]
     NotConstant(Parameter),
     /// A value outside the physical range.
@@ -144,6 +150,14 @@ impl Family {
         }
         match self.parameter {
             Parameter::LoadScale => rod.loads = self.base.loads.scaled(p),
+            Parameter::ControlScale => {
+                rod.loads = self.base.loads.scaled(p);
+                rod.energy = self
+                    .base
+                    .energy
+                    .with_intrinsic_scaled(p)
+                    .ok_or(FamilyError::NotConstant(self.parameter))?;
+            }
             Parameter::TipForce(i) => rod.loads.tip_force[i] = p,
             Parameter::TipCouple(i) => rod.loads.tip_couple[i] = p,
             Parameter::DistributedForce(i) => rod.loads.distributed_force[i] = p,

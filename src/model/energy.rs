@@ -39,6 +39,13 @@ pub trait StoredEnergy: std::fmt::Debug + Send + Sync {
     fn is_quadratic(&self) -> bool {
         false
     }
+    /// The same material with its intrinsic curvature κ⁰(s) multiplied by
+    /// `factor`, for energies that have one as a separate profile (None
+    /// otherwise): the control path of a designed arm raises κ⁰ with the
+    /// load (paper Sec. 5).
+    fn with_intrinsic_scaled(&self, _factor: f64) -> Option<std::sync::Arc<dyn StoredEnergy>> {
+        None
+    }
 }
 
 /// The linear-elastic energy with intrinsic curvature,
@@ -115,6 +122,13 @@ impl StoredEnergy for LinearElastic {
 
     fn is_quadratic(&self) -> bool {
         true
+    }
+
+    fn with_intrinsic_scaled(&self, factor: f64) -> Option<std::sync::Arc<dyn StoredEnergy>> {
+        Some(std::sync::Arc::new(LinearElastic {
+            stiffness: self.stiffness.clone(),
+            intrinsic_curvature: self.intrinsic_curvature.clone().map(|p| p.scaled(factor)),
+        }))
     }
 }
 

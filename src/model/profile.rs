@@ -69,6 +69,29 @@ impl Profile {
         }
     }
 
+    /// The profile times a constant factor (a control raising an
+    /// intrinsic curvature in proportion, paper Sec. 5).
+    pub fn scaled(&self, factor: f64) -> Profile {
+        let times = |v: &[f64]| v.iter().map(|x| x * factor).collect::<Vec<_>>();
+        match self {
+            Profile::Constant(v) => Profile::Constant(v * factor),
+            Profile::Polynomial(c) => Profile::Polynomial(times(c)),
+            Profile::Table { s, values } => Profile::Table {
+                s: s.clone(),
+                values: times(values),
+            },
+            Profile::Spline {
+                s,
+                values,
+                curvature,
+            } => Profile::Spline {
+                s: s.clone(),
+                values: times(values),
+                curvature: times(curvature),
+            },
+        }
+    }
+
     /// The value at s.
     pub fn value(&self, s: f64) -> f64 {
         match self {
