@@ -23,7 +23,7 @@ use crate::model::{
     Clamp, DeadLoads, LinearElastic, ModelChoice, ModelLevel, Profile, QuarticStiffening, Rod,
     StoredEnergy,
 };
-use crate::optimize::{ArmProblem, SearchOptions};
+use crate::optimize::{ArmProblem, ArmScene, SearchOptions};
 use crate::stability::{FixedShape, StabilityOptions};
 
 /// Why a problem could not be read.
@@ -372,6 +372,8 @@ pub struct Problem {
     pub continuation: Option<(Family, ContinuationOptions)>,
     /// The arm optimization, its search, and whether to compute R̂0.
     pub arm: Option<(ArmProblem, SearchOptions, bool)>,
+    /// The arm's loads and actuator limit, and the size of its reach map.
+    pub arm_scene: Option<(ArmScene, usize)>,
 }
 
 impl Problem {
@@ -396,6 +398,11 @@ impl Problem {
         let stability = build_stability(&file.stability)?;
         let continuation = build_continuation(&file, &rod, &model, &options, shape.as_ref())?;
         let arm = file.arm.as_ref().map(|a| a.build(&rod)).transpose()?;
+        let arm_scene = file
+            .arm
+            .as_ref()
+            .map(|a| a.scene(&rod).map(|s| (s, a.map_samples)))
+            .transpose()?;
         Ok(Problem {
             rod,
             model,
@@ -405,6 +412,7 @@ impl Problem {
             stability,
             continuation,
             arm,
+            arm_scene,
         })
     }
 }
