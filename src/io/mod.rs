@@ -8,7 +8,7 @@ mod diagram;
 mod hdf5_output;
 mod problem;
 
-pub use arm_output::write_arm;
+pub use arm_output::{read_search, write_arm, write_arm_study, ArmStudy, SavedSearch};
 pub use arm_section::ArmSection;
 pub use continuation_section::{ContinuationSection, MEASURES};
 pub use diagram::{read_saved, write_diagram};
