@@ -61,9 +61,14 @@ pub fn run_optimize(run: OptimizeRun) -> ExitCode {
     let stop = || interrupted.load(std::sync::atomic::Ordering::SeqCst);
     let (optimum, progress, was_interrupted) = arm.search(scene, search, progress, &stop);
     let Some(opt) = optimum else {
+        let limit = scene.max_curvature.map_or(String::new(), |k| {
+            format!(" that the actuator limit arm.max_curvature = {k} can hold")
+        });
         return fail(
             2,
-            "no design with a finite critical load was found in the bounds",
+            format!(
+                "arm.bounds: no design with a finite critical load{limit} was found in the bounds"
+            ),
         );
     };
     if was_interrupted {

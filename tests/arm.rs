@@ -393,3 +393,111 @@ fn actuator_limit_constrains_the_optimum() {
         last = r;
     }
 }
+
+fn optimize(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_cosserat"))
+        .arg("optimize")
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn read_reach(path: &std::path::Path) -> (f64, Vec<f64>, u64) {
+    let f = hdf5::File::open(path).unwrap();
+    let reach = f
+        .dataset("optimum/reach")
+        .unwrap()
+        .read_scalar::<f64>()
+        .unwrap();
+    let c = f
+        .dataset("optimum/shape_coefficients")
+        .unwrap()
+        .read_raw::<f64>()
+        .unwrap();
+    let evaluations = f
+        .group("optimum")
+        .unwrap()
+        .attr("evaluations")
+        .unwrap()
+        .read_scalar::<u64>()
+        .unwrap();
+    (reach, c, evaluations)
+}
+
+/// `optimize --resume` (issue 9): a run interrupted by SIGINT keeps its
+/// search progress; resuming it goes on from there (not from the start)
+/// and ends on exactly the optimum of an uninterrupted run, with the same
+/// number of design evaluations — nothing lost, nothing done twice. A file
+/// of another problem is refused.
+#[test]
+fn interrupted_optimization_resumes_where_it_stopped() {
+    let dir = std::env::temp_dir().join(format!("cosserat-opt-resume-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (out, reference) = (dir.join("arm.h5"), dir.join("reference.h5"));
+    let file = format!("{}/problems/longest_arm.toml", env!("CARGO_MANIFEST_DIR"));
+    let set = ["--set", "arm.samples=6000", "--set", "arm.straight=false"];
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_cosserat"))
+        .args(["optimize", &file, "-o", out.to_str().unwrap()])
+        .args(set)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1000));
+    let _ = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status();
+    assert_eq!(child.wait().unwrap().code(), Some(130));
+    let kept = hdf5::File::open(&out)
+        .unwrap()
+        .group("search")
+        .unwrap()
+        .attr("samples_done")
+        .unwrap()
+        .read_scalar::<u64>()
+        .unwrap();
+    assert!((1..6000).contains(&kept), "samples done {kept}");
+    let other = optimize(&[&file, "-o", out.to_str().unwrap(), "--resume"]);
+    assert_eq!(
+        other.status.code(),
+        Some(2),
+        "another problem (other --set) resumed"
+    );
+    let resumed = optimize(&[
+        &file,
+        "-o",
+        out.to_str().unwrap(),
+        "--resume",
+        set[0],
+        set[1],
+        set[2],
+        set[3],
+    ]);
+    let text = String::from_utf8_lossy(&resumed.stdout);
+    assert_eq!(resumed.status.code(), Some(0), "{text}");
+    assert!(text.contains(&format!("after {kept} samples")), "{text}");
+    let whole = optimize(&[
+        &file,
+        "-o",
+        reference.to_str().unwrap(),
+        set[0],
+        set[1],
+        set[2],
+        set[3],
+    ]);
+    assert_eq!(whole.status.code(), Some(0));
+    let (a, b) = (read_reach(&out), read_reach(&reference));
+    assert_eq!(a, b, "resumed {a:?} vs uninterrupted {b:?}");
+    let again = optimize(&[
+        &file,
+        "-o",
+        out.to_str().unwrap(),
+        "--resume",
+        set[0],
+        set[1],
+        set[2],
+        set[3],
+    ]);
+    assert!(String::from_utf8_lossy(&again.stdout).contains("nothing to resume"));
+    std::fs::remove_dir_all(dir).unwrap();
+}
