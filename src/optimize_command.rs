@@ -12,6 +12,23 @@ use cosserat::optimize::{ArmOptimum, ArmProblem, ArmScene, ArmWeight, SearchProg
 
 use crate::fail;
 
+/// How often a running search is saved (a kill loses at most this much).
+const CHECKPOINT: std::time::Duration = std::time::Duration::from_secs(2);
+
+/// A study of the best design so far, marked interrupted: what a killed or
+/// interrupted run leaves for `--resume`.
+fn interrupted_study<'a>(opt: &'a ArmOptimum, progress: &'a SearchProgress) -> ArmStudy<'a> {
+    ArmStudy {
+        optimum: opt,
+        straight: None,
+        map: None,
+        closest: None,
+        least_curvature: None,
+        progress: Some(progress),
+        stop_reason: "interrupted",
+    }
+}
+
 /// What `cosserat optimize` was asked for.
 pub struct OptimizeRun {
     /// The problem file.
@@ -59,7 +76,18 @@ pub fn run_optimize(run: OptimizeRun) -> ExitCode {
     }
     let t = Instant::now();
     let stop = || interrupted.load(std::sync::atomic::Ordering::SeqCst);
-    let (optimum, progress, was_interrupted) = arm.search(scene, search, progress, &stop);
+    let mut last_save = Instant::now();
+    let mut checkpoint = |p: &SearchProgress| {
+        if last_save.elapsed() < CHECKPOINT {
+            return;
+        }
+        if let (Some(out), Some(best)) = (&run.output, arm.best_so_far(scene, p)) {
+            let _ = write_arm_study(out, &problem.text, &interrupted_study(&best, p), true);
+        }
+        last_save = Instant::now();
+    };
+    let (optimum, progress, was_interrupted) =
+        arm.search(scene, search, progress, &stop, &mut checkpoint);
     let Some(opt) = optimum else {
         let limit = scene.max_curvature.map_or(String::new(), |k| {
             format!(" that the actuator limit arm.max_curvature = {k} can hold")
@@ -228,16 +256,7 @@ fn keep_interrupted(
         opt.design.reach
     );
     if let Some(out) = &run.output {
-        let study = ArmStudy {
-            optimum: opt,
-            straight: None,
-            map: None,
-            closest: None,
-            least_curvature: None,
-            progress: Some(progress),
-            stop_reason: "interrupted",
-        };
-        if let Err(e) = write_arm_study(out, text, &study, true) {
+        if let Err(e) = write_arm_study(out, text, &interrupted_study(opt, progress), true) {
             return fail(1, e);
         }
         eprintln!(

@@ -371,6 +371,7 @@ fn actuator_limit_constrains_the_optimum() {
             &SearchOptions::default(),
             Default::default(),
             &|| false,
+            &mut |_| {},
         );
         let o = o.unwrap();
         let r = o.design.reach;
@@ -424,58 +425,57 @@ fn read_reach(path: &std::path::Path) -> (f64, Vec<f64>, u64) {
     (reach, c, evaluations)
 }
 
-/// `optimize --resume` (issue 9): a run interrupted by SIGINT keeps its
-/// search progress; resuming it goes on from there (not from the start)
-/// and ends on exactly the optimum of an uninterrupted run, with the same
-/// number of design evaluations — nothing lost, nothing done twice. A file
-/// of another problem is refused.
-#[test]
-fn interrupted_optimization_resumes_where_it_stopped() {
-    let dir = std::env::temp_dir().join(format!("cosserat-opt-resume-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let (out, reference) = (dir.join("arm.h5"), dir.join("reference.h5"));
-    let file = format!("{}/problems/longest_arm.toml", env!("CARGO_MANIFEST_DIR"));
-    let set = ["--set", "arm.samples=6000", "--set", "arm.straight=false"];
+/// Starts `optimize` on `file` with `set`, sends `signal` after `wait`
+/// ms, and returns the exit code and the samples the file kept.
+fn interrupt(
+    file: &str,
+    out: &std::path::Path,
+    set: &[&str],
+    signal: &str,
+    wait: u64,
+) -> (Option<i32>, u64) {
     let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_cosserat"))
-        .args(["optimize", &file, "-o", out.to_str().unwrap()])
+        .args(["optimize", file, "-o", out.to_str().unwrap()])
         .args(set)
         .stdout(std::process::Stdio::null())
         .stderr(std::process::Stdio::null())
         .spawn()
         .unwrap();
-    std::thread::sleep(std::time::Duration::from_millis(1000));
+    std::thread::sleep(std::time::Duration::from_millis(wait));
     let _ = std::process::Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
+        .args([signal, &child.id().to_string()])
         .status();
-    assert_eq!(child.wait().unwrap().code(), Some(130));
-    let kept = hdf5::File::open(&out)
+    let code = child.wait().unwrap().code();
+    let f = hdf5::File::open(out).unwrap();
+    let reason = f
+        .attr("stop_reason")
         .unwrap()
+        .read_scalar::<hdf5::types::VarLenUnicode>()
+        .unwrap();
+    assert_eq!(reason.as_str(), "interrupted");
+    let kept = f
         .group("search")
         .unwrap()
         .attr("samples_done")
         .unwrap()
         .read_scalar::<u64>()
         .unwrap();
-    assert!((1..6000).contains(&kept), "samples done {kept}");
-    let other = optimize(&[&file, "-o", out.to_str().unwrap(), "--resume"]);
-    assert_eq!(
-        other.status.code(),
-        Some(2),
-        "another problem (other --set) resumed"
-    );
-    let resumed = optimize(&[
-        &file,
-        "-o",
-        out.to_str().unwrap(),
-        "--resume",
-        set[0],
-        set[1],
-        set[2],
-        set[3],
-    ]);
-    let text = String::from_utf8_lossy(&resumed.stdout);
-    assert_eq!(resumed.status.code(), Some(0), "{text}");
-    assert!(text.contains(&format!("after {kept} samples")), "{text}");
+    (code, kept)
+}
+
+/// `optimize --resume` (issue 9): a run interrupted by SIGINT, or killed
+/// (SIGKILL, no handler: the checkpoint saved every 2 s), keeps its search
+/// progress; resuming goes on from there (not from the start) and ends on
+/// exactly the optimum of an uninterrupted run, with the same number of
+/// design evaluations — nothing lost, nothing done twice. A file of another
+/// problem is refused; a completed one has nothing to resume.
+#[test]
+fn interrupted_optimization_resumes_where_it_stopped() {
+    let dir = std::env::temp_dir().join(format!("cosserat-opt-resume-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = format!("{}/problems/longest_arm.toml", env!("CARGO_MANIFEST_DIR"));
+    let set = ["--set", "arm.samples=6000", "--set", "arm.straight=false"];
+    let reference = dir.join("reference.h5");
     let whole = optimize(&[
         &file,
         "-o",
@@ -486,18 +486,39 @@ fn interrupted_optimization_resumes_where_it_stopped() {
         set[3],
     ]);
     assert_eq!(whole.status.code(), Some(0));
-    let (a, b) = (read_reach(&out), read_reach(&reference));
-    assert_eq!(a, b, "resumed {a:?} vs uninterrupted {b:?}");
-    let again = optimize(&[
-        &file,
-        "-o",
-        out.to_str().unwrap(),
-        "--resume",
-        set[0],
-        set[1],
-        set[2],
-        set[3],
-    ]);
-    assert!(String::from_utf8_lossy(&again.stdout).contains("nothing to resume"));
+    let expected = read_reach(&reference);
+    for (signal, wait, code) in [("-INT", 1000, Some(130)), ("-KILL", 3000, None)] {
+        let out = dir.join(format!("arm{signal}.h5"));
+        let (got, kept) = interrupt(&file, &out, &set, signal, wait);
+        assert_eq!(got, code, "{signal}");
+        assert!((1..6000).contains(&kept), "{signal}: samples done {kept}");
+        let other = optimize(&[&file, "-o", out.to_str().unwrap(), "--resume"]);
+        assert_eq!(
+            other.status.code(),
+            Some(2),
+            "another problem (other --set) resumed"
+        );
+        let resume = [
+            &file,
+            "-o",
+            out.to_str().unwrap(),
+            "--resume",
+            set[0],
+            set[1],
+            set[2],
+            set[3],
+        ];
+        let resumed = optimize(&resume);
+        let text = String::from_utf8_lossy(&resumed.stdout);
+        assert_eq!(resumed.status.code(), Some(0), "{text}");
+        assert!(text.contains(&format!("after {kept} samples")), "{text}");
+        let got = read_reach(&out);
+        assert_eq!(
+            got, expected,
+            "{signal}: resumed {got:?} vs uninterrupted {expected:?}"
+        );
+        let again = optimize(&resume);
+        assert!(String::from_utf8_lossy(&again.stdout).contains("nothing to resume"));
+    }
     std::fs::remove_dir_all(dir).unwrap();
 }

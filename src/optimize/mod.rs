@@ -248,8 +248,13 @@ impl ArmProblem {
         opts: &SearchOptions,
         stop: &dyn Fn() -> bool,
     ) -> Option<(ArmOptimum, bool)> {
-        let (optimum, _, interrupted) =
-            self.search(&ArmScene::default(), opts, SearchProgress::default(), stop);
+        let (optimum, _, interrupted) = self.search(
+            &ArmScene::default(),
+            opts,
+            SearchProgress::default(),
+            stop,
+            &mut |_| {},
+        );
         Some((optimum?, interrupted))
     }
 
@@ -259,13 +264,15 @@ impl ArmProblem {
     /// so far when interrupted), the progress to resume from, and whether
     /// `stop()` interrupted it. Resuming gives the same optimum as an
     /// uninterrupted run: the samples are a fixed sequence and a polish
-    /// cut short is redone from its start.
+    /// cut short is redone from its start. `checkpoint` sees the progress
+    /// after every sample and every polish (to save it against a kill).
     pub fn search(
         &self,
         scene: &ArmScene,
         opts: &SearchOptions,
         mut progress: SearchProgress,
         stop: &dyn Fn() -> bool,
+        checkpoint: &mut dyn FnMut(&SearchProgress),
     ) -> (Option<ArmOptimum>, SearchProgress, bool) {
         let keep = opts.starts.max(1);
         while progress.samples_done < opts.samples && !stop() {
@@ -278,6 +285,7 @@ impl ArmProblem {
                 progress.leaders.truncate(keep);
             }
             progress.samples_done = i;
+            checkpoint(&progress);
         }
         if self.bounds.is_empty() {
             let optimum = self
@@ -305,12 +313,23 @@ impl ArmProblem {
                 }
             }
             progress.polishes_done += 1;
+            checkpoint(&progress);
         }
-        let optimum = progress
-            .best
-            .clone()
-            .and_then(|b| self.finish(scene, b, progress.evaluations));
+        let optimum = self.best_so_far(scene, &progress);
         (optimum, progress, stop())
+    }
+
+    /// The best design of a search so far with its shapes: the best polish,
+    /// or the best sample while the global stage runs.
+    pub fn best_so_far(&self, scene: &ArmScene, progress: &SearchProgress) -> Option<ArmOptimum> {
+        let best = match &progress.best {
+            Some(b) if progress.polishes_done > 0 || progress.leaders.is_empty() => b.clone(),
+            _ => {
+                let (_, p) = progress.leaders.first()?;
+                self.design_in(scene, p)?
+            }
+        };
+        self.finish(scene, best, progress.evaluations)
     }
 
     /// The starting simplex around `start`: steps of 5 % of each bound's
