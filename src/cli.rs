@@ -90,6 +90,11 @@ pub enum Command {
         /// design, and write that diagram (HDF5, with a PNG beside it).
         #[arg(long)]
         control_path: Option<PathBuf>,
+        /// Also continue the designed arm along the shape-holding control,
+        /// κ⁰ = φ' − λ γ m̄ (the design shape an equilibrium at every load
+        /// λ), and write that diagram (HDF5, with a PNG beside it).
+        #[arg(long)]
+        holding_path: Option<PathBuf>,
         /// Draw the study (.png or .svg): reach map, optimum 'P', the
         /// sample closest to a straight rod 'Q', their shapes (Fig. 5).
         #[arg(long)]

@@ -39,6 +39,8 @@ pub struct OptimizeRun {
     pub loading_path: Option<PathBuf>,
     /// The control-path diagram (κ⁰ and load raised together).
     pub control_path: Option<PathBuf>,
+    /// The shape-holding diagram (κ⁰ = φ' − λγm̄).
+    pub holding_path: Option<PathBuf>,
     /// The chart of the study (Fig. 5).
     pub plot: Option<PathBuf>,
     /// `--set` overrides.
@@ -158,6 +160,7 @@ pub fn run_optimize(run: OptimizeRun) -> ExitCode {
     let paths = [
         (&run.loading_path, Route::LOADING),
         (&run.control_path, Route::CONTROL),
+        (&run.holding_path, Route::HOLDING),
     ];
     for (out, kind) in paths {
         if let Some(out) = out {
@@ -188,6 +191,7 @@ fn start_from(
         .filter(|_| !resumable)
         .chain(&run.loading_path)
         .chain(&run.control_path)
+        .chain(&run.holding_path)
         .chain(&run.plot);
     for out in targets {
         check_target(out, run.force).map_err(|e| fail(2, e))?;
@@ -331,6 +335,10 @@ impl Route {
         name: "control",
         axis: "control λ (κ⁰ = λ κ⁰_design, load × λ)",
     };
+    const HOLDING: Route = Route {
+        name: "holding",
+        axis: "shape-holding λ (κ⁰ = φ' − λγm̄, load × λ)",
+    };
 }
 
 /// Continues the designed arm along a path to its design and writes the
@@ -344,10 +352,10 @@ fn write_path(
     kind: Route,
 ) -> ExitCode {
     let t = Instant::now();
-    let diagram = if kind == Route::LOADING {
-        cosserat::optimize::loading_path_in(arm, scene, &opt.design, 2001)
-    } else {
-        cosserat::optimize::control_path(arm, scene, &opt.design, 2001)
+    let diagram = match kind.name {
+        "loading" => cosserat::optimize::loading_path_in(arm, scene, &opt.design, 2001),
+        "control" => cosserat::optimize::control_path(arm, scene, &opt.design, 2001),
+        _ => cosserat::optimize::shape_holding_path(arm, scene, &opt.design, 2001),
     };
     let diagram = match diagram {
         Ok(d) => d,

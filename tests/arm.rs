@@ -226,11 +226,14 @@ fn circular_arm_control_path_arrives_stably() {
 }
 
 /// The Sec. 4.4 arm (flat ellipse, M = 8) does not arrive at its design
-/// along either path: both end, stably, on another equilibrium of the
-/// design rod at the design load — the arm hangs below the clamp — far
-/// from the designed level tip (quadrature of φ).
+/// when loaded (κ⁰ fixed) nor along the proportional control (κ⁰ and load
+/// raised together): both end, stably, on another equilibrium of the design
+/// rod at the design load — the arm hangs below the clamp — far from the
+/// designed level tip (quadrature of φ). Holding its shape (κ⁰ = φ' − λγm̄)
+/// it does: the tip stays on the designed one at every λ, stable for λ < 1,
+/// marginal at λ = 1 (the design load is γ_crit).
 #[test]
-fn section_4_4_arm_paths_miss_the_design() {
+fn section_4_4_arm_reaches_its_design_only_holding_its_shape() {
     let path = format!("{}/problems/longest_arm.toml", env!("CARGO_MANIFEST_DIR"));
     let p = cosserat::io::Problem::from_path(std::path::Path::new(&path), &[]).unwrap();
     let (arm, search, _) = p.arm.unwrap();
@@ -238,6 +241,8 @@ fn section_4_4_arm_paths_miss_the_design() {
     let (x, z) = designed_tip(&o.design.shape_coefficients);
     assert!(x.abs() < 1e-6, "the design's tip is level: {x}");
     let scene = cosserat::optimize::ArmScene::default();
+    let miss =
+        |q: &cosserat::continuation::Point| (q.tip.position[0] - x).hypot(q.tip.position[2] - z);
     for d in [
         cosserat::optimize::loading_path(&arm, &o.design, 2001).unwrap(),
         cosserat::optimize::control_path(&arm, &scene, &o.design, 2001).unwrap(),
@@ -245,14 +250,32 @@ fn section_4_4_arm_paths_miss_the_design() {
         let last = d.branches[0].points.last().unwrap();
         assert_eq!(last.parameter, 1.0);
         assert!(last.stable);
-        let miss = (last.tip.position[0] - x).hypot(last.tip.position[2] - z);
-        assert!(miss > 0.5, "arrived within {miss}");
+        assert!(miss(last) > 0.5, "arrived within {}", miss(last));
         assert!(
             last.tip.position[0] > 0.3,
             "does not hang: {:?}",
             last.tip.position
         );
     }
+    let d = cosserat::optimize::shape_holding_path(&arm, &scene, &o.design, 2001).unwrap();
+    let points = &d.branches[0].points;
+    assert_eq!(points.last().unwrap().parameter, 1.0);
+    for q in points {
+        assert!(
+            miss(q) < 1e-7,
+            "off the design by {} at λ = {}",
+            miss(q),
+            q.parameter
+        );
+    }
+    assert!(points[..points.len() - 1].iter().all(|q| q.stable));
+    let lowest = points
+        .last()
+        .unwrap()
+        .eigenvalues
+        .iter()
+        .fold(f64::INFINITY, |a, b| a.min(b.abs()));
+    assert!(lowest < 1e-4, "not marginal: {lowest}");
 }
 
 fn straight_rod(b: [f64; 3], phi: f64) -> (cosserat::model::Rod, cosserat::stability::FixedShape) {

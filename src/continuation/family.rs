@@ -24,6 +24,12 @@ pub enum Parameter {
     /// together: the control path of a designed arm, on which the
     /// actuators raise κ⁰ as the load is applied (paper Sec. 5).
     ControlScale,
+    /// All loads multiplied by p and the intrinsic curvature moved from
+    /// the base rod's (p = 0) to a target's (p = 1), κ⁰ = (1 − p) κ⁰_base
+    /// + p κ⁰_target; build with [`Family::towards`]. With κ⁰_base = φ' and
+    /// κ⁰_target from (43) the designed shape is an equilibrium all along
+    /// (the shape-holding control of a designed arm).
+    CurvatureTowards,
     /// Component i of the tip force.
     TipForce(usize),
     /// Component i of the tip couple.
@@ -81,6 +87,8 @@ impl Parameter {
 #[derive(Debug, Clone)]
 pub struct Family {
     base: Rod,
+    /// The target energy of [`Parameter::CurvatureTowards`].
+    target: Option<std::sync::Arc<dyn crate::model::StoredEnergy>>,
     parameter: Parameter,
     level: ModelLevel,
     segments: usize,
@@ -113,10 +121,32 @@ impl Family {
     ) -> Self {
         Family {
             base,
+            target: None,
             parameter,
             level,
             segments: segments.max(1),
             tolerances,
+        }
+    }
+
+    /// The family [`Parameter::CurvatureTowards`]: the loads of `base`
+    /// scaled by p, κ⁰ moved from `base`'s to `target`'s.
+    pub fn towards(
+        base: Rod,
+        target: std::sync::Arc<dyn crate::model::StoredEnergy>,
+        level: ModelLevel,
+        segments: usize,
+        tolerances: Tolerances,
+    ) -> Self {
+        Family {
+            target: Some(target),
+            ..Family::new(
+                base,
+                Parameter::CurvatureTowards,
+                level,
+                segments,
+                tolerances,
+            )
         }
     }
 
@@ -156,6 +186,14 @@ impl Family {
                     .base
                     .energy
                     .with_intrinsic_scaled(p)
+                    .ok_or(FamilyError::NotConstant(self.parameter))?;
+            }
+            Parameter::CurvatureTowards => {
+                rod.loads = self.base.loads.scaled(p);
+                rod.energy = self
+                    .target
+                    .as_ref()
+                    .and_then(|t| self.base.energy.with_intrinsic_towards(t.as_ref(), p))
                     .ok_or(FamilyError::NotConstant(self.parameter))?;
             }
             Parameter::TipForce(i) => rod.loads.tip_force[i] = p,

@@ -92,6 +92,56 @@ impl Profile {
         }
     }
 
+    /// (1 − p) self + p other, where both are of one kind on the same knots
+    /// (so that the result is again a profile of that kind: the natural
+    /// spline is linear in its values); None otherwise. A control moving
+    /// an intrinsic curvature from one profile to another.
+    pub fn blend(&self, other: &Profile, p: f64) -> Option<Profile> {
+        let mix = |a: &[f64], b: &[f64]| -> Vec<f64> {
+            a.iter()
+                .zip(b)
+                .map(|(x, y)| (1.0 - p) * x + p * y)
+                .collect()
+        };
+        Some(match (self, other) {
+            (Profile::Constant(a), Profile::Constant(b)) => {
+                Profile::Constant((1.0 - p) * a + p * b)
+            }
+            (Profile::Polynomial(a), Profile::Polynomial(b)) => {
+                let n = a.len().max(b.len());
+                let pad = |c: &[f64]| {
+                    (0..n)
+                        .map(|i| c.get(i).copied().unwrap_or(0.0))
+                        .collect::<Vec<_>>()
+                };
+                Profile::Polynomial(mix(&pad(a), &pad(b)))
+            }
+            (Profile::Table { s, values: a }, Profile::Table { s: t, values: b }) if s == t => {
+                Profile::Table {
+                    s: s.clone(),
+                    values: mix(a, b),
+                }
+            }
+            (
+                Profile::Spline {
+                    s,
+                    values: a,
+                    curvature: ca,
+                },
+                Profile::Spline {
+                    s: t,
+                    values: b,
+                    curvature: cb,
+                },
+            ) if s == t => Profile::Spline {
+                s: s.clone(),
+                values: mix(a, b),
+                curvature: mix(ca, cb),
+            },
+            _ => return None,
+        })
+    }
+
     /// The value at s.
     pub fn value(&self, s: f64) -> f64 {
         match self {

@@ -15,8 +15,12 @@
 //! moment of the load λF is not compensated by λκ⁰ alone except at λ = 1,
 //! where the design is an exact equilibrium (κ⁰ from (43)).
 
-use super::{continue_to_design, designed_rod, ArmDesign, ArmProblem, ArmScene};
-use crate::continuation::{ContinuationError, Diagram, Parameter};
+use std::sync::Arc;
+
+use super::{continue_family, continue_to_design, derivative, designed_rod, polynomial};
+use super::{ArmDesign, ArmProblem, ArmScene};
+use crate::continuation::{ContinuationError, Diagram, Family, Parameter};
+use crate::model::{LinearElastic, ModelLevel, Profile};
 
 /// The arm continued along κ⁰ = λ κ⁰_design, loads λ × design loads, from
 /// λ = 10⁻³ to 1 with the Hessian eigenvalues tracked (both blocks, the
@@ -42,4 +46,43 @@ pub fn loading_path_in(
 ) -> Result<Diagram, ContinuationError> {
     let rod = designed_rod(problem, scene, design, points);
     continue_to_design(problem, rod, Parameter::LoadScale)
+}
+
+/// The shape-holding control: the loads raised from 0 to the design's
+/// while κ⁰ moves from φ' (the designed shape, unloaded) to the design's
+/// κ⁰ = φ' − γ m̄2 (43), κ⁰(λ) = φ' − λ γ m̄2. The designed shape is then an
+/// equilibrium at every λ, and its second variation is K0 + λK1 — the
+/// fixed-shape pencil whose smallest positive root is λ_crit = 1 — so the
+/// path stays on the design, stable for λ < 1, whatever the arm. The
+/// continuation checks that; κ⁰ is the natural spline through `points`
+/// nodes (the same nodes for both ends, so that κ⁰(λ) blends exactly).
+pub fn shape_holding_path(
+    problem: &ArmProblem,
+    scene: &ArmScene,
+    design: &ArmDesign,
+    points: usize,
+) -> Result<Diagram, ContinuationError> {
+    let target = designed_rod(problem, scene, design, points);
+    let s: Vec<f64> = (0..points)
+        .map(|i| i as f64 / (points - 1) as f64)
+        .collect();
+    let dphi = derivative(&design.shape_coefficients);
+    let unloaded: Vec<f64> = s.iter().map(|t| polynomial(&dphi, *t)).collect();
+    let mut base = target.clone();
+    base.energy = Arc::new(LinearElastic {
+        stiffness: [problem.b1, 1.0, problem.b3].map(Profile::Constant),
+        intrinsic_curvature: [
+            Profile::Constant(0.0),
+            Profile::spline(s, unloaded),
+            Profile::Constant(0.0),
+        ],
+    });
+    let family = Family::towards(
+        base,
+        target.energy,
+        ModelLevel::Planar,
+        32,
+        crate::bvp::integrator::Tolerances::default(),
+    );
+    continue_family(problem, &family)
 }

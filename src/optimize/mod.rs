@@ -26,7 +26,7 @@ pub mod control_path;
 pub mod fig5;
 pub mod scene;
 
-pub use control_path::{control_path, loading_path_in};
+pub use control_path::{control_path, loading_path_in, shape_holding_path};
 pub use fig5::{ClosestStraight, ReachMap};
 pub use scene::{ArmScene, ArmWeight};
 
@@ -730,14 +730,22 @@ pub(crate) fn continue_to_design(
     rod: Rod,
     parameter: crate::continuation::Parameter,
 ) -> Result<crate::continuation::Diagram, crate::continuation::ContinuationError> {
-    use crate::continuation::{continuation, ContinuationOptions, Family};
-    let family = Family::new(
+    let family = crate::continuation::Family::new(
         rod,
         parameter,
         crate::model::ModelLevel::Planar,
         32,
         crate::bvp::integrator::Tolerances::default(),
     );
+    continue_family(problem, &family)
+}
+
+/// Continues `family` from p = 10⁻³ to 1 with the design's own mesh.
+pub(crate) fn continue_family(
+    problem: &ArmProblem,
+    family: &crate::continuation::Family,
+) -> Result<crate::continuation::Diagram, crate::continuation::ContinuationError> {
+    use crate::continuation::{continuation, ContinuationOptions};
     let opts = ContinuationOptions {
         start: 1e-3,
         bounds: (0.0, 1.0),
@@ -751,7 +759,7 @@ pub(crate) fn continue_to_design(
         },
         ..Default::default()
     };
-    continuation(&family, &opts, &mut |_, _| true)
+    continuation(family, &opts, &mut |_, _| true)
 }
 
 /// The loading path of a designed arm (paper Sec. 5 warns that loading need
