@@ -25,8 +25,9 @@ pub enum Parameter {
     /// actuators raise κ⁰ as the load is applied (paper Sec. 5).
     ControlScale,
     /// All loads multiplied by p and the intrinsic curvature moved from
-    /// the base rod's (p = 0) to a target's (p = 1), κ⁰ = (1 − p) κ⁰_base
-    /// + p κ⁰_target; build with [`Family::towards`]. With κ⁰_base = φ' and
+    /// the base rod's (p = 0) to a target's (p = 1),
+    /// κ⁰ = (1 − p) κ⁰_base + p κ⁰_target; build with
+    /// [`Family::towards`]. With κ⁰_base = φ' and
     /// κ⁰_target from (43) the designed shape is an equilibrium all along
     /// (the shape-holding control of a designed arm).
     CurvatureTowards,
