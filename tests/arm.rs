@@ -545,3 +545,60 @@ fn interrupted_optimization_resumes_where_it_stopped() {
     }
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// `cosserat optimize problems/longest_arm_fig5.toml -o … --plot …`: the
+/// Fig. 5 file and chart. Checked from the file alone: 'Q' is the map
+/// sample of least Σb² (recomputed from /map/curvature_coefficients) with
+/// that sample's reach; the least-Σb² polish is no worse than Q; R* is at
+/// least every sample's reach (the map is the search's own first samples).
+#[test]
+fn fig5_file_and_chart() {
+    let dir = std::env::temp_dir().join(format!("cosserat-fig5-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (out, png) = (dir.join("fig5.h5"), dir.join("fig5.png"));
+    let file = format!(
+        "{}/problems/longest_arm_fig5.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let o = optimize(&[
+        &file,
+        "-o",
+        out.to_str().unwrap(),
+        "--plot",
+        png.to_str().unwrap(),
+        "--set",
+        "arm.map_samples=300",
+        "--set",
+        "arm.straight=false",
+    ]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(std::fs::metadata(&png).unwrap().len() > 10_000);
+    let f = hdf5::File::open(&out).unwrap();
+    let read = |name: &str| f.dataset(name).unwrap().read_raw::<f64>().unwrap();
+    let reach = read("map/reach");
+    let b = read("map/curvature_coefficients");
+    assert_eq!(b.len(), 4 * reach.len());
+    let norms: Vec<f64> = b.chunks(4).map(|r| r.iter().map(|v| v * v).sum()).collect();
+    let least = (0..norms.len())
+        .min_by(|&i, &j| norms[i].total_cmp(&norms[j]))
+        .unwrap();
+    let q = f.group("closest_straight").unwrap();
+    let index = q.attr("index").unwrap().read_scalar::<u64>().unwrap() as usize;
+    assert_eq!(index, least);
+    let q_reach = read("closest_straight/reach")[0];
+    assert!((q_reach - reach[least]).abs() < 1e-12);
+    let q_norm = read("closest_straight/curvature_norm")[0];
+    assert!((q_norm - norms[least]).abs() < 1e-9 * norms[least]);
+    assert!(read("least_curvature/curvature_norm")[0] <= q_norm);
+    let best = read("optimum/reach")[0];
+    assert!(
+        reach.iter().all(|r| *r <= best),
+        "a sample beats R* = {best}"
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}
