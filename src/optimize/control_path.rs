@@ -6,10 +6,13 @@
 //! curvature is increased as the load is applied". That is the path
 //! followed here: κ⁰(s) = λ κ⁰_design(s) and the load λ F together, from
 //! the straight unloaded rod (λ = 0) to the design (λ = 1). Raising κ⁰ with
-//! the load held at F instead would start from a straight rod under the
-//! full design load, which for a long arm (L̂ = √γ_crit beyond the Euler
-//! and Timoshenko lengths) is itself far past its first instability; the
-//! proportional path starts unloaded and stable, as a robot would.
+//! the load held at F instead is not what the paper proposes ("increased as
+//! the load is applied"), and it would start with the whole design load on
+//! a straight arm longer (L̂ = √γ_crit: 2.11 for the circular Fig. 5 arm,
+//! 4.38 for Sec. 4.4) than the best straight arm reaches stably
+//! (R̂0 = 1.82); the proportional path starts unloaded and stable, as a
+//! robot would. A third control, [`shape_holding_path`], moves κ⁰ so that
+//! the arm keeps its designed shape at every load.
 //!
 //! Along the path the equilibrium is not the design shape: at λ the
 //! moment of the load λF is not compensated by λκ⁰ alone except at λ = 1,
