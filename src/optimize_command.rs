@@ -8,7 +8,10 @@ use std::time::Instant;
 
 use cosserat::arm_chart::{draw_arm, ArmChart};
 use cosserat::io::{check_target, read_search, write_arm_study, ArmStudy, Problem};
-use cosserat::optimize::{ArmOptimum, ArmProblem, ArmScene, ArmWeight, SearchProgress};
+use cosserat::optimize::{
+    ArmOptimum, ArmProblem, ArmScene, ArmWeight, ClosestStraight, ReachMap, SearchOptions,
+    SearchProgress, StraightArm,
+};
 
 use crate::fail;
 
@@ -71,25 +74,9 @@ pub fn run_optimize(run: OptimizeRun) -> ExitCode {
         Err(code) => return code,
     };
     report_problem(path, arm, scene);
-    let interrupted = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
-    {
-        let flag = interrupted.clone();
-        let _ = ctrlc::set_handler(move || flag.store(true, std::sync::atomic::Ordering::SeqCst));
-    }
     let t = Instant::now();
-    let stop = || interrupted.load(std::sync::atomic::Ordering::SeqCst);
-    let mut last_save = Instant::now();
-    let mut checkpoint = |p: &SearchProgress| {
-        if last_save.elapsed() < CHECKPOINT {
-            return;
-        }
-        if let (Some(out), Some(best)) = (&run.output, arm.best_so_far(scene, p)) {
-            let _ = write_arm_study(out, &problem.text, &interrupted_study(&best, p), true);
-        }
-        last_save = Instant::now();
-    };
     let (optimum, progress, was_interrupted) =
-        arm.search(scene, search, progress, &stop, &mut checkpoint);
+        run_search(&run, &problem.text, arm, search, scene, progress);
     let Some(opt) = optimum else {
         let limit = scene.max_curvature.map_or(String::new(), |k| {
             format!(" that the actuator limit arm.max_curvature = {k} can hold")
@@ -105,57 +92,19 @@ pub fn run_optimize(run: OptimizeRun) -> ExitCode {
         return keep_interrupted(&run, &problem.text, &opt, &progress);
     }
     report_optimum(&opt, t.elapsed().as_secs_f64());
-    let straight_arm = (*straight && scene.weight == ArmWeight::Weightless)
+    let straight = (*straight && scene.weight == ArmWeight::Weightless)
         .then(|| straight_optimum(arm, &opt))
         .flatten();
-    let map = (*map_samples > 0).then(|| arm.reach_map(scene, *map_samples, &|| false));
-    let closest = map.as_ref().and_then(|m| m.closest_straight(arm, scene));
-    if let (Some(m), Some(q)) = (&map, &closest) {
-        println!(
-            "map       {} designs; Q (least Σb² = {:.3e}): R̂ = {:.6}; R*/R̂(Q) = {:.3}",
-            m.reach.len(),
-            q.curvature_norm,
-            q.optimum.design.reach,
-            opt.design.reach / q.optimum.design.reach
-        );
-    }
-    let least = map
-        .as_ref()
-        .and_then(|m| arm.least_curvature(scene, m, search.starts, search.iterations));
-    if let Some(l) = &least {
-        println!(
-            "least Σb² {:.3e} (the paper's R0 by Nelder–Mead from Q): R̂ = {:.6}; R*/R̂ = {:.3}",
-            l.curvature_norm,
-            l.optimum.design.reach,
-            opt.design.reach / l.optimum.design.reach
-        );
-    }
-    if let Some(out) = &run.output {
-        let study = ArmStudy {
-            optimum: &opt,
-            straight: straight_arm.as_ref(),
-            map: map.as_ref(),
-            closest: closest.as_ref(),
-            least_curvature: least.as_ref(),
-            progress: Some(&progress),
-            stop_reason: "completed",
-        };
-        if let Err(e) = write_arm_study(out, &problem.text, &study, true) {
-            return fail(1, e);
-        }
-        println!("written   {}", out.display());
-    }
-    if let Some(out) = &run.plot {
-        let chart = ArmChart {
-            optimum: &opt,
-            map: map.as_ref(),
-            closest: closest.as_ref(),
-            straight: straight_arm.as_ref(),
-        };
-        if let Err(e) = draw_arm(&chart, out) {
-            return fail(1, format!("{}: {e}", out.display()));
-        }
-        println!("plotted   {}", out.display());
+    let extras = map_extras(arm, search, scene, *map_samples, &opt);
+    if let Err(code) = write_study(
+        &run,
+        &problem.text,
+        &opt,
+        straight.as_ref(),
+        &extras,
+        &progress,
+    ) {
+        return code;
     }
     let paths = [
         (&run.loading_path, Route::LOADING),
@@ -171,6 +120,115 @@ pub fn run_optimize(run: OptimizeRun) -> ExitCode {
         }
     }
     ExitCode::SUCCESS
+}
+
+/// The search, stopped by Ctrl-C and saved every [`CHECKPOINT`] (so that a
+/// kill loses little) as an interrupted study.
+fn run_search(
+    run: &OptimizeRun,
+    text: &str,
+    arm: &ArmProblem,
+    search: &SearchOptions,
+    scene: &ArmScene,
+    progress: SearchProgress,
+) -> (Option<ArmOptimum>, SearchProgress, bool) {
+    let interrupted = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    {
+        let flag = interrupted.clone();
+        let _ = ctrlc::set_handler(move || flag.store(true, std::sync::atomic::Ordering::SeqCst));
+    }
+    let stop = || interrupted.load(std::sync::atomic::Ordering::SeqCst);
+    let mut last_save = Instant::now();
+    let mut checkpoint = |p: &SearchProgress| {
+        if last_save.elapsed() < CHECKPOINT {
+            return;
+        }
+        if let (Some(out), Some(best)) = (&run.output, arm.best_so_far(scene, p)) {
+            let _ = write_arm_study(out, text, &interrupted_study(&best, p), true);
+        }
+        last_save = Instant::now();
+    };
+    arm.search(scene, search, progress, &stop, &mut checkpoint)
+}
+
+/// The Fig. 5 data set: the map, its 'Q', the least-Σb² design.
+#[derive(Default)]
+struct MapExtras {
+    map: Option<ReachMap>,
+    closest: Option<ClosestStraight>,
+    least: Option<ClosestStraight>,
+}
+
+fn map_extras(
+    arm: &ArmProblem,
+    search: &SearchOptions,
+    scene: &ArmScene,
+    samples: usize,
+    opt: &ArmOptimum,
+) -> MapExtras {
+    if samples == 0 {
+        return MapExtras::default();
+    }
+    let map = arm.reach_map(scene, samples, &|| false);
+    let closest = map.closest_straight(arm, scene);
+    if let Some(q) = &closest {
+        println!(
+            "map       {} designs; Q (least Σb² = {:.3e}): R̂ = {:.6}; R*/R̂(Q) = {:.3}",
+            map.reach.len(),
+            q.curvature_norm,
+            q.optimum.design.reach,
+            opt.design.reach / q.optimum.design.reach
+        );
+    }
+    let least = arm.least_curvature(scene, &map, search.starts, search.iterations);
+    if let Some(l) = &least {
+        println!(
+            "least Σb² {:.3e} (the paper's R0 by Nelder–Mead from Q): R̂ = {:.6}; R*/R̂ = {:.3}",
+            l.curvature_norm,
+            l.optimum.design.reach,
+            opt.design.reach / l.optimum.design.reach
+        );
+    }
+    MapExtras {
+        map: Some(map),
+        closest,
+        least,
+    }
+}
+
+/// Writes the completed study (HDF5) and its chart, as asked.
+fn write_study(
+    run: &OptimizeRun,
+    text: &str,
+    opt: &ArmOptimum,
+    straight: Option<&StraightArm>,
+    extras: &MapExtras,
+    progress: &SearchProgress,
+) -> Result<(), ExitCode> {
+    if let Some(out) = &run.output {
+        let study = ArmStudy {
+            optimum: opt,
+            straight,
+            map: extras.map.as_ref(),
+            closest: extras.closest.as_ref(),
+            least_curvature: extras.least.as_ref(),
+            progress: Some(progress),
+            stop_reason: "completed",
+        };
+        write_arm_study(out, text, &study, true).map_err(|e| fail(1, e))?;
+        println!("written   {}", out.display());
+    }
+    if let Some(out) = &run.plot {
+        let chart = ArmChart {
+            optimum: opt,
+            map: extras.map.as_ref(),
+            closest: extras.closest.as_ref(),
+            straight,
+        };
+        draw_arm(&chart, out).map_err(|e| fail(1, format!("{}: {e}", out.display())))?;
+        println!("plotted   {}", out.display());
+    }
+    Ok(())
 }
 
 /// The search progress to start from: fresh, or what an interrupted run
