@@ -272,6 +272,31 @@ fn locate(knots: &[f64], s: f64) -> (usize, f64) {
 mod tests {
     use super::*;
 
+    /// Scaling and blending act on the function itself: the spline built
+    /// from scaled or blended knot values (built afresh) has the same
+    /// values and derivatives everywhere.
+    #[test]
+    fn scaled_and_blended_splines_are_the_splines_of_the_values() {
+        let s: Vec<f64> = (0..9).map(|i| i as f64 / 8.0).collect();
+        let a: Vec<f64> = s.iter().map(|x| (3.0 * x).sin()).collect();
+        let b: Vec<f64> = s.iter().map(|x| x * x - 2.0 * x).collect();
+        let (sa, sb) = (
+            Profile::spline(s.clone(), a.clone()),
+            Profile::spline(s.clone(), b.clone()),
+        );
+        let mix: Vec<f64> = a.iter().zip(&b).map(|(x, y)| 0.7 * x + 0.3 * y).collect();
+        let fresh_mix = Profile::spline(s.clone(), mix);
+        let fresh_scaled = Profile::spline(s.clone(), a.iter().map(|x| -2.5 * x).collect());
+        let blended = sa.blend(&sb, 0.3).unwrap();
+        let scaled = sa.scaled(-2.5);
+        for t in [0.0, 0.13, 0.5, 0.77, 1.0] {
+            assert!((blended.value(t) - fresh_mix.value(t)).abs() < 1e-13);
+            assert!((blended.derivative(t) - fresh_mix.derivative(t)).abs() < 1e-12);
+            assert!((scaled.value(t) - fresh_scaled.value(t)).abs() < 1e-13);
+        }
+        assert!(sa.blend(&Profile::Constant(0.0), 0.5).is_none());
+    }
+
     #[test]
     fn polynomial_value_and_derivative() {
         let p = Profile::Polynomial(vec![1.0, -2.0, 3.0]);
