@@ -85,6 +85,23 @@ pub enum Command {
         /// design load and write that diagram (HDF5, with a PNG beside it).
         #[arg(long)]
         loading_path: Option<PathBuf>,
+        /// Also continue the designed arm along the control path, κ⁰ and
+        /// the load raised together from the straight unloaded arm to the
+        /// design, and write that diagram (HDF5, with a PNG beside it).
+        #[arg(long)]
+        control_path: Option<PathBuf>,
+        /// Also continue the designed arm along the shape-holding control,
+        /// κ⁰ = φ' − λ γ m̄ (the design shape an equilibrium at every load
+        /// λ), and write that diagram (HDF5, with a PNG beside it).
+        #[arg(long)]
+        holding_path: Option<PathBuf>,
+        /// Draw the study (.png or .svg): reach map, optimum 'P', the
+        /// sample closest to a straight rod 'Q', their shapes (Fig. 5).
+        #[arg(long)]
+        plot: Option<PathBuf>,
+        /// Go on with the interrupted search kept in the output file.
+        #[arg(long)]
+        resume: bool,
         /// Override any key of the problem file.
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,

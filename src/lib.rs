@@ -6,6 +6,7 @@
 //! file: build a [`model::Rod`] (with any [`model::StoredEnergy`]), pick a
 //! [`model::ModelChoice`], and call [`bvp::solve`].
 
+pub mod arm_chart;
 pub mod bench;
 pub mod bvp;
 pub mod cli;

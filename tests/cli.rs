@@ -294,3 +294,55 @@ fn unstable_result_is_flagged() {
     ]);
     assert!(String::from_utf8_lossy(&o.stdout).contains("stability stable"));
 }
+
+/// Bad `[arm]` input to `cosserat optimize` (actuator limit, loads the arm
+/// does not take, `--resume` without an output file): exit code 2, a
+/// message naming the field, nothing written.
+#[test]
+fn optimize_rejects_bad_arm_input() {
+    const ARM: &str = include_str!("../problems/longest_arm_fig5.toml");
+    let cases: [(&str, String, &[&str], &str); 4] = [
+        (
+            "arm-negative-limit",
+            ARM.replace(
+                "map_samples = 4000",
+                "map_samples = 4000\nmax_curvature = -1.0",
+            ),
+            &[],
+            "arm.max_curvature",
+        ),
+        (
+            "arm-sideways-load",
+            ARM.replace("tip_force = [1.0, 0.0, 0.0]", "tip_force = [1.0, 0.5, 0.0]"),
+            &[],
+            "loads",
+        ),
+        (
+            "arm-no-load",
+            ARM.replace("tip_force = [1.0, 0.0, 0.0]", "tip_force = [0.0, 0.0, 0.0]"),
+            &[],
+            "loads",
+        ),
+        ("arm-resume-no-output", ARM.to_string(), &["--resume"], "-o"),
+    ];
+    for (name, text, extra, expect) in cases {
+        let dir = scratch(name);
+        let problem = dir.join("problem.toml");
+        std::fs::write(&problem, text).unwrap();
+        let out = dir.join("out.h5");
+        let plot = dir.join("out.png");
+        let mut args = vec!["optimize", problem.to_str().unwrap()];
+        if extra.is_empty() {
+            args.extend(["-o", out.to_str().unwrap()]);
+        }
+        args.extend(["--plot", plot.to_str().unwrap()]);
+        args.extend_from_slice(extra);
+        let o = run(&args);
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{name}: {err}");
+        assert!(err.contains(expect), "{name}: `{expect}` not in: {err}");
+        let left = std::fs::read_dir(&dir).unwrap().count();
+        assert_eq!(left, 1, "{name}: output left behind");
+        std::fs::remove_dir_all(dir).unwrap();
+    }
+}

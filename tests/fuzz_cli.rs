@@ -8,7 +8,7 @@ use cosserat::cli::Cli;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 
-const WORDS: [&str; 40] = [
+const WORDS: [&str; 42] = [
     "solve",
     "stability",
     "continue",
@@ -27,6 +27,8 @@ const WORDS: [&str; 40] = [
     "--resume",
     "--measure",
     "--loading-path",
+    "--control-path",
+    "--holding-path",
     "--quick",
     "--case",
     "--cases",

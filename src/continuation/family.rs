@@ -20,6 +20,17 @@ use crate::model::{ModelLevel, Profile, Rod};
 pub enum Parameter {
     /// All loads multiplied by p.
     LoadScale,
+    /// All loads and the intrinsic curvature κ⁰(s) multiplied by p
+    /// together: the control path of a designed arm, on which the
+    /// actuators raise κ⁰ as the load is applied (paper Sec. 5).
+    ControlScale,
+    /// All loads multiplied by p and the intrinsic curvature moved from
+    /// the base rod's (p = 0) to a target's (p = 1),
+    /// κ⁰ = (1 − p) κ⁰_base + p κ⁰_target; build with
+    /// [`Family::towards`]. With κ⁰_base = φ' and
+    /// κ⁰_target from (43) the designed shape is an equilibrium all along
+    /// (the shape-holding control of a designed arm).
+    CurvatureTowards,
     /// Component i of the tip force.
     TipForce(usize),
     /// Component i of the tip couple.
@@ -39,7 +50,7 @@ pub enum Parameter {
 impl Parameter {
     /// The parameter named by a problem-file key: `load_scale`,
     /// `loads.tip_force[i]`, `loads.tip_couple[i]`,
-    /// `loads.distributed_force[i]`, `rod.length`, `energy.stiffness[i]`,
+    /// `loads.distributed_force[i]`, `control_scale`, `rod.length`, `energy.stiffness[i]`,
     /// `energy.intrinsic_curvature[i]`, `clamp.angle`.
     pub fn from_key(key: &str) -> Option<Parameter> {
         let indexed = |prefix: &str| -> Option<usize> {
@@ -51,6 +62,7 @@ impl Parameter {
         };
         Some(match key {
             "load_scale" => Parameter::LoadScale,
+            "control_scale" => Parameter::ControlScale,
             "rod.length" => Parameter::Length,
             "clamp.angle" => Parameter::ClampAngle,
             _ => {
@@ -76,6 +88,8 @@ impl Parameter {
 #[derive(Debug, Clone)]
 pub struct Family {
     base: Rod,
+    /// The target energy of [`Parameter::CurvatureTowards`].
+    target: Option<std::sync::Arc<dyn crate::model::StoredEnergy>>,
     parameter: Parameter,
     level: ModelLevel,
     segments: usize,
@@ -87,7 +101,8 @@ pub struct Family {
 pub enum FamilyError {
     /// The parameter needs a linear energy with constant profiles.
     #[error(
-        "parameter {0:?} needs the linear energy with constant stiffness and intrinsic curvature"
+        "parameter {0:?} needs the linear energy (with constant stiffness and intrinsic curvature \
+         for a stiffness or curvature parameter)"
     )]
     NotConstant(Parameter),
     /// A value outside the physical range.
@@ -107,10 +122,32 @@ impl Family {
     ) -> Self {
         Family {
             base,
+            target: None,
             parameter,
             level,
             segments: segments.max(1),
             tolerances,
+        }
+    }
+
+    /// The family [`Parameter::CurvatureTowards`]: the loads of `base`
+    /// scaled by p, κ⁰ moved from `base`'s to `target`'s.
+    pub fn towards(
+        base: Rod,
+        target: std::sync::Arc<dyn crate::model::StoredEnergy>,
+        level: ModelLevel,
+        segments: usize,
+        tolerances: Tolerances,
+    ) -> Self {
+        Family {
+            target: Some(target),
+            ..Family::new(
+                base,
+                Parameter::CurvatureTowards,
+                level,
+                segments,
+                tolerances,
+            )
         }
     }
 
@@ -144,6 +181,22 @@ impl Family {
         }
         match self.parameter {
             Parameter::LoadScale => rod.loads = self.base.loads.scaled(p),
+            Parameter::ControlScale => {
+                rod.loads = self.base.loads.scaled(p);
+                rod.energy = self
+                    .base
+                    .energy
+                    .with_intrinsic_scaled(p)
+                    .ok_or(FamilyError::NotConstant(self.parameter))?;
+            }
+            Parameter::CurvatureTowards => {
+                rod.loads = self.base.loads.scaled(p);
+                rod.energy = self
+                    .target
+                    .as_ref()
+                    .and_then(|t| self.base.energy.with_intrinsic_towards(t.as_ref(), p))
+                    .ok_or(FamilyError::NotConstant(self.parameter))?;
+            }
             Parameter::TipForce(i) => rod.loads.tip_force[i] = p,
             Parameter::TipCouple(i) => rod.loads.tip_couple[i] = p,
             Parameter::DistributedForce(i) => rod.loads.distributed_force[i] = p,

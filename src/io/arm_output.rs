@@ -1,15 +1,31 @@
-//! Longest-arm results as HDF5: `/optimum/reach`, `/optimum/gamma_crit`,
+//! Longest-arm results as HDF5: `/optimum/reach`, `/optimum/gamma_crit`
+//! (the critical load factor of the optimal shape), `/optimum/load_factor`
+//! (the design load: γ_crit, or less when actuator-limited),
 //! `/optimum/shape_coefficients`, `/optimum/curvature_coefficients`,
 //! `/optimum/loaded_shape` (n×3), `/optimum/unloaded_shape` (n×3),
 //! `/optimum/intrinsic_curvature` (n), `/straight/reach`, `/straight/gamma_crit`,
 //! `/straight/clamp_angle`, `/straight/loaded_shape`; the problem text as the
 //! root attribute `problem`, and `stop_reason` (`completed` or
 //! `interrupted`: then /optimum is the best design found so far).
+//!
+//! With a reach map (the Fig. 5 data set): `/map/reach` (n),
+//! `/map/load_factor` (n), `/map/shape_coefficients` (n×M),
+//! `/map/curvature_coefficients` (n×M), and the sample closest to a
+//! straight rod (the paper's 'Q') in `/closest_straight/` (`index`,
+//! `curvature_norm` = Σb², `reach`, `load_factor`, `shape_coefficients`,
+//! `curvature_coefficients`, `loaded_shape`, `unloaded_shape`); the design
+//! of least Σb² found by Nelder–Mead from the map's best (the paper's way
+//! to R0, Sec. 3.2) in `/least_curvature/`, same names (`index`: the map
+//! sample it started from).
+//!
+//! `/search/` keeps how far the search came, for `optimize --resume`:
+//! attributes `samples_done`, `polishes_done`, `evaluations`, and the
+//! datasets `leader_reach` (k) and `leader_points` (k×(M−1)).
 
 use std::path::Path;
 
 use super::hdf5_output::{array, string_attr, write_atomically, OutputError};
-use crate::optimize::{ArmOptimum, StraightArm};
+use crate::optimize::{ArmOptimum, ClosestStraight, ReachMap, SearchProgress, StraightArm};
 
 fn scalar(g: &hdf5::Group, name: &str, v: f64) -> hdf5::Result<()> {
     g.new_dataset::<f64>().create(name)?.write_scalar(&v)
@@ -23,6 +39,35 @@ fn points(g: &hdf5::Group, name: &str, v: &[[f64; 3]]) -> hdf5::Result<()> {
         .write_raw(&flat)
 }
 
+fn rows(g: &hdf5::Group, name: &str, v: &[Vec<f64>]) -> hdf5::Result<()> {
+    let width = v.first().map_or(0, |r| r.len());
+    let flat: Vec<f64> = v.iter().flatten().copied().collect();
+    array(g, name, &[v.len(), width], &flat)
+}
+
+fn count(g: &hdf5::Location, name: &str, v: usize) -> hdf5::Result<()> {
+    g.new_attr::<u64>().create(name)?.write_scalar(&(v as u64))
+}
+
+/// Everything an optimize run keeps.
+#[derive(Debug, Clone, Copy)]
+pub struct ArmStudy<'a> {
+    /// The optimum (the best so far when interrupted).
+    pub optimum: &'a ArmOptimum,
+    /// R̂0 of the straight arm, if computed.
+    pub straight: Option<&'a StraightArm>,
+    /// The reach map, if asked for.
+    pub map: Option<&'a ReachMap>,
+    /// The map's sample closest to a straight rod.
+    pub closest: Option<&'a ClosestStraight>,
+    /// The design of least Σb² (the paper's R0 method).
+    pub least_curvature: Option<&'a ClosestStraight>,
+    /// How far the search came (to resume from).
+    pub progress: Option<&'a SearchProgress>,
+    /// `completed` or `interrupted`.
+    pub stop_reason: &'a str,
+}
+
 /// Writes the optimum (and the straight arm, if computed) atomically.
 pub fn write_arm(
     path: &Path,
@@ -32,38 +77,141 @@ pub fn write_arm(
     stop_reason: &str,
     force: bool,
 ) -> Result<(), OutputError> {
+    let study = ArmStudy {
+        optimum,
+        straight,
+        map: None,
+        closest: None,
+        least_curvature: None,
+        progress: None,
+        stop_reason,
+    };
+    write_arm_study(path, problem, &study, force)
+}
+
+/// Writes a whole study atomically.
+pub fn write_arm_study(
+    path: &Path,
+    problem: &str,
+    study: &ArmStudy,
+    force: bool,
+) -> Result<(), OutputError> {
     write_atomically(path, force, |file| {
         string_attr(file, "problem", problem)?;
-        string_attr(file, "stop_reason", stop_reason)?;
+        string_attr(file, "stop_reason", study.stop_reason)?;
         let g = file.create_group("optimum")?;
-        scalar(&g, "reach", optimum.design.reach)?;
-        scalar(&g, "gamma_crit", optimum.design.gamma)?;
-        array(
-            &g,
-            "shape_coefficients",
-            &[optimum.design.shape_coefficients.len()],
-            &optimum.design.shape_coefficients,
-        )?;
-        let b = &optimum.curvature_coefficients;
-        array(&g, "curvature_coefficients", &[b.len()], b)?;
-        points(&g, "loaded_shape", &optimum.loaded_shape)?;
-        points(&g, "unloaded_shape", &optimum.unloaded_shape)?;
-        array(
-            &g,
-            "intrinsic_curvature",
-            &[optimum.intrinsic_curvature.len()],
-            &optimum.intrinsic_curvature,
-        )?;
-        g.new_attr::<u64>()
-            .create("evaluations")?
-            .write_scalar(&(optimum.evaluations as u64))?;
-        if let Some(s) = straight {
+        write_design(&g, study.optimum)?;
+        scalar(&g, "gamma_crit", study.optimum.critical_load)?;
+        count(&g, "evaluations", study.optimum.evaluations)?;
+        if let Some(s) = study.straight {
             let g = file.create_group("straight")?;
             scalar(&g, "reach", s.reach)?;
             scalar(&g, "gamma_crit", s.gamma)?;
             scalar(&g, "clamp_angle", s.clamp_angle)?;
             points(&g, "loaded_shape", &s.loaded_shape)?;
         }
+        if let Some(m) = study.map {
+            let g = file.create_group("map")?;
+            array(&g, "reach", &[m.reach.len()], &m.reach)?;
+            array(&g, "load_factor", &[m.gamma.len()], &m.gamma)?;
+            rows(&g, "shape_coefficients", &m.shape_coefficients)?;
+            rows(&g, "curvature_coefficients", &m.curvature_coefficients)?;
+        }
+        for (name, q) in [
+            ("closest_straight", study.closest),
+            ("least_curvature", study.least_curvature),
+        ] {
+            if let Some(q) = q {
+                let g = file.create_group(name)?;
+                write_design(&g, &q.optimum)?;
+                count(&g, "index", q.index)?;
+                scalar(&g, "curvature_norm", q.curvature_norm)?;
+            }
+        }
+        if let Some(p) = study.progress {
+            write_progress(file, p)?;
+        }
         Ok(())
+    })
+}
+
+fn write_design(g: &hdf5::Group, o: &ArmOptimum) -> hdf5::Result<()> {
+    scalar(g, "reach", o.design.reach)?;
+    scalar(g, "load_factor", o.design.gamma)?;
+    let c = &o.design.shape_coefficients;
+    array(g, "shape_coefficients", &[c.len()], c)?;
+    let b = &o.curvature_coefficients;
+    array(g, "curvature_coefficients", &[b.len()], b)?;
+    points(g, "loaded_shape", &o.loaded_shape)?;
+    points(g, "unloaded_shape", &o.unloaded_shape)?;
+    let k = &o.intrinsic_curvature;
+    array(g, "intrinsic_curvature", &[k.len()], k)
+}
+
+fn write_progress(file: &hdf5::File, p: &SearchProgress) -> hdf5::Result<()> {
+    let g = file.create_group("search")?;
+    count(&g, "samples_done", p.samples_done)?;
+    count(&g, "polishes_done", p.polishes_done)?;
+    count(&g, "evaluations", p.evaluations)?;
+    let reach: Vec<f64> = p.leaders.iter().map(|l| l.0).collect();
+    array(&g, "leader_reach", &[reach.len()], &reach)?;
+    let pts: Vec<Vec<f64>> = p.leaders.iter().map(|l| l.1.clone()).collect();
+    rows(&g, "leader_points", &pts)
+}
+
+/// What an interrupted optimize run kept: the problem text, the stop
+/// reason, the search progress (its `best` left empty) and the shape
+/// coefficients c1..cM of the best design so far.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SavedSearch {
+    /// The effective problem text the run was made from.
+    pub problem: String,
+    /// `completed` or `interrupted`.
+    pub stop_reason: String,
+    /// How far the search came.
+    pub progress: SearchProgress,
+    /// c1..cM of the best design so far.
+    pub best: Vec<f64>,
+}
+
+/// Reads what [`write_arm_study`] kept of a search.
+pub fn read_search(path: &Path) -> hdf5::Result<SavedSearch> {
+    use hdf5::types::VarLenUnicode;
+    let file = hdf5::File::open(path)?;
+    let text = |name: &str| -> hdf5::Result<String> {
+        Ok(file
+            .attr(name)?
+            .read_scalar::<VarLenUnicode>()?
+            .as_str()
+            .to_owned())
+    };
+    let g = file.group("search")?;
+    let n =
+        |name: &str| -> hdf5::Result<usize> { Ok(g.attr(name)?.read_scalar::<u64>()? as usize) };
+    let reach = g.dataset("leader_reach")?.read_raw::<f64>()?;
+    let flat = g.dataset("leader_points")?.read_raw::<f64>()?;
+    let width = if reach.is_empty() {
+        0
+    } else {
+        flat.len() / reach.len()
+    };
+    let leaders = reach
+        .iter()
+        .enumerate()
+        .map(|(i, r)| (*r, flat[i * width..(i + 1) * width].to_vec()))
+        .collect();
+    Ok(SavedSearch {
+        problem: text("problem")?,
+        stop_reason: text("stop_reason")?,
+        progress: SearchProgress {
+            samples_done: n("samples_done")?,
+            polishes_done: n("polishes_done")?,
+            evaluations: n("evaluations")?,
+            leaders,
+            best: None,
+        },
+        best: file
+            .dataset("optimum/shape_coefficients")?
+            .read_raw::<f64>()?,
     })
 }

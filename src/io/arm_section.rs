@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use super::problem::{invalid, ProblemError};
 use crate::model::Rod;
-use crate::optimize::{ArmProblem, SearchOptions};
+use crate::optimize::{ArmProblem, ArmScene, ArmWeight, SearchOptions};
 use crate::stability::StabilityOptions;
 
 /// `[arm]`.
@@ -38,6 +38,13 @@ pub struct ArmSection {
     /// Also compute R̂0 of the intrinsically straight arm.
     #[serde(default = "default_true")]
     pub straight: bool,
+    /// Actuator limit on |κ⁰| in units of √(F/B2) (of (q/B2)^{1/3} for the
+    /// weight alone); absent: unlimited (paper Sec. 5, a constraint).
+    #[serde(default)]
+    pub max_curvature: Option<f64>,
+    /// Halton samples of the reach map (the Fig. 5 data set); 0: none.
+    #[serde(default)]
+    pub map_samples: usize,
 }
 
 fn default_samples() -> usize {
@@ -59,7 +66,51 @@ fn default_true() -> bool {
     true
 }
 
+/// Both loads point down (e1) or are absent, with no tip couple.
+fn downward(rod: &Rod) -> Result<(f64, f64), ProblemError> {
+    let l = &rod.loads;
+    let down = |v: &nalgebra::Vector3<f64>| v[1] == 0.0 && v[2] == 0.0 && v[0] >= 0.0;
+    if !(down(&l.tip_force) && down(&l.distributed_force) && l.tip_couple.norm() == 0.0) {
+        return Err(invalid(
+            "loads",
+            "the arm takes a downward tip force [F, 0, 0] and/or its weight as a downward \
+             distributed_force [q, 0, 0], no couple",
+        ));
+    }
+    Ok((l.tip_force[0], l.distributed_force[0]))
+}
+
 impl ArmSection {
+    /// The arm's loads (from `[loads]`: a tip force, the weight as a
+    /// distributed force, or both in the ratio w = qL/F) and actuator limit.
+    pub fn scene(&self, rod: &Rod) -> Result<ArmScene, ProblemError> {
+        let (tip, weight) = downward(rod)?;
+        let ratio = weight * rod.length / tip;
+        let weight = match (tip > 0.0, weight > 0.0) {
+            (true, false) => ArmWeight::Weightless,
+            (true, true) if ratio.is_finite() => ArmWeight::WithTipLoad(ratio),
+            (false, true) => ArmWeight::Alone,
+            _ => {
+                return Err(invalid(
+                    "loads",
+                    "the arm needs a finite downward tip force or distributed force",
+                ))
+            }
+        };
+        if let Some(k) = self.max_curvature {
+            if !(k.is_finite() && k > 0.0) {
+                return Err(invalid(
+                    "arm.max_curvature",
+                    format!("must be finite and positive, got {k}"),
+                ));
+            }
+        }
+        Ok(ArmScene {
+            weight,
+            max_curvature: self.max_curvature,
+        })
+    }
+
     /// The arm problem of `rod` (constant stiffness) and the search options.
     pub fn build(&self, rod: &Rod) -> Result<(ArmProblem, SearchOptions, bool), ProblemError> {
         let h = rod.energy.stiffness(0.0, &nalgebra::Vector3::zeros());

@@ -9,7 +9,7 @@ mod hdf5_output;
 mod problem;
 mod support_section;
 
-pub use arm_output::write_arm;
+pub use arm_output::{read_search, write_arm, write_arm_study, ArmStudy, SavedSearch};
 pub use arm_section::ArmSection;
 pub use continuation_section::{ContinuationSection, MEASURES};
 pub use diagram::{read_saved, write_diagram};

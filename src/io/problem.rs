@@ -25,7 +25,7 @@ use crate::model::{
     Clamp, DeadLoads, EnergyCatalog, EnergySpec, ModelChoice, ModelLevel, Profile, Rod, Shearable,
     StoredEnergy,
 };
-use crate::optimize::{ArmProblem, SearchOptions};
+use crate::optimize::{ArmProblem, ArmScene, SearchOptions};
 use crate::stability::{FixedShape, StabilityOptions};
 
 /// Why a problem could not be read.
@@ -387,6 +387,8 @@ pub struct Problem {
     pub continuation: Option<(Family, ContinuationOptions)>,
     /// The arm optimization, its search, and whether to compute R̂0.
     pub arm: Option<(ArmProblem, SearchOptions, bool)>,
+    /// The arm's loads and actuator limit, and the size of its reach map.
+    pub arm_scene: Option<(ArmScene, usize)>,
 }
 
 impl Problem {
@@ -430,6 +432,11 @@ impl Problem {
         let stability = build_stability(&file.stability)?;
         let continuation = build_continuation(&file, &rod, &model, &options, shape.as_ref())?;
         let arm = file.arm.as_ref().map(|a| a.build(&rod)).transpose()?;
+        let arm_scene = file
+            .arm
+            .as_ref()
+            .map(|a| a.scene(&rod).map(|s| (s, a.map_samples)))
+            .transpose()?;
         Ok(Problem {
             rod,
             model,
@@ -439,6 +446,7 @@ impl Problem {
             stability,
             continuation,
             arm,
+            arm_scene,
         })
     }
 }

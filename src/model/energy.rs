@@ -45,6 +45,27 @@ pub trait StoredEnergy: std::fmt::Debug + Send + Sync {
     fn shear_stiffness(&self, _s: f64) -> Option<Vector3<f64>> {
         None
     }
+    /// The same material with its intrinsic curvature κ⁰(s) multiplied by
+    /// `factor`, for energies that have one as a separate profile (None
+    /// otherwise): the control path of a designed arm raises κ⁰ with the
+    /// load (paper Sec. 5).
+    fn with_intrinsic_scaled(&self, _factor: f64) -> Option<std::sync::Arc<dyn StoredEnergy>> {
+        None
+    }
+    /// The intrinsic curvature profiles, for energies that have them.
+    fn intrinsic_profiles(&self) -> Option<&[Profile; 3]> {
+        None
+    }
+    /// The same material with κ⁰ = (1 − p) κ⁰_self + p κ⁰_target (None
+    /// when either has no κ⁰ profiles or they do not blend): a control
+    /// moving κ⁰ from one profile to another while the load is applied.
+    fn with_intrinsic_towards(
+        &self,
+        _target: &dyn StoredEnergy,
+        _p: f64,
+    ) -> Option<std::sync::Arc<dyn StoredEnergy>> {
+        None
+    }
 }
 
 /// The linear-elastic energy with intrinsic curvature,
@@ -121,6 +142,34 @@ impl StoredEnergy for LinearElastic {
 
     fn is_quadratic(&self) -> bool {
         true
+    }
+
+    fn intrinsic_profiles(&self) -> Option<&[Profile; 3]> {
+        Some(&self.intrinsic_curvature)
+    }
+
+    fn with_intrinsic_towards(
+        &self,
+        target: &dyn StoredEnergy,
+        p: f64,
+    ) -> Option<std::sync::Arc<dyn StoredEnergy>> {
+        let to = target.intrinsic_profiles()?;
+        let [a, b, c] = &self.intrinsic_curvature;
+        Some(std::sync::Arc::new(LinearElastic {
+            stiffness: self.stiffness.clone(),
+            intrinsic_curvature: [
+                a.blend(&to[0], p)?,
+                b.blend(&to[1], p)?,
+                c.blend(&to[2], p)?,
+            ],
+        }))
+    }
+
+    fn with_intrinsic_scaled(&self, factor: f64) -> Option<std::sync::Arc<dyn StoredEnergy>> {
+        Some(std::sync::Arc::new(LinearElastic {
+            stiffness: self.stiffness.clone(),
+            intrinsic_curvature: self.intrinsic_curvature.clone().map(|p| p.scaled(factor)),
+        }))
     }
 }
 

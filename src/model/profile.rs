@@ -69,6 +69,79 @@ impl Profile {
         }
     }
 
+    /// The profile times a constant factor (a control raising an
+    /// intrinsic curvature in proportion, paper Sec. 5).
+    pub fn scaled(&self, factor: f64) -> Profile {
+        let times = |v: &[f64]| v.iter().map(|x| x * factor).collect::<Vec<_>>();
+        match self {
+            Profile::Constant(v) => Profile::Constant(v * factor),
+            Profile::Polynomial(c) => Profile::Polynomial(times(c)),
+            Profile::Table { s, values } => Profile::Table {
+                s: s.clone(),
+                values: times(values),
+            },
+            Profile::Spline {
+                s,
+                values,
+                curvature,
+            } => Profile::Spline {
+                s: s.clone(),
+                values: times(values),
+                curvature: times(curvature),
+            },
+        }
+    }
+
+    /// (1 − p) self + p other, where both are of one kind on the same knots
+    /// (so that the result is again a profile of that kind: the natural
+    /// spline is linear in its values); None otherwise. A control moving
+    /// an intrinsic curvature from one profile to another.
+    pub fn blend(&self, other: &Profile, p: f64) -> Option<Profile> {
+        let mix = |a: &[f64], b: &[f64]| -> Vec<f64> {
+            a.iter()
+                .zip(b)
+                .map(|(x, y)| (1.0 - p) * x + p * y)
+                .collect()
+        };
+        Some(match (self, other) {
+            (Profile::Constant(a), Profile::Constant(b)) => {
+                Profile::Constant((1.0 - p) * a + p * b)
+            }
+            (Profile::Polynomial(a), Profile::Polynomial(b)) => {
+                let n = a.len().max(b.len());
+                let pad = |c: &[f64]| {
+                    (0..n)
+                        .map(|i| c.get(i).copied().unwrap_or(0.0))
+                        .collect::<Vec<_>>()
+                };
+                Profile::Polynomial(mix(&pad(a), &pad(b)))
+            }
+            (Profile::Table { s, values: a }, Profile::Table { s: t, values: b }) if s == t => {
+                Profile::Table {
+                    s: s.clone(),
+                    values: mix(a, b),
+                }
+            }
+            (
+                Profile::Spline {
+                    s,
+                    values: a,
+                    curvature: ca,
+                },
+                Profile::Spline {
+                    s: t,
+                    values: b,
+                    curvature: cb,
+                },
+            ) if s == t => Profile::Spline {
+                s: s.clone(),
+                values: mix(a, b),
+                curvature: mix(ca, cb),
+            },
+            _ => return None,
+        })
+    }
+
     /// The value at s.
     pub fn value(&self, s: f64) -> f64 {
         match self {
@@ -198,6 +271,31 @@ fn locate(knots: &[f64], s: f64) -> (usize, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Scaling and blending act on the function itself: the spline built
+    /// from scaled or blended knot values (built afresh) has the same
+    /// values and derivatives everywhere.
+    #[test]
+    fn scaled_and_blended_splines_are_the_splines_of_the_values() {
+        let s: Vec<f64> = (0..9).map(|i| i as f64 / 8.0).collect();
+        let a: Vec<f64> = s.iter().map(|x| (3.0 * x).sin()).collect();
+        let b: Vec<f64> = s.iter().map(|x| x * x - 2.0 * x).collect();
+        let (sa, sb) = (
+            Profile::spline(s.clone(), a.clone()),
+            Profile::spline(s.clone(), b.clone()),
+        );
+        let mix: Vec<f64> = a.iter().zip(&b).map(|(x, y)| 0.7 * x + 0.3 * y).collect();
+        let fresh_mix = Profile::spline(s.clone(), mix);
+        let fresh_scaled = Profile::spline(s.clone(), a.iter().map(|x| -2.5 * x).collect());
+        let blended = sa.blend(&sb, 0.3).unwrap();
+        let scaled = sa.scaled(-2.5);
+        for t in [0.0, 0.13, 0.5, 0.77, 1.0] {
+            assert!((blended.value(t) - fresh_mix.value(t)).abs() < 1e-13);
+            assert!((blended.derivative(t) - fresh_mix.derivative(t)).abs() < 1e-12);
+            assert!((scaled.value(t) - fresh_scaled.value(t)).abs() < 1e-13);
+        }
+        assert!(sa.blend(&Profile::Constant(0.0), 0.5).is_none());
+    }
 
     #[test]
     fn polynomial_value_and_derivative() {

@@ -13,7 +13,7 @@ use std::sync::Arc;
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::StoredEnergy;
+use super::{Profile, StoredEnergy};
 
 /// A bending energy W_b(s, κ) with the quadratic shear and extension
 /// energy ½ (ν − e3)ᵀ diag(S) (ν − e3).
@@ -65,5 +65,33 @@ impl StoredEnergy for Shearable {
 
     fn shear_stiffness(&self, _s: f64) -> Option<Vector3<f64>> {
         Some(self.shear)
+    }
+
+    fn with_intrinsic_scaled(&self, factor: f64) -> Option<Arc<dyn StoredEnergy>> {
+        let bending = self.bending.with_intrinsic_scaled(factor)?;
+        Some(self.with_bending(bending))
+    }
+
+    fn intrinsic_profiles(&self) -> Option<&[Profile; 3]> {
+        self.bending.intrinsic_profiles()
+    }
+
+    fn with_intrinsic_towards(
+        &self,
+        target: &dyn StoredEnergy,
+        p: f64,
+    ) -> Option<Arc<dyn StoredEnergy>> {
+        let bending = self.bending.with_intrinsic_towards(target, p)?;
+        Some(self.with_bending(bending))
+    }
+}
+
+impl Shearable {
+    /// The same shear part on another bending energy.
+    fn with_bending(&self, bending: Arc<dyn StoredEnergy>) -> Arc<dyn StoredEnergy> {
+        Arc::new(Shearable {
+            bending,
+            shear: self.shear,
+        })
     }
 }

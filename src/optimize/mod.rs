@@ -18,10 +18,17 @@ use std::sync::Arc;
 
 use argmin::core::{CostFunction, Error as ArgminError, Executor, State};
 use argmin::solver::neldermead::NelderMead;
-use nalgebra::Vector3;
 
-use crate::model::{Clamp, DeadLoads, LinearElastic, Profile, Rod};
+use crate::model::{Clamp, LinearElastic, Profile, Rod};
 use crate::stability::{critical_load, FixedShape, StabilityOptions};
+
+pub mod control_path;
+pub mod fig5;
+pub mod scene;
+
+pub use control_path::{control_path, loading_path_in, shape_holding_path};
+pub use fig5::{ClosestStraight, ReachMap};
+pub use scene::{ArmScene, ArmWeight};
 
 /// The arm to design.
 #[derive(Debug, Clone, PartialEq)]
@@ -62,9 +69,11 @@ impl Default for SearchOptions {
 /// One evaluated design.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ArmDesign {
-    /// R̂ = √γ_crit |(x̄(1), z̄(1))|.
+    /// R̂ = √γ_crit |(x̄(1), z̄(1))| (with an [`ArmScene`]: L̂(λ) |r̄(1)|).
     pub reach: f64,
-    /// γ_crit = F L²/B2.
+    /// The design load: γ_crit = F L²/B2 (with an [`ArmScene`]: the load
+    /// factor λ, γ_crit or, actuator-limited, the largest λ below it that
+    /// the actuators can hold).
     pub gamma: f64,
     /// c1..cM of the loaded shape φ(s̄).
     pub shape_coefficients: Vec<f64>,
@@ -84,6 +93,28 @@ pub struct ArmOptimum {
     /// κ̄⁰2 at the shape points.
     pub intrinsic_curvature: Vec<f64>,
     /// Designs evaluated.
+    pub evaluations: usize,
+    /// The critical load factor of the loaded shape (≥ `design.gamma`; equal
+    /// unless the actuators limit the load).
+    pub critical_load: f64,
+    /// The loads and limits the design was made for.
+    pub scene: ArmScene,
+}
+
+/// How far a search has come: what `cosserat optimize --resume` keeps of an
+/// interrupted run to go on where it stopped (issue 9).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct SearchProgress {
+    /// Halton samples evaluated: the global stage goes on from the next one.
+    pub samples_done: usize,
+    /// The best samples so far as (R̂, c2..cM), best first, at most
+    /// `starts` of them: the starting points of the polishes.
+    pub leaders: Vec<(f64, Vec<f64>)>,
+    /// Polishes finished (an interrupted polish is redone).
+    pub polishes_done: usize,
+    /// The best design so far.
+    pub best: Option<ArmDesign>,
+    /// Designs evaluated so far.
     pub evaluations: usize,
 }
 
@@ -127,14 +158,16 @@ impl ArmProblem {
     /// The non-dimensional rod: L = 1, B = (B̄1, 1, B̄3), a unit tip load
     /// pulling down (e1), clamped at the origin with d3 horizontal.
     pub fn rod(&self) -> Rod {
+        self.rod_in(&ArmScene::default())
+    }
+
+    /// The non-dimensional rod under the scene's loads per unit λ.
+    pub fn rod_in(&self, scene: &ArmScene) -> Rod {
         Rod {
             length: 1.0,
             energy: Arc::new(LinearElastic::uniform([self.b1, 1.0, self.b3], [0.0; 3])),
             clamp: Clamp::paper(),
-            loads: DeadLoads {
-                tip_force: Vector3::new(1.0, 0.0, 0.0),
-                ..Default::default()
-            },
+            loads: scene.loads(),
             support: None,
         }
     }
@@ -157,17 +190,42 @@ impl ArmProblem {
     /// R̂ and γ_crit of the shape with coefficients c2..cM; None when the
     /// shape is stable under any load (no finite critical load).
     pub fn design(&self, rest: &[f64]) -> Option<ArmDesign> {
+        self.design_in(&ArmScene::default(), rest)
+    }
+
+    /// R̂ and the design load of the shape c2..cM in a scene: λ_crit of the
+    /// fixed shape under the scene's loads, lowered to what the actuators
+    /// can hold when |κ⁰| is limited; R̂ = L̂(λ) |r̄(1)|.
+    pub fn design_in(&self, scene: &ArmScene, rest: &[f64]) -> Option<ArmDesign> {
         let (c, chord) = self.full_coefficients(rest);
+        let rod = self.rod_in(scene);
         let shape = FixedShape {
             turning_angle: Profile::Polynomial(c.clone()),
         };
-        let crit = critical_load(&self.rod(), &shape, &self.stability).ok()?;
-        let gamma = crit.load_factor?;
+        let crit = critical_load(&rod, &shape, &self.stability).ok()?;
+        let mut gamma = crit.load_factor?;
+        if scene.max_curvature.is_some() {
+            let points: Vec<f64> = (0..=200).map(|i| i as f64 / 200.0).collect();
+            let samples = shape.samples(&rod, &points);
+            let dphi = derivative(&c);
+            let phi1: Vec<f64> = points.iter().map(|s| polynomial(&dphi, *s)).collect();
+            let m2: Vec<f64> = samples.iter().map(|p| p.moment[1]).collect();
+            gamma = scene.operating_load(gamma, &phi1, &m2)?;
+        }
         Some(ArmDesign {
-            reach: gamma.sqrt() * chord,
+            reach: scene.length(gamma) * chord,
             gamma,
             shape_coefficients: c,
         })
+    }
+
+    /// The Halton point i of the box of c2..cM.
+    fn halton_point(&self, i: usize) -> Vec<f64> {
+        self.bounds
+            .iter()
+            .enumerate()
+            .map(|(d, (lo, hi))| lo + (hi - lo) * halton(i, PRIMES[d % PRIMES.len()]))
+            .collect()
     }
 
     /// Clamps a point into the bounds.
@@ -191,52 +249,94 @@ impl ArmProblem {
         opts: &SearchOptions,
         stop: &dyn Fn() -> bool,
     ) -> Option<(ArmOptimum, bool)> {
-        let dim = self.bounds.len();
-        let mut evaluations = 0;
-        let mut sampled: Vec<(f64, Vec<f64>)> = vec![];
-        for i in 1..=opts.samples {
-            if stop() {
-                break;
-            }
-            let p: Vec<f64> = self
-                .bounds
-                .iter()
-                .enumerate()
-                .map(|(d, (lo, hi))| lo + (hi - lo) * halton(i, PRIMES[d % PRIMES.len()]))
-                .collect();
-            evaluations += 1;
-            if let Some(d) = self.design(&p) {
-                sampled.push((d.reach, p));
-            }
-        }
-        if dim == 0 {
-            return Some((self.finish(self.design(&[])?, evaluations)?, false));
-        }
-        sampled.sort_by(|a, b| b.0.total_cmp(&a.0));
-        let mut best: Option<ArmDesign> = sampled.first().and_then(|(_, p)| self.design(p));
-        for (_, start) in sampled.iter().take(opts.starts) {
-            if stop() {
-                break;
-            }
-            let (design, used) = self.polish(start, opts.iterations, stop);
-            evaluations += used;
-            if let Some(d) = design {
-                if best.as_ref().is_none_or(|b| d.reach > b.reach) {
-                    best = Some(d);
-                }
-            }
-        }
-        Some((self.finish(best?, evaluations)?, stop()))
+        let (optimum, _, interrupted) = self.search(
+            &ArmScene::default(),
+            opts,
+            SearchProgress::default(),
+            stop,
+            &mut |_| {},
+        );
+        Some((optimum?, interrupted))
     }
 
-    /// Nelder–Mead from `start` on −R̂ (projected into the bounds).
-    fn polish(
+    /// The search in a scene, going on from `progress` (a fresh one, or
+    /// what an interrupted run kept): Halton samples of the box, then
+    /// Nelder–Mead from the best `starts`. Returns the optimum (the best
+    /// so far when interrupted), the progress to resume from, and whether
+    /// `stop()` interrupted it. Resuming gives the same optimum as an
+    /// uninterrupted run: the samples are a fixed sequence and a polish
+    /// cut short is redone from its start. `checkpoint` sees the progress
+    /// after every sample and every polish (to save it against a kill).
+    pub fn search(
         &self,
-        start: &[f64],
-        iterations: u64,
+        scene: &ArmScene,
+        opts: &SearchOptions,
+        mut progress: SearchProgress,
         stop: &dyn Fn() -> bool,
-    ) -> (Option<ArmDesign>, usize) {
-        let simplex: Vec<Vec<f64>> = std::iter::once(start.to_vec())
+        checkpoint: &mut dyn FnMut(&SearchProgress),
+    ) -> (Option<ArmOptimum>, SearchProgress, bool) {
+        let keep = opts.starts.max(1);
+        while progress.samples_done < opts.samples && !stop() {
+            let i = progress.samples_done + 1;
+            let p = self.halton_point(i);
+            progress.evaluations += 1;
+            if let Some(d) = self.design_in(scene, &p) {
+                let at = progress.leaders.partition_point(|(r, _)| *r >= d.reach);
+                progress.leaders.insert(at, (d.reach, p));
+                progress.leaders.truncate(keep);
+            }
+            progress.samples_done = i;
+            checkpoint(&progress);
+        }
+        if self.bounds.is_empty() {
+            let optimum = self
+                .design_in(scene, &[])
+                .and_then(|d| self.finish(scene, d, progress.evaluations));
+            return (optimum, progress, false);
+        }
+        if progress.polishes_done == 0 {
+            progress.best = progress
+                .leaders
+                .first()
+                .and_then(|(_, p)| self.design_in(scene, p));
+        }
+        let starts = opts.starts.min(progress.leaders.len());
+        while progress.polishes_done < starts && !stop() {
+            let start = progress.leaders[progress.polishes_done].1.clone();
+            let (design, used) = self.polish(scene, &start, opts.iterations, stop);
+            if stop() {
+                break;
+            }
+            progress.evaluations += used;
+            if let Some(d) = design {
+                if progress.best.as_ref().is_none_or(|b| d.reach > b.reach) {
+                    progress.best = Some(d);
+                }
+            }
+            progress.polishes_done += 1;
+            checkpoint(&progress);
+        }
+        let optimum = self.best_so_far(scene, &progress);
+        (optimum, progress, stop())
+    }
+
+    /// The best design of a search so far with its shapes: the best polish,
+    /// or the best sample while the global stage runs.
+    pub fn best_so_far(&self, scene: &ArmScene, progress: &SearchProgress) -> Option<ArmOptimum> {
+        let best = match &progress.best {
+            Some(b) if progress.polishes_done > 0 || progress.leaders.is_empty() => b.clone(),
+            _ => {
+                let (_, p) = progress.leaders.first()?;
+                self.design_in(scene, p)?
+            }
+        };
+        self.finish(scene, best, progress.evaluations)
+    }
+
+    /// The starting simplex around `start`: steps of 5 % of each bound's
+    /// width, inwards at the upper bound.
+    fn simplex(&self, start: &[f64]) -> Vec<Vec<f64>> {
+        std::iter::once(start.to_vec())
             .chain((0..start.len()).map(|d| {
                 let mut p = start.to_vec();
                 let (lo, hi) = self.bounds[d];
@@ -248,9 +348,21 @@ impl ArmProblem {
                 };
                 p
             }))
-            .collect();
+            .collect()
+    }
+
+    /// Nelder–Mead from `start` on −R̂ (projected into the bounds).
+    fn polish(
+        &self,
+        scene: &ArmScene,
+        start: &[f64],
+        iterations: u64,
+        stop: &dyn Fn() -> bool,
+    ) -> (Option<ArmDesign>, usize) {
+        let simplex = self.simplex(start);
         let cost = ReachCost {
             problem: self,
+            scene,
             stop,
             calls: std::cell::Cell::new(0),
         };
@@ -263,31 +375,36 @@ impl ArmProblem {
         let calls = cost.calls.get();
         let design = result.ok().and_then(|r| {
             let p = r.state().get_best_param()?.clone();
-            self.design(&self.project(&p))
+            self.design_in(scene, &self.project(&p))
         });
         (design, calls)
     }
 
-    fn finish(&self, design: ArmDesign, evaluations: usize) -> Option<ArmOptimum> {
-        let rod = self.rod();
+    /// The optimum with its shapes, intrinsic curvature (43) and its
+    /// Taylor fit (59), and the critical load of its shape.
+    fn finish(
+        &self,
+        scene: &ArmScene,
+        design: ArmDesign,
+        evaluations: usize,
+    ) -> Option<ArmOptimum> {
+        let rod = self.rod_in(scene);
         let shape = FixedShape {
             turning_angle: Profile::Polynomial(design.shape_coefficients.clone()),
         };
+        let critical = critical_load(&rod, &shape, &self.stability)
+            .ok()?
+            .load_factor?;
         let n = 101;
         let points: Vec<f64> = (0..n).map(|i| i as f64 / (n - 1) as f64).collect();
         let samples = shape.samples(&rod, &points);
         let c = &design.shape_coefficients;
-        let dphi: Vec<f64> = c
-            .iter()
-            .enumerate()
-            .skip(1)
-            .map(|(i, ci)| i as f64 * ci)
-            .collect();
+        let dphi = derivative(c);
         let kappa0: Vec<f64> = samples
             .iter()
             .map(|p| polynomial(&dphi, p.s) - design.gamma * p.moment[1])
             .collect();
-        let scale = design.gamma.sqrt();
+        let scale = scene.length(design.gamma);
         let loaded = samples
             .iter()
             .map(|p| {
@@ -306,8 +423,19 @@ impl ArmProblem {
             unloaded_shape: unloaded,
             intrinsic_curvature: kappa0,
             evaluations,
+            critical_load: critical,
+            scene: *scene,
         })
     }
+}
+
+/// The coefficients of p' for p = Σ c_i s^{i−1}.
+fn derivative(c: &[f64]) -> Vec<f64> {
+    c.iter()
+        .enumerate()
+        .skip(1)
+        .map(|(i, ci)| i as f64 * ci)
+        .collect()
 }
 
 /// The unloaded shape: φ⁰ = c1 + ∫κ⁰ (trapezoidal on the fine grid), then
@@ -353,6 +481,7 @@ fn halton(mut i: usize, b: usize) -> f64 {
 /// charged their squared distance.
 struct ReachCost<'a> {
     problem: &'a ArmProblem,
+    scene: &'a ArmScene,
     stop: &'a dyn Fn() -> bool,
     calls: std::cell::Cell<usize>,
 }
@@ -368,7 +497,10 @@ impl CostFunction for &ReachCost<'_> {
         self.calls.set(self.calls.get() + 1);
         let q = self.problem.project(p);
         let outside: f64 = p.iter().zip(&q).map(|(a, b)| (a - b).powi(2)).sum();
-        let reach = self.problem.design(&q).map_or(0.0, |d| d.reach);
+        let reach = self
+            .problem
+            .design_in(self.scene, &q)
+            .map_or(0.0, |d| d.reach);
         Ok(-reach + outside)
     }
 }
@@ -552,19 +684,17 @@ impl ArmProblem {
     }
 }
 
-/// The loading path of a designed arm (paper Sec. 5 warns that loading need
-/// not reach the design): the rod with the design's intrinsic curvature
-/// (κ̄⁰2 as a natural cubic spline through `points` nodes, exact at the
-/// nodes) and clamp angle
-/// c1, continued in the load factor λ from nearly unloaded to λ = 1 (the
-/// design load γ_crit) with the Hessian tracked.
-pub fn loading_path(
+/// The rod of a design at its design load: the intrinsic curvature κ̄⁰2 of
+/// (43) as a natural cubic spline through `points` nodes (exact at the
+/// nodes), the clamp turned by c1 (the design's tangent at s = 0), the
+/// scene's loads scaled by the design load.
+pub fn designed_rod(
     problem: &ArmProblem,
+    scene: &ArmScene,
     design: &ArmDesign,
     points: usize,
-) -> Result<crate::continuation::Diagram, crate::continuation::ContinuationError> {
-    use crate::continuation::{continuation, ContinuationOptions, Family, Parameter};
-    let rod0 = problem.rod();
+) -> Rod {
+    let rod0 = problem.rod_in(scene);
     let shape = FixedShape {
         turning_angle: Profile::Polynomial(design.shape_coefficients.clone()),
     };
@@ -572,12 +702,7 @@ pub fn loading_path(
         .map(|i| i as f64 / (points - 1) as f64)
         .collect();
     let c = &design.shape_coefficients;
-    let dphi: Vec<f64> = c
-        .iter()
-        .enumerate()
-        .skip(1)
-        .map(|(i, ci)| i as f64 * ci)
-        .collect();
+    let dphi = derivative(c);
     let kappa0: Vec<f64> = shape
         .samples(&rod0, &s)
         .iter()
@@ -592,17 +717,36 @@ pub fn loading_path(
             Profile::Constant(0.0),
         ],
     });
-    // The clamp turned by c1 (d3 towards d1), the design's tangent at s = 0.
     let axis = nalgebra::Unit::new_normalize(rod.clamp.director(1));
     rod.clamp.frame = nalgebra::Rotation3::from_axis_angle(&axis, c[0]).matrix() * rod.clamp.frame;
     rod.loads = rod.loads.scaled(design.gamma);
-    let family = Family::new(
+    rod
+}
+
+/// Continues the designed rod in `parameter` from nearly 0 to 1 (the
+/// design) with the Hessian tracked on the design's own discretization, so
+/// that λ = 1 is its γ_crit.
+pub(crate) fn continue_to_design(
+    problem: &ArmProblem,
+    rod: Rod,
+    parameter: crate::continuation::Parameter,
+) -> Result<crate::continuation::Diagram, crate::continuation::ContinuationError> {
+    let family = crate::continuation::Family::new(
         rod,
-        Parameter::LoadScale,
+        parameter,
         crate::model::ModelLevel::Planar,
         32,
         crate::bvp::integrator::Tolerances::default(),
     );
+    continue_family(problem, &family)
+}
+
+/// Continues `family` from p = 10⁻³ to 1 with the design's own mesh.
+pub(crate) fn continue_family(
+    problem: &ArmProblem,
+    family: &crate::continuation::Family,
+) -> Result<crate::continuation::Diagram, crate::continuation::ContinuationError> {
+    use crate::continuation::{continuation, ContinuationOptions};
     let opts = ContinuationOptions {
         start: 1e-3,
         bounds: (0.0, 1.0),
@@ -610,12 +754,25 @@ pub fn loading_path(
         max_step: 0.05,
         switch_depth: 0,
         max_points: 4000,
-        // The design's own discretization, so that λ = 1 is its γ_crit.
         stability: StabilityOptions {
             eigenvalues: 2,
             ..problem.stability
         },
         ..Default::default()
     };
-    continuation(&family, &opts, &mut |_, _| true)
+    continuation(family, &opts, &mut |_, _| true)
+}
+
+/// The loading path of a designed arm (paper Sec. 5 warns that loading need
+/// not reach the design): the rod with the design's intrinsic curvature
+/// and clamp angle ([`designed_rod`]), continued in the load factor λ from
+/// nearly unloaded to λ = 1 (the design load γ_crit) with the Hessian
+/// tracked.
+pub fn loading_path(
+    problem: &ArmProblem,
+    design: &ArmDesign,
+    points: usize,
+) -> Result<crate::continuation::Diagram, crate::continuation::ContinuationError> {
+    let rod = designed_rod(problem, &ArmScene::default(), design, points);
+    continue_to_design(problem, rod, crate::continuation::Parameter::LoadScale)
 }
