@@ -161,6 +161,12 @@ pub const FORMULAS: &[(&str, &str, &str)] = &[
     ),
     ("euler_clamped_free", "", "F L²/B = π²/4 (Euler 1744)"),
     (
+        "deflection_span",
+        "tilt",
+        "|z|√(F/B) = ∫_0^{π−ε} cos(θ/2) dθ = 2 cos(ε/2): the elastica from a clamp tilted ε from \
+         the vertical to the hanging tail (L → ∞); ε → 0 gives Rdef = 2 (paper eq. (3))",
+    ),
+    (
         "clamped_guided",
         "",
         "F L²/B = 4π²: a column clamped at both ends, one sliding (Timoshenko & Gere 1961, Sec. 2.3)",
@@ -322,6 +328,7 @@ pub fn evaluate(name: &str, params: &BTreeMap<String, f64>) -> Result<f64, Strin
         "none" => f64::NAN,
         "greenhill_clamped" => greenhill_clamped(param(params, "twist", name)?),
         "clamped_guided" => 4.0 * PI * PI,
+        "deflection_span" => 2.0 * (param(params, "tilt", name)? / 2.0).cos(),
         "timoshenko_ltb" => 2.0 * j(),
         "timoshenko_chi" => (2.0 * j()).sqrt(),
         other => {
