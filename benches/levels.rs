@@ -88,7 +88,9 @@ fn dims(level: ModelLevel) -> usize {
 }
 
 fn main() {
-    println!("| scene | level | ODEs | method | solve [µs] | stability [µs] | tip vs least level |");
+    println!(
+        "| scene | level | ODEs | method | solve [µs] | stability [µs] | tip vs least level |"
+    );
     println!("|---|---|---|---|---|---|---|");
     let plain = cantilever(None);
     let least = solve(
@@ -111,8 +113,7 @@ fn main() {
         Some(least),
     );
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("problems/bathe_bolourchi_45.toml");
-    let kirchhoff =
-        Problem::from_path(&path, &["solver.model=\"kirchhoff\"".to_string()]).unwrap();
+    let kirchhoff = Problem::from_path(&path, &["solver.model=\"kirchhoff\"".to_string()]).unwrap();
     let cosserat = Problem::from_path(&path, &[]).unwrap();
     let least = solve(&kirchhoff.rod, &kirchhoff.model, &kirchhoff.options)
         .unwrap()

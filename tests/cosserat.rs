@@ -184,3 +184,34 @@ fn problem_file_chooses_the_cosserat_level() {
         .to_string();
     assert!(err.contains("energy.shear[1]"), "{err}");
 }
+
+/// The Cosserat level through the continuation interface: `cosserat
+/// continue` on a shearable clamped–free column finds its branch point at
+/// Haringx's load (the BVP Jacobian's sign change, the Hessian eigenvalue
+/// agreeing) and switches onto the buckled branch.
+#[test]
+fn continuation_finds_haringx_branch_point() {
+    use cosserat::continuation::{continuation, SpecialKind};
+    let text = "[rod]\nlength = 1.0\n[energy]\nstiffness = [2.0, 1.0, 1.0]\n\
+                shear = [2.0, 1e3, 1e12]\n[loads]\ntip_force = [0.0, 0.0, -1.0]\n\
+                [stability]\nelements = 40\norder = 3\n\
+                [continuation]\nparameter = \"load_scale\"\nstart = 0.5\nbounds = [0.0, 3.0]\n\
+                step = 0.2\nmax_step = 0.4\nelements = 40\norder = 3\neigenvalues = 2\n\
+                tip_angle_limit = 60.0\n";
+    let p = Problem::from_str_with(text, &[]).unwrap();
+    assert_eq!(p.model.level, ModelLevel::Cosserat);
+    let (family, opts) = p.continuation.clone().unwrap();
+    let d = continuation(&family, &opts, &mut |_, _| true).unwrap();
+    let haringx = 0.5 * 2.0 * ((1.0 + 4.0 * PI * PI / 4.0 / 2.0).sqrt() - 1.0);
+    let bp = d
+        .special_points
+        .iter()
+        .find(|s| s.kind == SpecialKind::BranchPoint)
+        .expect("a branch point");
+    assert!(
+        (bp.point.parameter - haringx).abs() < 1e-8 * haringx,
+        "{} vs {haringx}",
+        bp.point.parameter
+    );
+    assert!(!bp.children.is_empty(), "switched onto the buckled branch");
+}
