@@ -197,3 +197,30 @@ fn bad_supports_name_the_field() {
     );
     assert!(err(&["support.position=[0.0, nan, 1.0]"]).contains("support.position"));
 }
+
+/// A hinged base (clamp.hinge): the pinned–pinned column buckles at π² B/L²
+/// (Euler's fundamental case) and the pinned–guided one, a clamped–pinned
+/// column turned round, at x² with tan x = x; the hinge is refused where
+/// the planar model cannot run.
+#[test]
+fn hinged_base_columns_buckle_at_their_classical_loads() {
+    for (rotation, reference) in [("free", PI * PI), ("fixed", clamped_pinned())] {
+        let column = Column {
+            overrides: vec![
+                "clamp.hinge=true".into(),
+                "support.translation=\"axial\"".into(),
+                format!("support.rotation=\"{rotation}\""),
+            ],
+        };
+        assert_eq!(column.at(1.0).model.level, ModelLevel::Planar);
+        let p = column.critical(reference);
+        assert!(
+            (p - reference).abs() / reference < 1e-9,
+            "hinge + {rotation}: {p} vs {reference}"
+        );
+    }
+    let spatial = ["clamp.hinge=true", "loads.tip_couple=[0.0, 0.0, 1.0]"];
+    let o: Vec<String> = spatial.iter().map(|s| s.to_string()).collect();
+    let e = Problem::from_str_with(COLUMN, &o).unwrap_err().to_string();
+    assert!(e.contains("clamp.hinge"), "{e}");
+}

@@ -260,6 +260,14 @@ pub fn solve(
         ));
     }
     check_energy(rod)?;
+    if rod.clamp.hinge && model.level != ModelLevel::Planar {
+        return Err(SolveError::Model(format!(
+            "a hinged base (clamp.hinge) is implemented in the planar model only; this scene \
+             runs the {} model ({})",
+            model.level.name(),
+            model.reason
+        )));
+    }
     let start = Instant::now();
     let mut stats = IntegrationStats::default();
     let ramp_first = match opts.strategy {

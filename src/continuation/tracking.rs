@@ -97,7 +97,8 @@ impl Tracker {
         p: f64,
     ) -> Result<(FiniteElements, Vec<BlockMatrices>, f64, Vec<RodSample>), PointError> {
         let rod = family.rod_at(p)?;
-        let fe = FiniteElements::new(rod.length, self.opts.elements, self.opts.order);
+        let fe = FiniteElements::new(rod.length, self.opts.elements, self.opts.order)
+            .with_hinged_base(rod.clamp.hinge);
         // One integration for the quadrature points and the 21 shape points
         // (the last is the tip).
         let quadrature = fe.quadrature_points();

@@ -9,6 +9,9 @@
 //! κ2' = (−N1 − ∂sM2)/H22. State y = (x, z, φ, κ2); one unknown κ2(0); one
 //! tip condition M2(L) = C·d2.
 //!
+//! A hinged base ([`crate::model::Clamp::hinge`]) makes the angle φ(0) the
+//! unknown instead of κ2(0), which then follows from M2(0) = 0.
+//!
 //! A support that holds the tip's position adds the in-plane reaction
 //! (R_x, R_z) as two constant states with unknown initial values, and its
 //! conditions replace the natural one: the position (or its component
@@ -79,6 +82,22 @@ impl PlanarEquations {
 }
 
 impl PlanarEquations {
+    /// κ2(0) at a hinged base: the root of ∂W/∂κ2(0, κ2) = 0 (κ⁰2(0) for
+    /// the linear energy), by Newton from κ2 = 0.
+    fn hinge_curvature(&self) -> f64 {
+        let e = &self.rod.energy;
+        let mut k2 = 0.0;
+        for _ in 0..50 {
+            let kappa = Self::kappa(k2);
+            let step = e.moment(0.0, &kappa)[1] / e.stiffness(0.0, &kappa)[(1, 1)];
+            k2 -= step;
+            if step.abs() <= 1e-15 * k2.abs().max(1.0) {
+                break;
+            }
+        }
+        k2
+    }
+
     /// The residuals (3) and Jacobian (3 × dim) of a supported tip, as
     /// moments (positions × M_s/L, angles × M_s, forces × L). The support
     /// is planar (see [`crate::model::ModelChoice`]): targets in the plane,
@@ -150,11 +169,23 @@ impl RodEquations for PlanarEquations {
     fn initial_state(&self, u: &[f64], y0: &mut [f64]) {
         y0[..3].fill(0.0);
         y0[3..].copy_from_slice(u);
+        if self.rod.clamp.hinge {
+            y0[2] = u[0];
+            y0[3] = self.hinge_curvature();
+        }
     }
 
     fn initial_sensitivity(&self) -> DMatrix<f64> {
         let n = self.dim();
-        DMatrix::from_fn(n, n - 3, |i, j| if i == j + 3 { 1.0 } else { 0.0 })
+        let first = if self.rod.clamp.hinge { 2 } else { 3 };
+        DMatrix::from_fn(n, n - 3, |i, j| {
+            let row = if j == 0 { first } else { j + 3 };
+            if i == row {
+                1.0
+            } else {
+                0.0
+            }
+        })
     }
 
     fn rhs(&self, s: f64, y: &[f64], dy: &mut [f64]) {
@@ -233,13 +264,17 @@ impl RodEquations for PlanarEquations {
                 break;
             }
         }
-        let mut u = vec![k2];
+        let mut u = vec![if self.rod.clamp.hinge { 0.0 } else { k2 }];
         u.resize(self.unknowns(), 0.0);
         u
     }
 
     fn unknowns_of(&self, y0: &[f64]) -> Vec<f64> {
-        y0[3..].to_vec()
+        let mut u = y0[3..].to_vec();
+        if self.rod.clamp.hinge {
+            u[0] = y0[2];
+        }
+        u
     }
 
     fn sample(&self, s: f64, y: &[f64]) -> RodSample {

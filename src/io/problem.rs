@@ -245,6 +245,9 @@ pub struct ClampSection {
     /// d1: the clamp angle of the paper's Fig. 2.
     #[serde(default)]
     pub angle: f64,
+    /// A hinge about d2 instead of a clamp (a pinned base; planar scenes).
+    #[serde(default)]
+    pub hinge: bool,
 }
 
 fn unit_x() -> [f64; 3] {
@@ -262,6 +265,7 @@ impl Default for ClampSection {
             d1: unit_x(),
             d3: unit_z(),
             angle: 0.0,
+            hinge: false,
         }
     }
 }
@@ -427,6 +431,15 @@ impl Problem {
             toml::from_str(&text).map_err(|e| ProblemError::Parse(e.to_string()))?;
         let rod = build_rod(&file, catalog)?;
         let model = choose_model(&rod, &file.solver.model, file.energy.shear.is_some())?;
+        if rod.clamp.hinge && model.level != ModelLevel::Planar {
+            return Err(invalid(
+                "clamp.hinge",
+                format!(
+                    "a hinged base needs the planar model, but the scene runs {}",
+                    model.reason
+                ),
+            ));
+        }
         let options = build_options(&file.solver)?;
         let shape = build_shape(&file)?;
         let stability = build_stability(&file.stability)?;
@@ -690,6 +703,7 @@ fn build_clamp(c: &ClampSection) -> Result<Clamp, ProblemError> {
     let clamp = Clamp::new(position, d1, d3);
     Ok(Clamp {
         frame: turned(&clamp, angle),
+        hinge: c.hinge,
         ..clamp
     })
 }

@@ -6,14 +6,20 @@ use nalgebra::{Matrix3, Vector3};
 
 use super::{DeadLoads, StoredEnergy, TipSupport};
 
-/// The clamp at s = 0: position and the directors d1(0), d2(0), d3(0).
+/// The support at s = 0: position and the directors d1(0), d2(0), d3(0);
+/// a clamp, or a hinge about d2(0).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Clamp {
     /// r(0) (m).
     pub position: Vector3<f64>,
     /// The director frame [d1 d2 d3] at s = 0, as columns (orthonormal,
-    /// right-handed).
+    /// right-handed); for a hinge, the frame the turning angle is measured
+    /// from.
     pub frame: Matrix3<f64>,
+    /// A hinge about d2(0) instead of a clamp: the frame may turn about
+    /// d2(0) (its angle is an unknown) and the moment about d2(0) vanishes
+    /// there (planar scenes: the pinned end of a column).
+    pub hinge: bool,
 }
 
 impl Clamp {
@@ -24,6 +30,7 @@ impl Clamp {
         Clamp {
             position,
             frame: Matrix3::from_columns(&[d1, d2, d3]),
+            hinge: false,
         }
     }
 

@@ -147,6 +147,13 @@ pub fn critical_load(
             "a fixed-shape scene takes forces only".into(),
         ));
     }
+    if rod.clamp.hinge || rod.support.is_some() || rod.energy.shear_stiffness(0.0).is_some() {
+        return Err(StabilityError::FixedShape(
+            "a fixed shape is a clamped, free-tipped Kirchhoff cantilever (paper Sec. 3); \
+             remove clamp.hinge, [support] and energy.shear"
+                .into(),
+        ));
+    }
     let normal = rod.clamp.director(1);
     let off_plane =
         rod.loads.tip_force.dot(&normal).abs() + rod.loads.distributed_force.dot(&normal).abs();

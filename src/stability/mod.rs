@@ -187,7 +187,8 @@ pub fn analyze(
     opts: &StabilityOptions,
 ) -> Result<Stability, StabilityError> {
     check_conservative(rod)?;
-    let fe = FiniteElements::new(rod.length, opts.elements, opts.order);
+    let fe = FiniteElements::new(rod.length, opts.elements, opts.order)
+        .with_hinged_base(rod.clamp.hinge);
     let mut points = fe.quadrature_points();
     points.push(rod.length);
     let mut samples = eq.resample(rod, solver, &points)?;

@@ -156,6 +156,8 @@ pub struct FiniteElements {
     length: f64,
     elements: usize,
     order: usize,
+    /// A hinged base: ω2(0) is free (the in-plane block keeps node 0).
+    hinged: bool,
 }
 
 /// Gauss–Legendre nodes and weights on [0, 1] with `m` points (m = 2..4).
@@ -192,6 +194,24 @@ impl FiniteElements {
             length,
             elements: elements.max(1),
             order: order.clamp(1, 3),
+            hinged: false,
+        }
+    }
+
+    /// The same elements for a base that is a hinge about d2(0) (true) or a
+    /// clamp (false): with a hinge the in-plane rotation ω2 at s = 0 is an
+    /// unknown too.
+    pub fn with_hinged_base(self, hinged: bool) -> Self {
+        FiniteElements { hinged, ..self }
+    }
+
+    /// The first node carrying unknowns of a block: 0 where the base lets
+    /// the block's rotation free, 1 at a clamp.
+    fn first_node(&self, block: Block) -> usize {
+        if self.hinged && block == Block::InPlane {
+            0
+        } else {
+            1
         }
     }
 
@@ -240,9 +260,10 @@ impl FiniteElements {
         (value, deriv)
     }
 
-    /// Number of unknowns of a block (the clamp node is fixed).
+    /// Number of unknowns of a block (the clamp node is fixed, unless the
+    /// base is hinged and the block is in-plane).
     pub fn size(&self, block: Block) -> usize {
-        block.components().len() * self.elements * self.order
+        block.components().len() * (self.elements * self.order + 1 - self.first_node(block))
     }
 
     /// K for the coefficients at the quadrature points (in the order of
@@ -282,6 +303,7 @@ impl FiniteElements {
         let nc = comps.len();
         let p = self.order;
         let mut k = SymmetricBanded::zeros(self.size(block), nc * (p + 1) - 1);
+        let first = self.first_node(block);
         let (xs, ws) = gauss(p + 1);
         let h = self.h();
         let shapes: Vec<_> = xs.iter().map(|&x| self.shape(x)).collect();
@@ -289,11 +311,11 @@ impl FiniteElements {
             for (g, ((val, der), w)) in shapes.iter().zip(&ws).enumerate() {
                 let q = e * (p + 1) + g;
                 for a in 0..=p {
-                    let Some(ia) = (e * p + a).checked_sub(1) else {
+                    let Some(ia) = (e * p + a).checked_sub(first) else {
                         continue;
                     };
                     for b in 0..=p {
-                        let Some(ib) = (e * p + b).checked_sub(1) else {
+                        let Some(ib) = (e * p + b).checked_sub(first) else {
                             continue;
                         };
                         for (x, &ci) in comps.iter().enumerate() {
@@ -373,11 +395,11 @@ impl FiniteElements {
             Freedom::Fixed => (0..3).map(|j| Vector3::ith(j, 1.0)).collect(),
             Freedom::Axial(a) => across(&a).map(|b| frame.transpose() * b).to_vec(),
         };
-        let last = self.elements * self.order;
+        let last = self.elements * self.order - self.first_node(block);
         for v in turns {
             let mut row = DVector::zeros(n);
             for (x, &c) in block.components().iter().enumerate() {
-                row[(last - 1) * block.components().len() + x] = v[c];
+                row[last * block.components().len() + x] = v[c];
             }
             rows.push(row);
         }
@@ -397,7 +419,7 @@ impl FiniteElements {
                 let d = &sample.directors;
                 let (val, _) = self.shape(x);
                 for (local, phi) in val.iter().enumerate() {
-                    let Some(node) = (e * p + local).checked_sub(1) else {
+                    let Some(node) = (e * p + local).checked_sub(self.first_node(block)) else {
                         continue;
                     };
                     for (i, &c) in comps.iter().enumerate() {
@@ -413,10 +435,11 @@ impl FiniteElements {
     /// block unknowns.
     pub fn nodal_rotations(&self, block: Block, v: &[f64]) -> Vec<Vector3<f64>> {
         let comps = block.components();
+        let first = self.first_node(block);
         let mut out = vec![Vector3::zeros(); self.elements * self.order + 1];
-        for (node, w) in out.iter_mut().enumerate().skip(1) {
+        for (node, w) in out.iter_mut().enumerate().skip(first) {
             for (x, &c) in comps.iter().enumerate() {
-                w[c] = v[(node - 1) * comps.len() + x];
+                w[c] = v[(node - first) * comps.len() + x];
             }
         }
         out
