@@ -3,18 +3,60 @@
 //! or a field.
 //!
 //! The number of inputs is `COSSERAT_FUZZ_CASES` (default 100 000, split
-//! over the three generators below).
+//! over the three generators below). The seeds are every shipped problem
+//! file and the corpus in tests/corpus/: bad inputs kept with the field
+//! their rejection must name (`# expect: …` on the first line), so that a
+//! class of bad input once covered stays covered.
 
 use cosserat::io::Problem;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 
-const BASES: [&str; 2] = [
-    include_str!("../problems/cantilever_tip_load.toml"),
-    include_str!("../problems/helix_tip_load.toml"),
-];
+/// The seeds: problems/*.toml and tests/corpus/*.toml, sorted by path so
+/// that the generators are deterministic.
+fn bases() -> &'static [String] {
+    static BASES: std::sync::OnceLock<Vec<String>> = std::sync::OnceLock::new();
+    BASES.get_or_init(|| {
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+        let mut paths: Vec<_> = ["problems", "tests/corpus"]
+            .iter()
+            .flat_map(|d| std::fs::read_dir(root.join(d)).unwrap())
+            .map(|e| e.unwrap().path())
+            .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+            .collect();
+        paths.sort();
+        paths
+            .iter()
+            .map(|p| std::fs::read_to_string(p).unwrap())
+            .collect()
+    })
+}
 
-const KEYS: [&str; 22] = [
+/// Every corpus file is rejected with a message naming what its first line
+/// expects.
+#[test]
+fn corpus_rejections_name_their_field() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/corpus");
+    let mut seen = 0;
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let expect = text
+            .lines()
+            .next()
+            .and_then(|l| l.strip_prefix("# expect: "))
+            .unwrap_or_else(|| panic!("{}: no `# expect:` line", path.display()));
+        let err = Problem::from_str_with(&text, &[])
+            .err()
+            .unwrap_or_else(|| panic!("{}: accepted", path.display()))
+            .to_string();
+        assert!(err.contains(expect), "{}: {err}", path.display());
+        seen += 1;
+    }
+    assert!(seen >= 10, "{seen} corpus files");
+}
+
+const KEYS: [&str; 35] = [
     "rod.length",
     "energy.kind",
     "energy.stiffness",
@@ -37,6 +79,19 @@ const KEYS: [&str; 22] = [
     "solver.output_points",
     "solver.initial_curvature",
     "rod.colour",
+    "energy.shear",
+    "energy.parameters.quartic",
+    "energy.parameters.x",
+    "clamp.angle",
+    "clamp.hinge",
+    "support.translation",
+    "support.rotation",
+    "support.axis",
+    "support.position",
+    "support.d3",
+    "continuation.step",
+    "arm.coefficients",
+    "arm.alpha",
 ];
 
 const VALUES: [&str; 30] = [
@@ -120,7 +175,7 @@ fn runner(cases: u32) -> TestRunner {
 fn byte_mutations_never_panic() {
     let alphabet: Vec<char> = "[]{}=,.\"'#\n 0123456789-+einfaxyz_".chars().collect();
     let strategy = (
-        0..BASES.len(),
+        0..bases().len(),
         prop::collection::vec(
             (
                 any::<prop::sample::Index>(),
@@ -132,7 +187,7 @@ fn byte_mutations_never_panic() {
     );
     runner(cases() / 3)
         .run(&strategy, |(base, edits)| {
-            let mut chars: Vec<char> = BASES[base].chars().collect();
+            let mut chars: Vec<char> = bases()[base].chars().collect();
             for (at, op, pick) in edits {
                 let i = at
                     .index(chars.len().max(1))
@@ -156,7 +211,7 @@ fn byte_mutations_never_panic() {
 #[test]
 fn value_overrides_never_panic() {
     let strategy = (
-        0..BASES.len(),
+        0..bases().len(),
         prop::collection::vec((0..KEYS.len(), 0..VALUES.len()), 1..4),
     );
     runner(cases() / 3)
@@ -165,7 +220,7 @@ fn value_overrides_never_panic() {
                 .iter()
                 .map(|&(k, v)| format!("{}={}", KEYS[k], VALUES[v]))
                 .collect();
-            check(BASES[base], &overrides)
+            check(&bases()[base], &overrides)
         })
         .unwrap();
     let (a, r) = (
@@ -181,10 +236,10 @@ fn value_overrides_never_panic() {
 /// Arbitrary override strings (malformed keys, empty values, unicode).
 #[test]
 fn arbitrary_override_strings_never_panic() {
-    let strategy = (0..BASES.len(), prop::collection::vec(".{0,24}", 1..3));
+    let strategy = (0..bases().len(), prop::collection::vec(".{0,24}", 1..3));
     runner(cases() - 2 * (cases() / 3))
         .run(&strategy, |(base, overrides)| {
-            check(BASES[base], &overrides)
+            check(&bases()[base], &overrides)
         })
         .unwrap();
 }

@@ -770,6 +770,7 @@ fn build_continuation(
         let fe_points: Vec<f64> = (0..=64).map(|i| rod.length * i as f64 / 64.0).collect();
         let moment = shape
             .samples(rod, &fe_points)
+            .map_err(|e| invalid("shape", e.to_string()))?
             .iter()
             .map(|p| p.moment.norm())
             .fold(0.0, f64::max);

@@ -206,7 +206,7 @@ impl ArmProblem {
         let mut gamma = crit.load_factor?;
         if scene.max_curvature.is_some() {
             let points: Vec<f64> = (0..=200).map(|i| i as f64 / 200.0).collect();
-            let samples = shape.samples(&rod, &points);
+            let samples = shape.samples(&rod, &points).ok()?;
             let dphi = derivative(&c);
             let phi1: Vec<f64> = points.iter().map(|s| polynomial(&dphi, *s)).collect();
             let m2: Vec<f64> = samples.iter().map(|p| p.moment[1]).collect();
@@ -397,7 +397,7 @@ impl ArmProblem {
             .load_factor?;
         let n = 101;
         let points: Vec<f64> = (0..n).map(|i| i as f64 / (n - 1) as f64).collect();
-        let samples = shape.samples(&rod, &points);
+        let samples = shape.samples(&rod, &points).ok()?;
         let c = &design.shape_coefficients;
         let dphi = derivative(c);
         let kappa0: Vec<f64> = samples
@@ -705,6 +705,7 @@ pub fn designed_rod(
     let dphi = derivative(c);
     let kappa0: Vec<f64> = shape
         .samples(&rod0, &s)
+        .expect("a design's shape was integrated when its critical load was found")
         .iter()
         .map(|p| polynomial(&dphi, p.s) - design.gamma * p.moment[1])
         .collect();

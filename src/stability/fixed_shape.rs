@@ -43,8 +43,10 @@ pub struct CriticalLoad {
 impl FixedShape {
     /// The shape sampled at sorted points, with the load-per-unit-factor
     /// moment m(s) and force n(s) of `rod.loads`: curvature κ = (0, φ', 0),
-    /// moment = body components of m, force = the internal force n.
-    pub fn samples(&self, rod: &Rod, points: &[f64]) -> Vec<RodSample> {
+    /// moment = body components of m, force = the internal force n. Fails
+    /// when the shape's quadrature does (a length or shape so extreme that
+    /// the integrator's step underflows).
+    pub fn samples(&self, rod: &Rod, points: &[f64]) -> Result<Vec<RodSample>, StabilityError> {
         let c = &rod.clamp;
         let (ex, ez) = (c.director(0), c.director(2));
         let phi = &self.turning_angle;
@@ -71,12 +73,14 @@ impl FixedShape {
                 |s, y| states.push((s, [y[0], y[1], y[2], y[3]])),
                 |_| {},
             )
-            .expect("the shape integral of bounded functions does not blow up");
+            .map_err(|e| {
+                StabilityError::FixedShape(format!("the shape's quadrature failed: {e:?}"))
+            })?;
         let (_, tip) = *states.last().expect("the tip is a stop");
         // In-plane vectors to global: (a, b) ↦ a ex + b ez.
         let global = |a: f64, b: f64| ex * a + ez * b;
         let loads = &rod.loads;
-        states[..points.len()]
+        Ok(states[..points.len()]
             .iter()
             .map(|(s, v)| {
                 let (sin, cos) = phi.value(*s).sin_cos();
@@ -105,7 +109,7 @@ impl FixedShape {
                     force: loads.internal_force(*s, rod.length),
                 }
             })
-            .collect()
+            .collect())
     }
 }
 
@@ -163,7 +167,7 @@ pub fn critical_load(
         ));
     }
     let fe = FiniteElements::new(rod.length, opts.elements, opts.order);
-    let samples = shape.samples(rod, &fe.quadrature_points());
+    let samples = shape.samples(rod, &fe.quadrature_points())?;
     let (c0, c1) = split_coefficients(rod, &samples);
     let mut blocks = Vec::new();
     for block in [Block::InPlane, Block::OutOfPlane] {
