@@ -55,6 +55,10 @@ fn runner_closed_forms_match_the_test_support() {
     }
     let j = support::bessel::first_zero(-0.25, 1.0, 3.0);
     assert!((reference::bessel_first_zero(-0.25, 1.0, 3.0) - j).abs() < 1e-14);
+    for tau in [0.0, 2.0, 5.0] {
+        let a = support::columns::greenhill_clamped(tau, 1.0, 1.0);
+        assert!((reference::greenhill_clamped(tau) - a).abs() < 1e-10 * a);
+    }
 }
 
 #[test]

@@ -20,8 +20,8 @@ use nalgebra::{DMatrix, DVector};
 
 use super::banded::{BandedLdlt, SymmetricBanded};
 use super::eigen::{
-    count_below, dense_pencil, lanczos, lowest_eigenpairs_near, row_sum_norm, EigenError,
-    Eigenpairs, DENSE_LIMIT,
+    count_below, dense_pencil, diagonal_ratio, lanczos, lowest_eigenpairs_near, row_sum_norm,
+    shift_below, EigenError, Eigenpairs, DENSE_LIMIT,
 };
 
 /// Linear constraints C v = 0 with orthonormal rows (m × n).
@@ -140,7 +140,7 @@ fn try_count_below_constrained(
     c: &Constraints,
     sigma: f64,
 ) -> Option<usize> {
-    let nudge = 1e-10 * spectrum_scale(k, g);
+    let nudge = 1e-10 * diagonal_ratio(k, g);
     let mut s = sigma;
     for _ in 0..8 {
         if let Some(b) = Bordered::new(k, g, c, s) {
@@ -149,13 +149,6 @@ fn try_count_below_constrained(
         s += nudge;
     }
     None
-}
-
-/// max |K_ii/G_ii|: the scale of the spectrum.
-fn spectrum_scale(k: &SymmetricBanded, g: &SymmetricBanded) -> f64 {
-    (0..k.size())
-        .map(|i| (k.get(i, i) / g.get(i, i)).abs())
-        .fold(1e-12, f64::max)
 }
 
 /// The `count` lowest eigenpairs of (K, G) on null C; `previous` as in
@@ -174,7 +167,7 @@ pub fn lowest_eigenpairs_constrained(
     if k.size() <= DENSE_LIMIT {
         return dense_constrained(k, g, c, count);
     }
-    let sigma = shift_below(k, g, c);
+    let sigma = shift_below_constrained(k, g, c);
     let bordered = Bordered::new(k, g, c, sigma)
         .ok_or_else(|| EigenError::NotDefinite(format!("K − σG is singular at σ = {sigma}")))?;
     let s_inv = bordered
@@ -205,32 +198,12 @@ pub fn lowest_eigenpairs_constrained(
     }
 }
 
-/// A shift below the constrained spectrum by Sturm bisection on the
-/// constrained count, kept a relative 1e-8 away from λ_1.
-fn shift_below(k: &SymmetricBanded, g: &SymmetricBanded, c: &Constraints) -> f64 {
-    let scale = spectrum_scale(k, g);
-    // Undecidable counts err on the safe side: "some below".
-    let none_below = |s: f64| try_count_below_constrained(k, g, c, s) == Some(0);
-    let mut lo = -1e-6 * scale;
-    while !none_below(lo) && lo > -1e6 * scale {
-        lo *= 4.0;
-    }
-    let mut hi = 1e-6 * scale;
-    while none_below(hi) && hi < 1e6 * scale {
-        hi *= 4.0;
-    }
-    for _ in 0..60 {
-        let mid = 0.5 * (lo + hi);
-        if none_below(mid) {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-        if hi - lo <= (0.05 * (hi.abs() + lo.abs())).max(1e-8 * scale) {
-            break;
-        }
-    }
-    lo - (0.05 * (hi - lo)).max(1e-8 * scale)
+/// A shift below the constrained spectrum: [`shift_below`] on the
+/// constrained Sturm count.
+fn shift_below_constrained(k: &SymmetricBanded, g: &SymmetricBanded, c: &Constraints) -> f64 {
+    shift_below(diagonal_ratio(k, g), |s| {
+        try_count_below_constrained(k, g, c, s)
+    })
 }
 
 /// Backward error of K v − λ G v projected off the constraint normals, and

@@ -148,17 +148,22 @@ pub fn lowest_eigenpairs_near(
 /// A shift σ < λ_1 close to λ_1: Sturm counts double outwards to bracket
 /// λ_1, then bisect.
 /// max |K_ii/G_ii|: the scale of the spectrum.
-fn diagonal_ratio(k: &SymmetricBanded, g: &SymmetricBanded) -> f64 {
+pub(super) fn diagonal_ratio(k: &SymmetricBanded, g: &SymmetricBanded) -> f64 {
     (0..k.size())
         .map(|i| (k.get(i, i) / g.get(i, i)).abs())
         .fold(1e-12, f64::max)
 }
 
 fn shift_below_spectrum(k: &SymmetricBanded, g: &SymmetricBanded) -> f64 {
-    let scale = diagonal_ratio(k, g);
-    // An undecidable count (persistent zero pivots) counts as "below", so
-    // that the shift errs on the safe side, under the spectrum.
-    let none_below = |s: f64| try_count_below(k, g, s) == Some(0);
+    shift_below(diagonal_ratio(k, g), |s| try_count_below(k, g, s))
+}
+
+/// A shift σ < λ_1 close to λ_1, from Sturm counts `count(σ)` (None when
+/// undecidable, e.g. persistent zero pivots, which counts as "below" so
+/// that the shift errs on the safe side): counts double outwards to
+/// bracket λ_1, then bisect; `scale` is the spectrum's.
+pub(super) fn shift_below(scale: f64, count: impl Fn(f64) -> Option<usize>) -> f64 {
+    let none_below = |s: f64| count(s) == Some(0);
     let mut lo = -1e-6 * scale;
     while !none_below(lo) && lo > -1e6 * scale {
         lo *= 4.0;

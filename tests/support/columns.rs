@@ -8,7 +8,12 @@ use nalgebra::{Complex, DMatrix};
 /// Sec. 2.4), by bisection on sin x − x cos x in (π, 3π/2).
 pub fn clamped_pinned() -> f64 {
     let f = |x: f64| x.sin() - x * x.cos();
-    let (mut lo, mut hi) = (std::f64::consts::PI, 1.5 * std::f64::consts::PI - 1e-9);
+    let x = bisect(f, std::f64::consts::PI, 1.5 * std::f64::consts::PI - 1e-9);
+    x * x
+}
+
+/// The root of f in [lo, hi], where f changes sign, to round-off.
+fn bisect(f: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> f64 {
     for _ in 0..200 {
         let mid = 0.5 * (lo + hi);
         if f(lo) * f(mid) <= 0.0 {
@@ -17,8 +22,7 @@ pub fn clamped_pinned() -> f64 {
             lo = mid;
         }
     }
-    let x = 0.5 * (lo + hi);
-    x * x
+    0.5 * (lo + hi)
 }
 
 /// Greenhill's problem with clamped ends: a rod (bending stiffness B,
@@ -70,14 +74,5 @@ pub fn greenhill_clamped(m: f64, b: f64, l: f64) -> f64 {
         lo += step;
         assert!(lo < 100.0 * b / (l * l), "no root below 100 B/L²");
     }
-    let mut hi = lo + step;
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if f(lo) * f(mid) <= 0.0 {
-            hi = mid;
-        } else {
-            lo = mid;
-        }
-    }
-    0.5 * (lo + hi)
+    bisect(f, lo, lo + step)
 }
