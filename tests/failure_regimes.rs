@@ -307,3 +307,51 @@ fn interval_budget_too_small_is_an_error() {
     let message = assert_clear_failure(solve(&rod, &choice, &opts), "collocation");
     assert!(message.contains("within 32 intervals"), "{message}");
 }
+
+/// Continuation where single shooting fails: a long cantilever (L = 16,
+/// so k = F L²/B reaches 256 at F = 1) followed in its load. Single
+/// shooting cannot carry the branch to the end and says why (a stalled
+/// step or a failing start), never returning points off the branch; on 16
+/// segments of multiple shooting the same continuation reaches F = 1 with
+/// every point on the Bisshopp–Drucker elastica.
+#[test]
+fn continuation_recovers_on_multiple_shooting_for_a_long_rod() {
+    use cosserat::continuation::continuation;
+    use cosserat::io::Problem;
+    let text = |method: &str| {
+        format!(
+            "[rod]\nlength = 16.0\n[energy]\nstiffness = [10.0, 1.0, 10.0]\n\
+             [loads]\ntip_force = [1.0, 0.0, 0.0]\n[solver]\nmethod = \"{method}\"\n\
+             segments = 16\n[continuation]\nparameter = \"load_scale\"\nstart = 0.001\n\
+             bounds = [0.0, 1.0]\nstep = 0.01\nmax_step = 0.05\nelements = 32\n\
+             eigenvalues = 1\nswitch_depth = 0\n"
+        )
+    };
+    let single = Problem::from_str_with(&text("shooting"), &[]).unwrap();
+    let (family, opts) = single.continuation.clone().unwrap();
+    match continuation(&family, &opts, &mut |_, _| true) {
+        Err(e) => assert!(!e.to_string().is_empty()),
+        Ok(d) => {
+            let b = &d.branches[0];
+            let last = b.points.last().unwrap().parameter;
+            assert!(last < 1.0, "single shooting reached the end: {last}");
+            assert!(!b.stop_reason.contains("bound"), "{}", b.stop_reason);
+        }
+    }
+    let multiple = Problem::from_str_with(&text("multiple-shooting"), &[]).unwrap();
+    let (family, opts) = multiple.continuation.clone().unwrap();
+    let d = continuation(&family, &opts, &mut |_, _| true).unwrap();
+    let b = &d.branches[0];
+    assert!((b.points.last().unwrap().parameter - 1.0).abs() < 1e-12);
+    for p in &b.points {
+        let k = p.parameter * 256.0;
+        let exact = cantilever_tip(k);
+        let tip = p.tip.position / 16.0;
+        assert!(
+            (tip[0] - exact.x).abs() < 1e-7 && (tip[2] - exact.z).abs() < 1e-7,
+            "k = {k}: {tip:?} vs ({}, {})",
+            exact.x,
+            exact.z
+        );
+    }
+}

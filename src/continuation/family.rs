@@ -255,7 +255,35 @@ impl Family {
         Ok(std::sync::Arc::new(linear))
     }
 
-    /// F(x, p) and F_x, scaled as in [`ShootingSystem`].
+    /// The typical magnitudes of the shooting unknowns: 1 for the free
+    /// values at the clamp, the state scales (lengths L, curvatures 1/L,
+    /// reactions M_s/L, see [`crate::equations::RodEquations::state_scales`])
+    /// for the interior node states of multiple shooting. The family's
+    /// unknowns x are the shooting unknowns divided by these, so that the
+    /// arclength of continuation is not dominated by node positions of long
+    /// rods.
+    fn weights(&self) -> Vec<f64> {
+        let eq = equations(&self.base, self.level);
+        let mut w = vec![1.0; eq.unknowns()];
+        let scales = eq.state_scales();
+        for _ in 1..self.segments {
+            w.extend_from_slice(&scales);
+        }
+        w
+    }
+
+    /// The family's unknowns of raw shooting unknowns.
+    pub fn scaled(&self, raw: &[f64]) -> Vec<f64> {
+        raw.iter().zip(self.weights()).map(|(v, w)| v / w).collect()
+    }
+
+    /// The raw shooting unknowns of the family's unknowns.
+    pub fn unscaled(&self, x: &[f64]) -> Vec<f64> {
+        x.iter().zip(self.weights()).map(|(v, w)| v * w).collect()
+    }
+
+    /// F(x, p) and F_x (with respect to the family's scaled unknowns), the
+    /// residual scaled as in [`ShootingSystem`].
     pub fn residual(
         &self,
         x: &[f64],
@@ -266,7 +294,10 @@ impl Family {
         let rod = self.rod_at(p)?;
         let eq = equations(&rod, self.level);
         let mut sys = ShootingSystem::new(eq.as_ref(), self.segments, self.tolerances);
-        sys.evaluate(x, r, jac)?;
+        sys.evaluate(&self.unscaled(x), r, jac)?;
+        for (mut column, w) in jac.column_iter_mut().zip(self.weights()) {
+            column *= w;
+        }
         Ok(())
     }
 
@@ -285,7 +316,7 @@ impl Family {
         let rod = self.rod_at(p)?;
         let eq = equations(&rod, self.level);
         let mut sys = ShootingSystem::new(eq.as_ref(), self.segments, self.tolerances);
-        sys.residual(x, r)?;
+        sys.residual(&self.unscaled(x), r)?;
         Ok(())
     }
 
@@ -302,7 +333,7 @@ impl Family {
         let eq = equations(&rod, self.level);
         let u = eq.initial_guess();
         let mut sys = ShootingSystem::new(eq.as_ref(), self.segments, self.tolerances);
-        Ok(sys.initial_unknowns(&u))
+        Ok(self.scaled(&sys.initial_unknowns(&u)))
     }
 
     /// The solution at sorted points.
@@ -310,7 +341,7 @@ impl Family {
         let rod = self.rod_at(p)?;
         let eq = equations(&rod, self.level);
         let mut sys = ShootingSystem::new(eq.as_ref(), self.segments, self.tolerances);
-        Ok(sys.sample(x, points)?.0)
+        Ok(sys.sample(&self.unscaled(x), points)?.0)
     }
 
     /// The tip sample (position, directors) at (x, p).

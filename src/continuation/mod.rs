@@ -344,9 +344,10 @@ impl<'a> Run<'a> {
             strategy: Strategy::Auto,
             ..Default::default()
         };
-        let x = solve(&rod, &model, &solver)
+        let raw = solve(&rod, &model, &solver)
             .map_err(|e| start_err(e.to_string()))?
             .unknowns;
+        let x = self.family.scaled(&raw);
         let x = self
             .newton_at_fixed_p(x, p)
             .map_err(|e| start_err(e.to_string()))?;
