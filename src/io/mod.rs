@@ -7,6 +7,8 @@ mod continuation_section;
 mod diagram;
 mod hdf5_output;
 mod problem;
+mod sweep_output;
+mod sweep_section;
 
 pub use arm_output::write_arm;
 pub use arm_section::ArmSection;
@@ -16,3 +18,5 @@ pub use hdf5_output::{
     check_target, write_equilibrium, write_stability, OutputError, StabilityResult,
 };
 pub use problem::{Problem, ProblemError, ProblemFile, ProfileSpec};
+pub use sweep_output::{read_sweep, write_sweep, SweepHeader};
+pub use sweep_section::{AxisSpec, Sweep, SweepAxis, SweepSection, MAX_POINTS};

@@ -15,6 +15,7 @@ use serde::{Deserialize, Deserializer, Serialize};
 
 use super::arm_section::ArmSection;
 use super::continuation_section::ContinuationSection;
+use super::sweep_section::{Sweep, SweepSection};
 use crate::bvp::integrator::Tolerances;
 use crate::bvp::newton::NewtonOptions;
 use crate::bvp::{Method, SolverOptions, Strategy};
@@ -83,6 +84,9 @@ pub struct ProblemFile {
     /// The longest-arm optimization, for `cosserat optimize`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub arm: Option<ArmSection>,
+    /// A grid over keys of this file, for `cosserat sweep`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sweep: Option<SweepSection>,
 }
 
 /// `[shape]`.
@@ -372,6 +376,8 @@ pub struct Problem {
     pub continuation: Option<(Family, ContinuationOptions)>,
     /// The arm optimization, its search, and whether to compute R̂0.
     pub arm: Option<(ArmProblem, SearchOptions, bool)>,
+    /// The grid of a `[sweep]` table.
+    pub sweep: Option<Sweep>,
 }
 
 impl Problem {
@@ -396,6 +402,7 @@ impl Problem {
         let stability = build_stability(&file.stability)?;
         let continuation = build_continuation(&file, &rod, &model, &options, shape.as_ref())?;
         let arm = file.arm.as_ref().map(|a| a.build(&rod)).transpose()?;
+        let sweep = file.sweep.as_ref().map(SweepSection::build).transpose()?;
         Ok(Problem {
             rod,
             model,
@@ -405,6 +412,7 @@ impl Problem {
             stability,
             continuation,
             arm,
+            sweep,
         })
     }
 }
@@ -442,9 +450,33 @@ fn apply_overrides(text: &str, overrides: &[String]) -> Result<String, ProblemEr
                 .as_table_mut()
                 .ok_or_else(|| fail(&format!("`{part}` is not a table")))?;
         }
-        table.insert(last.to_string(), value);
+        match indexed(last) {
+            Some((name, i)) => {
+                let list = table
+                    .get_mut(name)
+                    .and_then(toml::Value::as_array_mut)
+                    .ok_or_else(|| fail(&format!("`{name}` is not an array")))?;
+                let len = list.len();
+                *list
+                    .get_mut(i)
+                    .ok_or_else(|| fail(&format!("`{name}` has {len} elements, no [{i}]")))? =
+                    value;
+            }
+            None => {
+                table.insert(last.to_string(), value);
+            }
+        }
     }
     toml::to_string(&doc).map_err(|e| ProblemError::Parse(e.to_string()))
+}
+
+/// `name[i]` → (name, i): one element of an array, as in
+/// `--set energy.stiffness[0]=4` (what `[sweep]` axes and continuation
+/// parameters are named).
+fn indexed(part: &str) -> Option<(&str, usize)> {
+    let (name, rest) = part.split_once('[')?;
+    let i = rest.strip_suffix(']')?.trim().parse().ok()?;
+    Some((name.trim(), i))
 }
 
 fn parse_value(raw: &str) -> toml::Value {

@@ -23,6 +23,8 @@ use nalgebra::Vector3;
 use crate::model::{Clamp, DeadLoads, LinearElastic, Profile, Rod};
 use crate::stability::{critical_load, FixedShape, StabilityOptions};
 
+mod warm_start;
+
 /// The arm to design.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ArmProblem {
