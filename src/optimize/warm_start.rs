@@ -32,6 +32,10 @@ impl ArmProblem {
         iterations: u64,
         step: f64,
     ) -> (Option<ArmDesign>, usize) {
+        if start.is_empty() {
+            // M = 1: nothing to polish, the shape is fixed by α.
+            return (self.design(&[]), 1);
+        }
         let start = self.project(start);
         let simplex: Vec<Vec<f64>> = std::iter::once(start.clone())
             .chain((0..start.len()).map(|d| {

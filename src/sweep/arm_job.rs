@@ -84,9 +84,6 @@ impl ArmJob {
             evaluations += used;
             polished.extend(d);
         }
-        if arm.bounds.is_empty() {
-            polished.extend(arm.design(&[]));
-        }
         polished.sort_by(|a, b| b.reach.total_cmp(&a.reach));
         let best = polished.first().cloned();
         let second = best.as_ref().and_then(|b| {

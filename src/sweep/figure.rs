@@ -33,6 +33,10 @@ pub fn reach_fit(header: &SweepHeader, records: &[Record], family: usize) -> Opt
     let [x, y] = &header.axes[..] else {
         return None;
     };
+    // Only stiffness-like axes: positive values, not the direction α.
+    if header.keys.iter().any(|k| k == ALPHA) || x.iter().chain(y).any(|v| *v <= 0.0) {
+        return None;
+    }
     let z = grid_values(header, records, &format!("family_{family}/reach"));
     let field = GridField { x, y, z: &z };
     fit_power_law(&field, &field.levels(8))
@@ -79,6 +83,9 @@ fn map_chart(
         .map(|(f, z)| MapPanel {
             title: match (f, &fit) {
                 (0, Some(fit)) => format!("R*, family 0 (dashed: (61), ι = {:.3})", fit.iota),
+                _ if z.iter().all(|v| v.is_nan()) => {
+                    format!("R*, family {f}: no distinct optimum found")
+                }
                 _ => format!("R*, family {f}"),
             },
             field: GridField {
