@@ -72,8 +72,11 @@ fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
+/// A record as bit patterns: index, numeric columns, labels.
+type Bits = (usize, Vec<(String, Vec<u64>)>, Vec<(String, String)>);
+
 /// Records as bit patterns, so that NaN = NaN and −0 ≠ 0.
-fn bits(records: &[Record]) -> Vec<(usize, Vec<(String, Vec<u64>)>, Vec<(String, String)>)> {
+fn bits(records: &[Record]) -> Vec<Bits> {
     records
         .iter()
         .map(|r| {
