@@ -293,18 +293,20 @@ fn summarize(header: &SweepHeader, records: &[Record]) {
     }
     if let Some(fit) = figure::reach_fit(header, records, 0) {
         println!(
-            "fit (61)  {} = Ω {}^(−ι): ι = {:.4} (rms of ln: {:.3}; {} contours, Ω = {})",
+            "fit (61)  {} = Ω {}^(−ι) on {} contours of R*: common ι = {:.4} (rms of ln {}: {:.3})",
             header.keys[1],
             header.keys[0],
-            fit.iota,
-            fit.rms,
             fit.contours.len(),
-            fit.contours
-                .iter()
-                .map(|(l, o, _)| format!("{o:.3} at R* = {l:.3}"))
-                .collect::<Vec<_>>()
-                .join(", ")
+            fit.iota,
+            header.keys[1],
+            fit.rms
         );
+        for c in &fit.contours {
+            println!(
+                "          R* = {:.3}: Ω = {:.3} (common ι); this contour alone ι = {:.3} ({} points)",
+                c.level, c.omega, c.iota, c.points
+            );
+        }
     }
 }
 

@@ -360,3 +360,71 @@ fn bad_sweeps_are_rejected_before_any_work() {
     }
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// The shipped Fig. 6 problem on a 3 × 3 grid (the CI-sized run): every
+/// point has an optimum, and R* grows with B̄1 and with B̄3 (paper Sec. 4.2:
+/// "the outreach is an increasing function of B̄1 and B̄3").
+#[test]
+fn fig6_problem_on_a_small_grid() {
+    let dir = scratch("fig6");
+    let problem = format!(
+        "{}/problems/longest_arm_fig6.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let out = dir.join("fig6.h5");
+    let chart = dir.join("fig6.svg");
+    let axes = "sweep.axes=[{key=\"energy.stiffness[0]\",linspace=[0.25,7,3]},\
+                {key=\"energy.stiffness[2]\",linspace=[0.1666666666666667,4.666666666666667,3]}]";
+    let o = run(&mut sweep(
+        Path::new(&problem),
+        &out,
+        &["--set", axes, "--plot", chart.to_str().unwrap()],
+    ));
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(chart.exists());
+    let (header, records) = read_sweep(&out).unwrap();
+    assert_eq!(header.points(), 9);
+    let reach: Vec<f64> = records
+        .iter()
+        .map(|r| r.number("family_0/reach").unwrap())
+        .collect();
+    for i in 0..3 {
+        for j in 0..2 {
+            assert!(
+                reach[i * 3 + j + 1] > reach[i * 3 + j],
+                "B̄3 row {i}: {reach:?}"
+            );
+            assert!(
+                reach[(j + 1) * 3 + i] > reach[j * 3 + i],
+                "B̄1 column {i}: {reach:?}"
+            );
+        }
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// The shipped Fig. 7 problem straight up (α = 90°): the optimized arm
+/// reaches Euler's column height Rb = π/2 (paper eq. (2) and Sec. 4.3: in
+/// the plane, intrinsic curvature cannot raise it), and intrinsic curvature
+/// lets the level arm (α = 0) reach farther than the straight one.
+#[test]
+fn fig7_problem_reaches_euler_height_upwards() {
+    let dir = scratch("fig7");
+    let problem = format!(
+        "{}/problems/longest_arm_fig7.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let out = dir.join("fig7.h5");
+    let axes = "sweep.axes=[{key=\"energy.stiffness[0]\",values=[1.0]},\
+                {key=\"arm.alpha\",values=[90,0]}]";
+    let o = run(&mut sweep(Path::new(&problem), &out, &["--set", axes]));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (_, records) = read_sweep(&out).unwrap();
+    let up = records[0].number("family_0/reach").unwrap();
+    let rb = std::f64::consts::FRAC_PI_2;
+    assert!((up - rb).abs() < 1e-3 * rb, "R*(90°) = {up}");
+    let level = records[1].number("family_0/reach").unwrap();
+    let straight = records[1].number("straight/reach").unwrap();
+    assert!(level > straight, "R* = {level}, R0 = {straight}");
+    std::fs::remove_dir_all(dir).unwrap();
+}

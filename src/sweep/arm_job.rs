@@ -6,9 +6,10 @@
 //! the best `starts` samples — plus, with two families, `starts` more
 //! polishes from samples spread evenly over the ranking, so that a basin
 //! other than the best one is entered. Family 0 is the best polished
-//! design; family 1 the best one whose loaded shape differs from it
-//! (paper Sec. 4.2: "two local optimum values of C for each value of
-//! B̄1 and B̄3").
+//! design; family 1 the best one that is a distinct local optimum
+//! ([`distinct_optima`]: another loaded shape, and a valley in between;
+//! paper Sec. 4.2: "two local optimum values of C for each value of B̄1
+//! and B̄3").
 //!
 //! Warm (the next points of the line): each family is polished from its
 //! predecessor's optimum with a small simplex (1 % of the bounds), and
@@ -55,6 +56,24 @@ pub fn shape_distance(a: &[f64], b: &[f64]) -> f64 {
     (sum / n as f64).sqrt()
 }
 
+/// Two designs are one local optimum unless their loaded shapes differ
+/// (by more than [`SAME_SHAPE`]) *and* a valley separates them: the reach
+/// dips below the lower of the two (by more than 0.1 %) somewhere on the
+/// straight path between their coefficients. The reach is flat along a
+/// ridge of different shapes, so a shape difference alone would count
+/// unfinished polishes on the ridge as optima of their own.
+pub fn distinct_optima(arm: &ArmProblem, a: &ArmDesign, b: &ArmDesign) -> bool {
+    if shape_distance(&a.shape_coefficients, &b.shape_coefficients) <= SAME_SHAPE {
+        return false;
+    }
+    let (ca, cb) = (&a.shape_coefficients[1..], &b.shape_coefficients[1..]);
+    let floor = a.reach.min(b.reach) * (1.0 - 1e-3);
+    [0.25, 0.5, 0.75].iter().any(|t| {
+        let p: Vec<f64> = ca.iter().zip(cb).map(|(x, y)| x + t * (y - x)).collect();
+        arm.design(&p).map_or(true, |d| d.reach < floor)
+    })
+}
+
 /// A family's outcome at a point.
 struct Found {
     design: Option<ArmDesign>,
@@ -89,7 +108,7 @@ impl ArmJob {
         let second = best.as_ref().and_then(|b| {
             polished
                 .iter()
-                .find(|d| shape_distance(&d.shape_coefficients, &b.shape_coefficients) > SAME_SHAPE)
+                .find(|d| distinct_optima(arm, d, b))
                 .cloned()
         });
         let found = |design: Option<ArmDesign>, missing: &'static str| Found {
@@ -191,7 +210,7 @@ impl Job for ArmJob {
         };
         if let [first, second] = &mut found[..] {
             if let (Some(a), Some(b)) = (&first.design, &second.design) {
-                if shape_distance(&a.shape_coefficients, &b.shape_coefficients) <= SAME_SHAPE {
+                if !distinct_optima(arm, a, b) {
                     second.status = "merged";
                 }
             }

@@ -159,7 +159,7 @@ where
         }
     }
     if let Some(fit) = panel.fit {
-        for (_, omega, _) in &fit.contours {
+        for omega in fit.contours.iter().map(|c| c.omega) {
             let pts: Vec<(f64, f64)> = (0..=100)
                 .map(|k| x0 + (x1 - x0) * k as f64 / 100.0)
                 .map(|x| (x, omega * x.powf(-fit.iota)))

@@ -78,10 +78,34 @@ impl GridField<'_> {
 pub struct PowerFit {
     /// ι, the common exponent.
     pub iota: f64,
-    /// (level, Ω, points) of each contour used.
-    pub contours: Vec<(f64, f64, usize)>,
+    /// Each contour used: its level, Ω (with the common ι), the number of
+    /// points, and the contour's own exponent (its separate slope).
+    pub contours: Vec<ContourFit>,
     /// Root-mean-square residual of ln B̄3.
     pub rms: f64,
+}
+
+/// One contour of a [`PowerFit`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContourFit {
+    /// The value on the contour.
+    pub level: f64,
+    /// Ω with the common exponent.
+    pub omega: f64,
+    /// Contour points used.
+    pub points: usize,
+    /// The exponent of this contour alone.
+    pub iota: f64,
+}
+
+/// Least-squares slope of v on u, and the means.
+fn slope(p: &[(f64, f64)]) -> (f64, f64, f64) {
+    let n = p.len() as f64;
+    let mx = p.iter().map(|q| q.0).sum::<f64>() / n;
+    let my = p.iter().map(|q| q.1).sum::<f64>() / n;
+    let sxy: f64 = p.iter().map(|(u, v)| (u - mx) * (v - my)).sum();
+    let sxx: f64 = p.iter().map(|(u, _)| (u - mx).powi(2)).sum();
+    (sxy / sxx, mx, my)
 }
 
 /// Fits ln y = ln Ω_l − ι ln x by least squares with a common slope over
@@ -130,7 +154,12 @@ pub fn fit_power_law(field: &GridField, levels: &[f64]) -> Option<PowerFit> {
                 sse += (v - (ln_omega - iota * u)).powi(2);
                 count += 1;
             }
-            (*l, ln_omega.exp(), p.len())
+            ContourFit {
+                level: *l,
+                omega: ln_omega.exp(),
+                points: p.len(),
+                iota: -slope(p).0,
+            }
         })
         .collect();
     Some(PowerFit {

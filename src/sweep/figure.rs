@@ -27,6 +27,18 @@ pub fn grid_values(header: &SweepHeader, records: &[Record], column: &str) -> Ve
     z
 }
 
+/// R* of family `f` on the whole grid, NaN where the family has no
+/// optimum of its own (not found, or merged into family 0).
+pub fn family_map(header: &SweepHeader, records: &[Record], f: usize) -> Vec<f64> {
+    let status = format!("family_{f}/status");
+    let own: Vec<Record> = records
+        .iter()
+        .filter(|r| r.labels.get(&status).is_some_and(|s| s == "optimum"))
+        .cloned()
+        .collect();
+    grid_values(header, &own, &format!("family_{f}/reach"))
+}
+
 /// The fit of B̄3 = Ω B̄1^(−ι) to 8 contours of `family`'s R* on a sweep
 /// over two axes (None otherwise).
 pub fn reach_fit(header: &SweepHeader, records: &[Record], family: usize) -> Option<PowerFit> {
@@ -37,7 +49,7 @@ pub fn reach_fit(header: &SweepHeader, records: &[Record], family: usize) -> Opt
     if header.keys.iter().any(|k| k == ALPHA) || x.iter().chain(y).any(|v| *v <= 0.0) {
         return None;
     }
-    let z = grid_values(header, records, &format!("family_{family}/reach"));
+    let z = family_map(header, records, family);
     let field = GridField { x, y, z: &z };
     fit_power_law(&field, &field.levels(8))
 }
@@ -74,7 +86,7 @@ fn map_chart(
         .collect();
     let maps: Vec<Vec<f64>> = families
         .iter()
-        .map(|f| grid_values(header, records, &format!("family_{f}/reach")))
+        .map(|f| family_map(header, records, *f))
         .collect();
     let fit = reach_fit(header, records, 0);
     let panels: Vec<MapPanel> = families

@@ -23,7 +23,7 @@ pub mod figure;
 mod schedule;
 mod solve_job;
 
-pub use arm_job::{shape_distance, ArmJob};
+pub use arm_job::{distinct_optima, shape_distance, ArmJob};
 pub use schedule::{run, Shard, SweepPlan};
 pub use solve_job::SolveJob;
 
