@@ -70,7 +70,7 @@ pub fn distinct_optima(arm: &ArmProblem, a: &ArmDesign, b: &ArmDesign) -> bool {
     let floor = a.reach.min(b.reach) * (1.0 - 1e-3);
     [0.25, 0.5, 0.75].iter().any(|t| {
         let p: Vec<f64> = ca.iter().zip(cb).map(|(x, y)| x + t * (y - x)).collect();
-        arm.design(&p).map_or(true, |d| d.reach < floor)
+        arm.design(&p).is_none_or(|d| d.reach < floor)
     })
 }
 
