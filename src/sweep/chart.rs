@@ -176,21 +176,25 @@ pub type Envelope = (String, Vec<(f64, f64)>);
 
 /// Reach envelopes, one panel per entry of `panels` (title, curves).
 pub fn envelopes(out: &Path, panels: &[(String, Vec<Envelope>)]) -> Chart {
-    let extent = panels
-        .iter()
-        .flat_map(|p| p.1.iter().flat_map(|c| c.1.iter()))
-        .fold(2.2f64, |m, (z, h)| m.max(z.abs()).max(h.abs()))
-        * 1.05;
-    let svg = |a: &DrawingArea<SVGBackend, Shift>, k: usize| envelope_panel(a, &panels[k], extent);
+    let points = || {
+        panels
+            .iter()
+            .flat_map(|p| p.1.iter().flat_map(|c| c.1.iter()))
+    };
+    let z_max = points().fold(2.2f64, |m, (z, _)| m.max(z.abs())) * 1.05;
+    let low = points().fold(0.0f64, |m, (_, h)| m.min(*h)) * 1.05;
+    let high = points().fold(2.5f64, |m, (_, h)| m.max(*h)) * 1.05;
+    let frame = (z_max, low, high);
+    let svg = |a: &DrawingArea<SVGBackend, Shift>, k: usize| envelope_panel(a, &panels[k], frame);
     let png =
-        |a: &DrawingArea<BitMapBackend, Shift>, k: usize| envelope_panel(a, &panels[k], extent);
+        |a: &DrawingArea<BitMapBackend, Shift>, k: usize| envelope_panel(a, &panels[k], frame);
     draw_panels(out, panels.len(), &svg, &png)
 }
 
 fn envelope_panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     (title, curves): &(String, Vec<Envelope>),
-    extent: f64,
+    (extent, low, high): (f64, f64, f64),
 ) -> Chart
 where
     DB::ErrorType: 'static,
@@ -200,7 +204,7 @@ where
         .margin(12)
         .x_label_area_size(40)
         .y_label_area_size(50)
-        .build_cartesian_2d(0.0..extent, -extent * 0.6..extent * 0.8)?;
+        .build_cartesian_2d(0.0..extent, low..high)?;
     chart
         .configure_mesh()
         .x_desc("ẑ = z √(F/B2)")
@@ -219,7 +223,7 @@ where
         .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], grey));
     chart
         .draw_series(DashedLineSeries::new(
-            vec![(2.0, -extent), (2.0, extent)],
+            vec![(2.0, low), (2.0, high)],
             2,
             4,
             grey.stroke_width(1),
@@ -240,6 +244,7 @@ where
     }
     chart
         .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
         .label_font(("sans-serif", 14))
