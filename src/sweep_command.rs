@@ -54,10 +54,12 @@ pub fn run_sweep(args: SweepArgs) -> ExitCode {
 fn prepare(args: &SweepArgs) -> Result<Option<Setup>, ExitCode> {
     let at = |e: &dyn std::fmt::Display| fail(2, format!("{}: {e}", args.path.display()));
     let problem = Problem::from_path(&args.path, &args.set).map_err(|e| at(&e))?;
-    let sweep = problem
+    let mut sweep = problem
         .sweep
         .clone()
         .ok_or_else(|| at(&"sweep: the problem has no [sweep] table"))?;
+    // Warm starts are for the arm's search; solves run point by point.
+    sweep.warm_start &= problem.arm.is_some();
     let shard = match &args.shard {
         Some(s) => Shard::parse(s).map_err(|e| fail(2, e))?,
         None => Shard::ALL,
