@@ -428,3 +428,34 @@ fn fig7_problem_reaches_euler_height_upwards() {
     assert!(level > straight, "R* = {level}, R0 = {straight}");
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// A solve sweep over the tip load of the shipped cantilever: every tip
+/// on the Bisshopp–Drucker elastica (elliptic integrals).
+#[test]
+fn solve_sweep_follows_the_elastica() {
+    let dir = scratch("solve");
+    let problem = dir.join("p.toml");
+    let base = include_str!("../problems/cantilever_tip_load.toml");
+    let text = format!(
+        "{base}\n[sweep]\naxes = [{{ key = \"loads.tip_force[0]\", values = [0.5, 1, 2, 3] }}]\n"
+    );
+    std::fs::write(&problem, text).unwrap();
+    let out = dir.join("s.h5");
+    let o = run(&mut sweep(&problem, &out, &[]));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (header, records) = read_sweep(&out).unwrap();
+    assert_eq!(header.kind, "solve");
+    for r in &records {
+        let k = header.axes[0][r.index];
+        let exact = support::references::cantilever_tip(k);
+        let tip = &r.numbers["solve/tip_position"];
+        assert_eq!(r.labels["solve/status"], "converged");
+        assert!(
+            (tip[0] - exact.x).abs() < 1e-8 && (tip[2] - exact.z).abs() < 1e-8,
+            "k = {k}: {tip:?} vs ({}, {})",
+            exact.x,
+            exact.z
+        );
+    }
+    std::fs::remove_dir_all(dir).unwrap();
+}
