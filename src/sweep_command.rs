@@ -166,42 +166,47 @@ fn progress_bar(total: usize, done: usize) -> ProgressBar {
     bar
 }
 
+/// Prints what is about to run.
+fn announce(args: &SweepArgs, setup: &Setup, members: usize) {
+    println!("problem   {}", args.path.display());
+    let axes: Vec<String> = setup
+        .sweep
+        .axes
+        .iter()
+        .map(|a| format!("{} × {}", a.key, a.values.len()))
+        .collect();
+    println!(
+        "sweep     {} ({} points), shard {}: {members} points, {} done; job {}",
+        axes.join(", "),
+        setup.sweep.points(),
+        setup.shard,
+        setup.done.len(),
+        setup.job.kind()
+    );
+}
+
+/// Sets a flag on Ctrl-C.
+fn interrupt_flag() -> Arc<AtomicBool> {
+    let interrupted = Arc::new(AtomicBool::new(false));
+    let flag = interrupted.clone();
+    let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
+    interrupted
+}
+
 /// Runs the points, checkpointing every second; writes the final file.
 fn execute(args: &SweepArgs, setup: Setup) -> ExitCode {
-    let Setup {
-        problem,
-        sweep,
-        shard,
-        done,
-        job,
-    } = setup;
     let plan = SweepPlan {
-        text: &problem.text,
-        sweep: &sweep,
-        shard,
+        text: &setup.problem.text,
+        sweep: &setup.sweep,
+        shard: setup.shard,
     };
     let members = plan.members().len();
-    println!("problem   {}", args.path.display());
-    println!(
-        "sweep     {} ({} points), shard {shard}: {members} points, {} done; job {}",
-        sweep
-            .axes
-            .iter()
-            .map(|a| format!("{} × {}", a.key, a.values.len()))
-            .collect::<Vec<_>>()
-            .join(", "),
-        sweep.points(),
-        done.len(),
-        job.kind()
-    );
-    let interrupted = Arc::new(AtomicBool::new(false));
-    {
-        let flag = interrupted.clone();
-        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
-    }
-    let before = done.len();
+    announce(args, &setup, members);
+    let interrupted = interrupt_flag();
+    let before = setup.done.len();
     let bar = progress_bar(members, before);
-    let running = header(&problem, &sweep, shard, job.kind(), "running");
+    let kind = setup.job.kind();
+    let running = header(&setup.problem, &setup.sweep, setup.shard, kind, "running");
     let last_save = Mutex::new(Instant::now());
     let on_point = |all: &[Record]| {
         bar.set_position(all.len() as u64);
@@ -217,39 +222,54 @@ fn execute(args: &SweepArgs, setup: Setup) -> ExitCode {
     };
     let start = Instant::now();
     let threads = args.threads.unwrap_or(0);
-    let records = match run(&plan, job.as_ref(), threads, done, &interrupted, &on_point) {
+    let done = setup.done.clone();
+    let records = match run(
+        &plan,
+        setup.job.as_ref(),
+        threads,
+        done,
+        &interrupted,
+        &on_point,
+    ) {
         Ok(r) => r,
         Err(e) => return fail(1, format!("thread pool: {e}")),
     };
     bar.finish_and_clear();
     let elapsed = start.elapsed().as_secs_f64();
-    let stopped = interrupted.load(Ordering::SeqCst) && records.len() < members;
-    let reason = if stopped { "interrupted" } else { "completed" };
-    let final_header = SweepHeader {
-        stop_reason: reason.into(),
-        ..running
-    };
-    if let Err(e) = write_sweep(&args.output, &final_header, &records, true) {
-        return fail(1, e);
-    }
     let computed = records.len() - before;
     println!(
         "time      {elapsed:.1} s for {computed} points ({:.3} s per point, {} threads)",
         elapsed / computed.max(1) as f64,
         rayon_threads(threads)
     );
-    summarize(&final_header, &records);
+    let stopped = interrupted.load(Ordering::SeqCst) && records.len() < members;
+    finish(args, running, &records, stopped)
+}
+
+/// Writes the final file (marked completed or interrupted), reports, and
+/// draws the chart of a completed sweep.
+fn finish(args: &SweepArgs, running: SweepHeader, records: &[Record], stopped: bool) -> ExitCode {
+    let reason = if stopped { "interrupted" } else { "completed" };
+    let header = SweepHeader {
+        stop_reason: reason.into(),
+        ..running
+    };
+    if let Err(e) = write_sweep(&args.output, &header, records, true) {
+        return fail(1, e);
+    }
+    summarize(&header, records);
     println!("written   {}", args.output.display());
     if stopped {
         eprintln!(
-            "interrupted: {} of {members} points are in {}; rerun with --resume",
+            "interrupted: {} of {} points are in {}; rerun with --resume",
             records.len(),
+            header.members,
             args.output.display()
         );
         return ExitCode::from(130);
     }
     match &args.plot {
-        Some(out) => plot(out, &final_header, &records),
+        Some(out) => plot(out, &header, records),
         None => ExitCode::SUCCESS,
     }
 }

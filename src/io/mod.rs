@@ -19,4 +19,4 @@ pub use hdf5_output::{
 };
 pub use problem::{Problem, ProblemError, ProblemFile, ProfileSpec};
 pub use sweep_output::{read_sweep, write_sweep, SweepHeader};
-pub use sweep_section::{AxisSpec, Sweep, SweepAxis, SweepSection, MAX_POINTS};
+pub use sweep_section::{grid_index, AxisSpec, Sweep, SweepAxis, SweepSection, MAX_POINTS};

@@ -24,6 +24,7 @@ use std::path::Path;
 use hdf5::types::VarLenUnicode;
 
 use super::hdf5_output::{array, string_attr, text, write_atomically, OutputError};
+use super::sweep_section::grid_index;
 use crate::sweep::Record;
 
 /// What a sweep file says about itself.
@@ -118,14 +119,14 @@ fn write_grid(file: &hdf5::File, header: &SweepHeader) -> hdf5::Result<()> {
         .write_raw(&shape)
 }
 
-/// The multi-index of flat index `i` on the grid of `axes`.
-fn parameters(axes: &[Vec<f64>], mut i: usize) -> Vec<f64> {
-    let mut out = vec![0.0; axes.len()];
-    for (k, a) in axes.iter().enumerate().rev() {
-        out[k] = a[i % a.len()];
-        i /= a.len();
-    }
-    out
+/// The axis values at flat index `i` on the grid of `axes`.
+fn parameters(axes: &[Vec<f64>], i: usize) -> Vec<f64> {
+    let shape: Vec<usize> = axes.iter().map(Vec::len).collect();
+    grid_index(&shape, i)
+        .iter()
+        .zip(axes)
+        .map(|(j, a)| a[*j])
+        .collect()
 }
 
 fn write_points(file: &hdf5::File, header: &SweepHeader, records: &[Record]) -> hdf5::Result<()> {

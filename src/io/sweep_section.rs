@@ -223,13 +223,8 @@ impl Sweep {
     }
 
     /// The multi-index of flat point `i` (row-major, last axis fastest).
-    pub fn multi_index(&self, mut i: usize) -> Vec<usize> {
-        let mut out = vec![0; self.axes.len()];
-        for (k, a) in self.axes.iter().enumerate().rev() {
-            out[k] = i % a.values.len();
-            i /= a.values.len();
-        }
-        out
+    pub fn multi_index(&self, i: usize) -> Vec<usize> {
+        grid_index(&self.shape(), i)
     }
 
     /// The axis values at flat point `i`.
@@ -260,4 +255,15 @@ fn toml_number(v: f64) -> String {
     } else {
         format!("{v:?}")
     }
+}
+
+/// The multi-index of flat point `i` on a grid of `shape` (row-major, the
+/// last axis fastest) — the order of every sweep file.
+pub fn grid_index(shape: &[usize], mut i: usize) -> Vec<usize> {
+    let mut out = vec![0; shape.len()];
+    for (k, n) in shape.iter().enumerate().rev() {
+        out[k] = i % n;
+        i /= n;
+    }
+    out
 }

@@ -139,13 +139,9 @@ fn curves(header: &SweepHeader, records: &[Record], a: usize, column: &str) -> V
     out.into_iter().map(|(_, e)| e).collect()
 }
 
-fn multi_index(axes: &[Vec<f64>], mut i: usize) -> Vec<usize> {
-    let mut out = vec![0; axes.len()];
-    for (k, a) in axes.iter().enumerate().rev() {
-        out[k] = i % a.len();
-        i /= a.len();
-    }
-    out
+fn multi_index(axes: &[Vec<f64>], i: usize) -> Vec<usize> {
+    let shape: Vec<usize> = axes.iter().map(Vec::len).collect();
+    crate::io::grid_index(&shape, i)
 }
 
 fn envelope_chart(
