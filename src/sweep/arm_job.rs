@@ -14,7 +14,8 @@
 //! Warm (the next points of the line): each family is polished from its
 //! predecessor's optimum with a small simplex (1 % of the bounds), and
 //! family 0 also from `warm_samples` Halton samples; family 1 is marked
-//! `merged` when its polish lands on family 0's shape.
+//! `merged` when its polish lands on family 0's shape. Family 0 is the
+//! better of the two at each point (they swap labels where they cross).
 
 use super::{Job, Record};
 use crate::io::Problem;
@@ -212,6 +213,11 @@ impl Job for ArmJob {
             if let (Some(a), Some(b)) = (&first.design, &second.design) {
                 if !distinct_optima(arm, a, b) {
                     second.status = "merged";
+                } else if b.reach > a.reach {
+                    // Family 0 is the better optimum at every point (the
+                    // paper's panel a, "the global optimum"); the two
+                    // continued optima swap labels where they cross.
+                    std::mem::swap(first, second);
                 }
             }
         }
