@@ -109,6 +109,48 @@ pub enum Command {
         #[arg(long)]
         force: bool,
     },
+    /// Run the problem's analysis at every point of its [sweep] grid, in
+    /// parallel, resumable and shardable (one HDF5 file per shard).
+    Sweep {
+        /// The problem file (TOML) with a [sweep] table.
+        problem: PathBuf,
+        /// The HDF5 results (also the checkpoint of a running sweep).
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Compute shard i of n (0 ≤ i < n): every n-th line of the grid.
+        #[arg(long, value_name = "I/N")]
+        shard: Option<String>,
+        /// Worker threads (default: all cores).
+        #[arg(long)]
+        threads: Option<usize>,
+        /// Go on with an interrupted or killed sweep saved in the output file.
+        #[arg(long)]
+        resume: bool,
+        /// Also draw the sweep (.png or .svg): contour maps or reach envelopes.
+        #[arg(long)]
+        plot: Option<PathBuf>,
+        /// Override any key of the problem file.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// Overwrite an existing output file.
+        #[arg(long)]
+        force: bool,
+    },
+    /// Join the shard files of one sweep into one file.
+    Merge {
+        /// The shard files.
+        #[arg(required = true)]
+        inputs: Vec<PathBuf>,
+        /// The joined file.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Also draw the joined sweep (.png or .svg).
+        #[arg(long)]
+        plot: Option<PathBuf>,
+        /// Overwrite an existing output file.
+        #[arg(long)]
+        force: bool,
+    },
     /// Draw a bifurcation diagram file.
     Plot {
         /// The HDF5 diagram from `cosserat continue`.

@@ -17,4 +17,5 @@ pub mod model;
 pub mod optimize;
 pub mod plot;
 pub mod stability;
+pub mod sweep;
 pub mod validate;

@@ -8,6 +8,7 @@ use std::process::ExitCode;
 
 mod continue_command;
 mod optimize_command;
+mod sweep_command;
 
 use clap::Parser;
 use cosserat::bvp::{solve, Equilibrium};
@@ -65,6 +66,31 @@ fn main() -> ExitCode {
             force,
             resume,
         }),
+        Command::Sweep {
+            problem,
+            output,
+            shard,
+            threads,
+            resume,
+            plot,
+            set,
+            force,
+        } => sweep_command::run_sweep(sweep_command::SweepArgs {
+            path: problem,
+            output,
+            shard,
+            threads,
+            resume,
+            plot,
+            set,
+            force,
+        }),
+        Command::Merge {
+            inputs,
+            output,
+            plot,
+            force,
+        } => sweep_command::run_merge(&inputs, &output, plot.as_deref(), force),
         Command::Plot {
             diagram,
             output,

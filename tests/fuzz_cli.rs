@@ -8,7 +8,7 @@ use cosserat::cli::Cli;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, TestRunner};
 
-const WORDS: [&str; 42] = [
+const WORDS: &[&str] = &[
     "solve",
     "stability",
     "continue",
@@ -51,6 +51,14 @@ const WORDS: [&str; 42] = [
     "",
     "é",
     "--set=a=b",
+    "sweep",
+    "merge",
+    "--shard",
+    "--threads",
+    "0/2",
+    "2/1",
+    "0",
+    "a.h5",
 ];
 
 fn cases() -> u32 {

@@ -8,6 +8,8 @@ mod diagram;
 mod hdf5_output;
 mod problem;
 mod support_section;
+mod sweep_output;
+mod sweep_section;
 
 pub use arm_output::{read_search, write_arm, write_arm_study, ArmStudy, SavedSearch};
 pub use arm_section::ArmSection;
@@ -18,3 +20,5 @@ pub use hdf5_output::{
 };
 pub use problem::{Problem, ProblemError, ProblemFile, ProfileSpec};
 pub use support_section::SupportSection;
+pub use sweep_output::{read_sweep, write_sweep, SweepHeader};
+pub use sweep_section::{grid_index, AxisSpec, Sweep, SweepAxis, SweepSection, MAX_POINTS};

@@ -16,6 +16,7 @@ use serde::{Deserialize, Deserializer, Serialize};
 
 use super::arm_section::ArmSection;
 use super::continuation_section::ContinuationSection;
+use super::sweep_section::{Sweep, SweepSection};
 use super::SupportSection;
 use crate::bvp::integrator::Tolerances;
 use crate::bvp::newton::NewtonOptions;
@@ -88,6 +89,9 @@ pub struct ProblemFile {
     /// The longest-arm optimization, for `cosserat optimize`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub arm: Option<ArmSection>,
+    /// A grid over keys of this file, for `cosserat sweep`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sweep: Option<SweepSection>,
 }
 
 /// `[shape]`.
@@ -393,6 +397,8 @@ pub struct Problem {
     pub arm: Option<(ArmProblem, SearchOptions, bool)>,
     /// The arm's loads and actuator limit, and the size of its reach map.
     pub arm_scene: Option<(ArmScene, usize)>,
+    /// The grid of a `[sweep]` table.
+    pub sweep: Option<Sweep>,
 }
 
 impl Problem {
@@ -450,6 +456,7 @@ impl Problem {
             .as_ref()
             .map(|a| a.scene(&rod).map(|s| (s, a.map_samples)))
             .transpose()?;
+        let sweep = file.sweep.as_ref().map(SweepSection::build).transpose()?;
         Ok(Problem {
             rod,
             model,
@@ -460,6 +467,7 @@ impl Problem {
             continuation,
             arm,
             arm_scene,
+            sweep,
         })
     }
 }
@@ -497,9 +505,33 @@ fn apply_overrides(text: &str, overrides: &[String]) -> Result<String, ProblemEr
                 .as_table_mut()
                 .ok_or_else(|| fail(&format!("`{part}` is not a table")))?;
         }
-        table.insert(last.to_string(), value);
+        match indexed(last) {
+            Some((name, i)) => {
+                let list = table
+                    .get_mut(name)
+                    .and_then(toml::Value::as_array_mut)
+                    .ok_or_else(|| fail(&format!("`{name}` is not an array")))?;
+                let len = list.len();
+                *list
+                    .get_mut(i)
+                    .ok_or_else(|| fail(&format!("`{name}` has {len} elements, no [{i}]")))? =
+                    value;
+            }
+            None => {
+                table.insert(last.to_string(), value);
+            }
+        }
     }
     toml::to_string(&doc).map_err(|e| ProblemError::Parse(e.to_string()))
+}
+
+/// `name[i]` → (name, i): one element of an array, as in
+/// `--set energy.stiffness[0]=4` (what `[sweep]` axes and continuation
+/// parameters are named).
+fn indexed(part: &str) -> Option<(&str, usize)> {
+    let (name, rest) = part.split_once('[')?;
+    let i = rest.strip_suffix(']')?.trim().parse().ok()?;
+    Some((name.trim(), i))
 }
 
 fn parse_value(raw: &str) -> toml::Value {

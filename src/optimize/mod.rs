@@ -29,6 +29,7 @@ pub mod scene;
 pub use control_path::{control_path, loading_path_in, shape_holding_path};
 pub use fig5::{ClosestStraight, ReachMap};
 pub use scene::{ArmScene, ArmWeight};
+mod warm_start;
 
 /// The arm to design.
 #[derive(Debug, Clone, PartialEq)]
@@ -217,15 +218,6 @@ impl ArmProblem {
             gamma,
             shape_coefficients: c,
         })
-    }
-
-    /// The Halton point i of the box of c2..cM.
-    fn halton_point(&self, i: usize) -> Vec<f64> {
-        self.bounds
-            .iter()
-            .enumerate()
-            .map(|(d, (lo, hi))| lo + (hi - lo) * halton(i, PRIMES[d % PRIMES.len()]))
-            .collect()
     }
 
     /// Clamps a point into the bounds.
