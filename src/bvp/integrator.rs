@@ -283,7 +283,11 @@ impl Dop853 {
         } else {
             (0.01 / d1.max(d2)).powf(1.0 / 8.0)
         };
-        (100.0 * h0).min(h1).min(span)
+        // Hairer's 100 h0 bound, but not below 1e-6 of the span: with y
+        // nearly zero and above Hairer's threshold (a straight column whose
+        // clamp curvature is 1e-17), h0 = 0.01 d0/d1 is ~1e-19 and the first
+        // step would count as an underflow; h1 still bounds the step.
+        (100.0 * h0).max(1e-6 * span).min(h1).min(span)
     }
 
     /// The 12 stages of one step of size h from (s, y); the 8th-order result
