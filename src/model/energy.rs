@@ -103,6 +103,16 @@ impl LinearElastic {
     fn kappa0_rate(&self, s: f64) -> Vector3<f64> {
         Vector3::from_fn(|i, _| self.intrinsic_curvature[i].derivative(s))
     }
+
+    /// A prismatic rod with constant κ⁰: W has no explicit s-dependence,
+    /// so its s-derivatives vanish without evaluating six profiles (a fast
+    /// path: they sit in the innermost loop of every integration).
+    fn is_uniform(&self) -> bool {
+        self.stiffness
+            .iter()
+            .chain(&self.intrinsic_curvature)
+            .all(|p| matches!(p, Profile::Constant(_)))
+    }
 }
 
 impl StoredEnergy for LinearElastic {
@@ -120,11 +130,17 @@ impl StoredEnergy for LinearElastic {
     }
 
     fn moment_rate(&self, s: f64, kappa: &Vector3<f64>) -> Vector3<f64> {
+        if self.is_uniform() {
+            return Vector3::zeros();
+        }
         self.b_rate(s).component_mul(&(kappa - self.kappa0(s)))
             - self.b(s).component_mul(&self.kappa0_rate(s))
     }
 
     fn stiffness_rate(&self, s: f64, _kappa: &Vector3<f64>) -> Matrix3<f64> {
+        if self.is_uniform() {
+            return Matrix3::zeros();
+        }
         Matrix3::from_diagonal(&self.b_rate(s))
     }
 

@@ -143,6 +143,7 @@ impl Profile {
     }
 
     /// The value at s.
+    #[inline]
     pub fn value(&self, s: f64) -> f64 {
         match self {
             Profile::Constant(c) => *c,
@@ -168,6 +169,7 @@ impl Profile {
     }
 
     /// The derivative d/ds at s (one-sided at table knots: the right segment).
+    #[inline]
     pub fn derivative(&self, s: f64) -> f64 {
         match self {
             Profile::Constant(_) => 0.0,
