@@ -328,11 +328,16 @@ impl ArmProblem {
     /// The starting simplex around `start`: steps of 5 % of each bound's
     /// width, inwards at the upper bound.
     fn simplex(&self, start: &[f64]) -> Vec<Vec<f64>> {
+        self.simplex_sized(start, 0.05)
+    }
+
+    /// The simplex with steps of `fraction` of each bound's width.
+    fn simplex_sized(&self, start: &[f64], fraction: f64) -> Vec<Vec<f64>> {
         std::iter::once(start.to_vec())
             .chain((0..start.len()).map(|d| {
                 let mut p = start.to_vec();
                 let (lo, hi) = self.bounds[d];
-                let step = 0.05 * (hi - lo);
+                let step = fraction * (hi - lo);
                 p[d] = if p[d] + step <= hi {
                     p[d] + step
                 } else {
@@ -351,7 +356,18 @@ impl ArmProblem {
         iterations: u64,
         stop: &dyn Fn() -> bool,
     ) -> (Option<ArmDesign>, usize) {
-        let simplex = self.simplex(start);
+        self.nelder_mead(scene, self.simplex(start), iterations, stop)
+    }
+
+    /// Nelder–Mead on −R̂ from a simplex; the polished design and the
+    /// evaluations used.
+    fn nelder_mead(
+        &self,
+        scene: &ArmScene,
+        simplex: Vec<Vec<f64>>,
+        iterations: u64,
+        stop: &dyn Fn() -> bool,
+    ) -> (Option<ArmDesign>, usize) {
         let cost = ReachCost {
             problem: self,
             scene,

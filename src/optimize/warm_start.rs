@@ -7,10 +7,7 @@
 //! A child module of `optimize`, so that it uses the search's private
 //! pieces instead of copying them.
 
-use argmin::core::{Executor, State};
-use argmin::solver::neldermead::NelderMead;
-
-use super::{halton, ArmDesign, ArmOptimum, ArmProblem, ArmScene, ReachCost, PRIMES};
+use super::{halton, ArmDesign, ArmOptimum, ArmProblem, ArmScene, PRIMES};
 
 impl ArmProblem {
     /// The i-th Halton point (i ≥ 1) of the box of c2..cM — the samples of
@@ -38,33 +35,9 @@ impl ArmProblem {
             return (self.design_in(scene, &[]), 1);
         }
         let start = self.project(start);
-        let simplex: Vec<Vec<f64>> = std::iter::once(start.clone())
-            .chain((0..start.len()).map(|d| {
-                let mut p = start.clone();
-                let (lo, hi) = self.bounds[d];
-                let h = step * (hi - lo);
-                p[d] = if p[d] + h <= hi { p[d] + h } else { p[d] - h };
-                p
-            }))
-            .collect();
-        let never = || false;
-        let cost = ReachCost {
-            problem: self,
-            scene,
-            stop: &never,
-            calls: std::cell::Cell::new(0),
-        };
-        let Ok(solver) = NelderMead::new(simplex).with_sd_tolerance(1e-12) else {
-            return (None, 0);
-        };
-        let result = Executor::new(&cost, solver)
-            .configure(|state| state.max_iters(iterations))
-            .run();
-        let design = result.ok().and_then(|r| {
-            let p = r.state().get_best_param()?.clone();
-            self.design_in(scene, &self.project(&p))
-        });
-        (design, cost.calls.get())
+        self.nelder_mead(scene, self.simplex_sized(&start, step), iterations, &|| {
+            false
+        })
     }
 
     /// The optimum record of a design: the Taylor fit b of κ̄⁰2 (paper
