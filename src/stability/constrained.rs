@@ -20,8 +20,8 @@ use nalgebra::{DMatrix, DVector};
 
 use super::banded::{BandedLdlt, SymmetricBanded};
 use super::eigen::{
-    count_below, dense_pencil, diagonal_ratio, lanczos, lowest_eigenpairs_near, row_sum_norm,
-    shift_below, EigenError, Eigenpairs, DENSE_LIMIT,
+    count_below, dense_pencil, diagonal_ratio, lowest_eigenpairs_near, row_sum_norm, shift_below,
+    shift_invert_lanczos, EigenError, Eigenpairs, DENSE_LIMIT,
 };
 
 /// Linear constraints C v = 0 with orthonormal rows (m × n).
@@ -179,23 +179,9 @@ pub fn lowest_eigenpairs_constrained(
         g.matvec(x, y);
         bordered.solve(&s_inv, y);
     };
-    let mut steps = 3 * count + 40;
-    loop {
-        let ritz = lanczos(
-            k.size(),
-            count,
-            steps,
-            apply,
-            g,
-            |theta| sigma + 1.0 / theta,
-            |a, b| b.total_cmp(&a),
-        )?;
-        match verify(k, g, c, ritz) {
-            Ok(pairs) => return Ok(pairs),
-            Err(_) if steps < k.size() => steps = (2 * steps).min(k.size()),
-            Err(e) => return Err(e),
-        }
-    }
+    shift_invert_lanczos(k.size(), count, sigma, apply, g, |ritz| {
+        verify(k, g, c, ritz)
+    })
 }
 
 /// A shift below the constrained spectrum: [`shift_below`] on the
