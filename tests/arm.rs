@@ -148,16 +148,7 @@ fn interrupted_optimization_keeps_its_best_design() {
         .read_scalar::<hdf5::types::VarLenUnicode>()
         .unwrap();
     assert_eq!(reason.as_str(), "interrupted");
-    let reach = f
-        .dataset("optimum/reach")
-        .unwrap()
-        .read_scalar::<f64>()
-        .unwrap();
-    let c = f
-        .dataset("optimum/shape_coefficients")
-        .unwrap()
-        .read_raw::<f64>()
-        .unwrap();
+    let (reach, c, _) = read_reach(&out);
     let p = cosserat::io::Problem::from_path(std::path::Path::new(&file), &[]).unwrap();
     let (arm, _, _) = p.arm.unwrap();
     let again = arm.design(&c[1..]).unwrap();
