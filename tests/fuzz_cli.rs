@@ -6,7 +6,8 @@
 use clap::Parser;
 use cosserat::cli::Cli;
 use proptest::prelude::*;
-use proptest::test_runner::{Config, TestRunner};
+mod support;
+use support::fuzz::runner;
 
 const WORDS: &[&str] = &[
     "solve",
@@ -87,25 +88,15 @@ fn check(args: Vec<String>) -> Result<(), TestCaseError> {
 #[test]
 fn vocabulary_argument_vectors_never_panic() {
     let strategy = prop::collection::vec(0..WORDS.len(), 0..8);
-    TestRunner::new(Config {
-        cases: cases() / 2,
-        failure_persistence: None,
-        ..Config::default()
-    })
-    .run(&strategy, |idx| {
-        check(idx.into_iter().map(|i| WORDS[i].to_string()).collect())
-    })
-    .unwrap();
+    runner(cases() / 2)
+        .run(&strategy, |idx| {
+            check(idx.into_iter().map(|i| WORDS[i].to_string()).collect())
+        })
+        .unwrap();
 }
 
 #[test]
 fn arbitrary_argument_vectors_never_panic() {
     let strategy = prop::collection::vec(".{0,16}", 0..6);
-    TestRunner::new(Config {
-        cases: cases() - cases() / 2,
-        failure_persistence: None,
-        ..Config::default()
-    })
-    .run(&strategy, check)
-    .unwrap();
+    runner(cases() - cases() / 2).run(&strategy, check).unwrap();
 }

@@ -10,7 +10,8 @@
 
 use cosserat::io::Problem;
 use proptest::prelude::*;
-use proptest::test_runner::{Config, TestRunner};
+mod support;
+use support::fuzz::runner;
 
 /// The seeds: problems/*.toml and tests/corpus/*.toml, sorted by path so
 /// that the generators are deterministic.
@@ -160,14 +161,6 @@ fn check(text: &str, overrides: &[String]) -> Result<(), TestCaseError> {
         }
     }
     Ok(())
-}
-
-fn runner(cases: u32) -> TestRunner {
-    TestRunner::new(Config {
-        cases,
-        failure_persistence: None,
-        ..Config::default()
-    })
 }
 
 /// Byte-level edits: delete, insert from a TOML alphabet, or replace.

@@ -202,6 +202,13 @@ fn spaced(field: &str, a: f64, b: f64, n: usize) -> Result<Vec<f64>, ProblemErro
             ),
         ));
     }
+    if n > MAX_POINTS {
+        // Checked before allocating: a count of 5e11 would abort the process.
+        return Err(invalid(
+            field,
+            format!("{n} values exceed the grid limit of {MAX_POINTS} points"),
+        ));
+    }
     if n == 1 {
         return Ok(vec![a]);
     }

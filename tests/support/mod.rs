@@ -5,4 +5,5 @@
 pub mod bessel;
 pub mod columns;
 pub mod elliptic;
+pub mod fuzz;
 pub mod references;
