@@ -420,16 +420,16 @@ fn refine_into(mesh: &[f64], pieces: &[(usize, usize)]) -> Vec<f64> {
 /// a_jl = ∫_0^{c_j} ℓ_l, b_l = ∫_0^1 ℓ_l for the Lagrange basis ℓ_l on the
 /// Gauss points c (AMR §5.6.1).
 #[derive(Debug, Clone)]
-struct Tableau {
-    m: usize,
-    c: Vec<f64>,
+pub(crate) struct Tableau {
+    pub(crate) m: usize,
+    pub(crate) c: Vec<f64>,
     /// m × m, row-major.
     a: Vec<f64>,
-    b: Vec<f64>,
+    pub(crate) b: Vec<f64>,
 }
 
 impl Tableau {
-    fn gauss(m: usize) -> Option<Tableau> {
+    pub(crate) fn gauss(m: usize) -> Option<Tableau> {
         let (c, b) = match m {
             1 => (vec![0.5], vec![1.0]),
             2 => {
@@ -452,7 +452,7 @@ impl Tableau {
         Some(Tableau { m, c, a, b })
     }
 
-    fn a(&self, j: usize, l: usize) -> f64 {
+    pub(crate) fn a(&self, j: usize, l: usize) -> f64 {
         self.a[j * self.m + l]
     }
 }

@@ -10,6 +10,7 @@
 //! DifferentialEquations.jl.
 
 mod collocation;
+mod gauss_step;
 pub mod integrator;
 pub mod newton;
 mod shooting;

@@ -12,6 +12,8 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use super::collocation::Tableau;
+use super::gauss_step::gauss_step;
 use super::integrator::{Dop853, IntegrationError, IntegrationStats, Tolerances};
 use super::newton::NonlinearSystem;
 use crate::equations::{RodEquations, RodSample};
@@ -24,6 +26,9 @@ pub struct ShootingSystem<'a> {
     dop: Dop853,
     scales: Vec<f64>,
     moment_scale: f64,
+    /// Segments as single Gauss–Legendre steps (the collocation equations
+    /// of the segment mesh) instead of adaptive DOP853 integration.
+    gauss: Option<Tableau>,
     /// Integration work so far.
     pub stats: IntegrationStats,
 }
@@ -39,8 +44,28 @@ impl<'a> ShootingSystem<'a> {
             dop: Dop853::new(eq.dim()),
             scales,
             moment_scale: eq.moment_scale(),
+            gauss: None,
             stats: IntegrationStats::default(),
         }
+    }
+
+    /// The collocation equations of Gauss–Legendre collocation with
+    /// `stages` points (1 to 3; order 2·stages at the nodes) on `intervals`
+    /// equal intervals, posed as multiple shooting whose segments are
+    /// single Gauss steps ([`super::gauss_step`]); None for a stage count
+    /// without a tableau. Samples between the nodes are integrated from
+    /// the node states by DOP853.
+    pub fn collocation(
+        eq: &'a dyn RodEquations,
+        intervals: usize,
+        stages: usize,
+        tol: Tolerances,
+    ) -> Option<Self> {
+        let tab = Tableau::gauss(stages)?;
+        Some(ShootingSystem {
+            gauss: Some(tab),
+            ..ShootingSystem::new(eq, intervals, tol)
+        })
     }
 
     fn node(&self, j: usize) -> f64 {
@@ -72,6 +97,11 @@ impl<'a> ShootingSystem<'a> {
         phi0: &DMatrix<f64>,
     ) -> Result<(Vec<f64>, DMatrix<f64>), IntegrationError> {
         let n = self.eq.dim();
+        if let Some(tab) = &self.gauss {
+            let (a, b) = (self.node(j), self.node(j + 1));
+            self.stats.accepted += 1;
+            return gauss_step(self.eq, tab, a, b - a, start, phi0);
+        }
         let cols = phi0.ncols();
         let mut y = Vec::with_capacity(n * (cols + 1));
         y.extend_from_slice(start);

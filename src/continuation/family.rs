@@ -93,6 +93,9 @@ pub struct Family {
     parameter: Parameter,
     level: ModelLevel,
     segments: usize,
+    /// Gauss points per interval when the segments are collocation
+    /// intervals (one Gauss step each) rather than integrated segments.
+    stages: Option<usize>,
     tolerances: Tolerances,
 }
 
@@ -126,7 +129,35 @@ impl Family {
             parameter,
             level,
             segments: segments.max(1),
+            stages: None,
             tolerances,
+        }
+    }
+
+    /// The family on the collocation discretization: Gauss–Legendre
+    /// collocation with `stages` points (1 to 3) on `intervals` equal
+    /// intervals, its unknowns the node states (see
+    /// [`ShootingSystem::collocation`]).
+    pub fn collocation(
+        base: Rod,
+        parameter: Parameter,
+        level: ModelLevel,
+        intervals: usize,
+        stages: usize,
+        tolerances: Tolerances,
+    ) -> Self {
+        Family {
+            stages: Some(stages.clamp(1, 3)),
+            ..Family::new(base, parameter, level, intervals, tolerances)
+        }
+    }
+
+    /// The discrete system at a rod's equations.
+    fn system<'e>(&self, eq: &'e dyn crate::equations::RodEquations) -> ShootingSystem<'e> {
+        match self.stages {
+            Some(m) => ShootingSystem::collocation(eq, self.segments, m, self.tolerances)
+                .expect("stages clamped to a tableau"),
+            None => ShootingSystem::new(eq, self.segments, self.tolerances),
         }
     }
 
@@ -151,7 +182,9 @@ impl Family {
         }
     }
 
-    /// The BVP method of the family's discretization.
+    /// The BVP method of the family's discretization, or, for collocation,
+    /// the multiple shooting on the same nodes whose solution starts the
+    /// branch (Newton then moves it onto the collocation equations).
     pub fn method(&self) -> crate::bvp::Method {
         match self.segments {
             1 => crate::bvp::Method::Shooting,
@@ -293,7 +326,7 @@ impl Family {
     ) -> Result<(), PointError> {
         let rod = self.rod_at(p)?;
         let eq = equations(&rod, self.level);
-        let mut sys = ShootingSystem::new(eq.as_ref(), self.segments, self.tolerances);
+        let mut sys = self.system(eq.as_ref());
         sys.evaluate(&self.unscaled(x), r, jac)?;
         for (mut column, w) in jac.column_iter_mut().zip(self.weights()) {
             column *= w;
@@ -315,7 +348,7 @@ impl Family {
     pub fn residual_only(&self, x: &[f64], p: f64, r: &mut DVector<f64>) -> Result<(), PointError> {
         let rod = self.rod_at(p)?;
         let eq = equations(&rod, self.level);
-        let mut sys = ShootingSystem::new(eq.as_ref(), self.segments, self.tolerances);
+        let mut sys = self.system(eq.as_ref());
         sys.residual(&self.unscaled(x), r)?;
         Ok(())
     }
@@ -332,7 +365,7 @@ impl Family {
         let rod = self.rod_at(p)?;
         let eq = equations(&rod, self.level);
         let u = eq.initial_guess();
-        let mut sys = ShootingSystem::new(eq.as_ref(), self.segments, self.tolerances);
+        let mut sys = self.system(eq.as_ref());
         Ok(self.scaled(&sys.initial_unknowns(&u)))
     }
 
@@ -340,7 +373,7 @@ impl Family {
     pub fn samples(&self, x: &[f64], p: f64, points: &[f64]) -> Result<Vec<RodSample>, PointError> {
         let rod = self.rod_at(p)?;
         let eq = equations(&rod, self.level);
-        let mut sys = ShootingSystem::new(eq.as_ref(), self.segments, self.tolerances);
+        let mut sys = self.system(eq.as_ref());
         Ok(sys.sample(&self.unscaled(x), points)?.0)
     }
 

@@ -52,6 +52,11 @@ pub struct ContinuationSection {
     /// Corrector tolerance (scaled residual).
     #[serde(default = "default_tolerance")]
     pub tolerance: f64,
+    /// Collocation intervals of the continued discretization when
+    /// `solver.method = "collocation"` (a fixed mesh; Gauss points per
+    /// interval from `solver.stages`).
+    #[serde(default = "default_intervals")]
+    pub intervals: usize,
     /// What `cosserat plot` puts on the vertical axis by default: `tip_x`,
     /// `tip_y`, `tip_z`, `norm` or `tip_angle`.
     #[serde(default = "default_measure")]
@@ -78,6 +83,9 @@ fn default_elements() -> usize {
 }
 fn default_order() -> usize {
     2
+}
+fn default_intervals() -> usize {
+    32
 }
 fn default_eigenvalues() -> usize {
     4

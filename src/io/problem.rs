@@ -785,14 +785,17 @@ fn build_continuation(
         return Ok(None);
     };
     let (parameter, opts) = section.build()?;
-    let segments = match options.method {
-        Method::Shooting => 1,
-        Method::MultipleShooting { segments } => segments,
-        _ => {
-            return Err(invalid(
-                "solver.method",
-                "continuation runs on shooting or multiple-shooting",
-            ))
+    let (segments, stages) = match options.method {
+        Method::Shooting => (1, None),
+        Method::MultipleShooting { segments } => (segments, None),
+        Method::Collocation { stages } => {
+            if !(1..=10_000).contains(&section.intervals) {
+                return Err(invalid(
+                    "continuation.intervals",
+                    format!("must be between 1 and 10000, got {}", section.intervals),
+                ));
+            }
+            (section.intervals, Some(stages))
         }
     };
     if let Some(shape) = shape {
@@ -820,7 +823,17 @@ fn build_continuation(
         // The parameter is the absolute angle: start from the unturned frame.
         base.clamp.frame = turned(&rod.clamp, -file.clamp.angle);
     }
-    let family = Family::new(base, parameter, model.level, segments, options.integration);
+    let family = match stages {
+        None => Family::new(base, parameter, model.level, segments, options.integration),
+        Some(m) => Family::collocation(
+            base,
+            parameter,
+            model.level,
+            segments,
+            m,
+            options.integration,
+        ),
+    };
     Ok(Some((family, opts)))
 }
 
