@@ -20,8 +20,8 @@ use nalgebra::{DMatrix, DVector};
 
 use super::banded::{BandedLdlt, SymmetricBanded};
 use super::eigen::{
-    count_below, dense_pencil, diagonal_ratio, lowest_eigenpairs_near, row_sum_norm, shift_below,
-    shift_invert_lanczos, EigenError, Eigenpairs, DENSE_LIMIT,
+    count_below, dense_pencil, diagonal_ratio, lowest_eigenpairs_near, shift_below,
+    shift_invert_lanczos, verify_with, EigenError, Eigenpairs, DENSE_LIMIT,
 };
 
 /// Linear constraints C v = 0 with orthonormal rows (m × n).
@@ -200,25 +200,13 @@ fn verify(
     c: &Constraints,
     pairs: Eigenpairs,
 ) -> Result<Eigenpairs, EigenError> {
-    let n = k.size();
-    let (norm_k, norm_g) = (row_sum_norm(k), row_sum_norm(g));
-    let (mut kv, mut gv) = (vec![0.0; n], vec![0.0; n]);
-    for (lambda, v) in pairs.values.iter().zip(&pairs.vectors) {
-        k.matvec(v, &mut kv);
-        g.matvec(v, &mut gv);
-        let r = DVector::from_iterator(n, kv.iter().zip(&gv).map(|(a, b)| a - lambda * b));
-        let r = &r - c.rows.transpose() * (&c.rows * &r);
-        let v_norm = DVector::from_column_slice(v).norm();
-        let backward =
-            r.norm() / ((norm_k + lambda.abs() * norm_g) * v_norm).max(f64::MIN_POSITIVE);
-        if backward > 1e-8 || c.apply(v).norm() > 1e-8 * v_norm {
-            return Err(EigenError::NoConvergence {
-                residual: backward,
-                steps: 0,
-            });
-        }
-    }
-    Ok(pairs)
+    verify_with(
+        k,
+        g,
+        pairs,
+        |r| &r - c.rows.transpose() * (&c.rows * &r),
+        |v| c.apply(v).norm() <= 1e-8 * DVector::from_column_slice(v).norm(),
+    )
 }
 
 /// Small problems: an orthonormal basis N of null C (Gram–Schmidt on the

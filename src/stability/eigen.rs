@@ -210,23 +210,34 @@ fn verify(
     g: &SymmetricBanded,
     pairs: Eigenpairs,
 ) -> Result<Eigenpairs, EigenError> {
+    verify_with(k, g, pairs, |r| r, |_| true)
+}
+
+/// [`verify`] with the residual first passed through `project` (off the
+/// normals of constraints) and each vector required to be `admissible`.
+pub(super) fn verify_with(
+    k: &SymmetricBanded,
+    g: &SymmetricBanded,
+    pairs: Eigenpairs,
+    project: impl Fn(DVector<f64>) -> DVector<f64>,
+    admissible: impl Fn(&[f64]) -> bool,
+) -> Result<Eigenpairs, EigenError> {
     let n = k.size();
     let (norm_k, norm_g) = (row_sum_norm(k), row_sum_norm(g));
     let (mut kv, mut gv) = (vec![0.0; n], vec![0.0; n]);
     for (lambda, v) in pairs.values.iter().zip(&pairs.vectors) {
         k.matvec(v, &mut kv);
         g.matvec(v, &mut gv);
-        let r: f64 = kv
-            .iter()
-            .zip(&gv)
-            .map(|(a, b)| (a - lambda * b).powi(2))
-            .sum::<f64>()
-            .sqrt();
+        let r = project(DVector::from_iterator(
+            n,
+            kv.iter().zip(&gv).map(|(a, b)| a - lambda * b),
+        ));
         let v_norm = v.iter().map(|a| a * a).sum::<f64>().sqrt();
-        let backward = r / ((norm_k + lambda.abs() * norm_g) * v_norm).max(f64::MIN_POSITIVE);
+        let backward =
+            r.norm() / ((norm_k + lambda.abs() * norm_g) * v_norm).max(f64::MIN_POSITIVE);
         // Unconverged Ritz pairs sit far above this; converged ones carry
         // round-off amplified by the shift-invert conditioning.
-        if backward > 1e-8 {
+        if backward > 1e-8 || !admissible(v) {
             return Err(EigenError::NoConvergence {
                 residual: backward,
                 steps: 0,
