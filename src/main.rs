@@ -249,26 +249,39 @@ fn run_solve(path: PathBuf, output: Option<PathBuf>, set: &[String], force: bool
     ExitCode::SUCCESS
 }
 
-/// The stability verdict of a solved equilibrium (conservative loads): a
-/// converged but unstable equilibrium is one the loading does not reach —
-/// say so rather than let it pass as the answer.
+/// The stability verdict of a solved equilibrium (conservative loads), on a
+/// mesh refined from the problem's `[stability]` settings until the Morse
+/// index and the signs of the lowest eigenvalues are certain
+/// ([`cosserat::stability::decide`]): a converged but unstable equilibrium
+/// is one the loading does not reach — say so rather than let it pass as
+/// the answer — and an uncertain one is "undecided".
 fn verdict(problem: &Problem, eq: &Equilibrium) {
-    let opts = cosserat::stability::StabilityOptions {
-        elements: 40,
-        order: 2,
-        eigenvalues: 1,
-    };
-    match analyze(&problem.rod, eq, &problem.options, &opts) {
-        Ok(st) if st.stable => println!("stability stable (Morse index 0)"),
-        Ok(st) => {
-            println!("stability UNSTABLE (Morse index {})", st.morse_index);
-            eprintln!(
-                "warning: this equilibrium is unstable (Morse index {}): loading the rod \
-                 would not settle here; follow the load with `cosserat continue` or try \
-                 --method multiple-shooting / collocation",
-                st.morse_index
-            );
-        }
+    use cosserat::stability::{decide, Verdict};
+    match decide(&problem.rod, eq, &problem.options, &problem.stability) {
+        Ok(d) => match d.verdict {
+            Verdict::Stable => println!(
+                "stability stable (Morse index 0; {} elements, eigenvalue error ≤ {:.1e})",
+                d.elements, d.eigenvalue_error
+            ),
+            Verdict::Unstable { morse_index } => {
+                println!(
+                    "stability UNSTABLE (Morse index {morse_index}; {} elements, eigenvalue error ≤ {:.1e})",
+                    d.elements, d.eigenvalue_error
+                );
+                eprintln!(
+                    "warning: this equilibrium is unstable (Morse index {morse_index}): loading the rod \
+                     would not settle here; follow the load with `cosserat continue` or try \
+                     --method multiple-shooting / collocation"
+                );
+            }
+            Verdict::Undecided { reason } => {
+                println!("stability undecided: {reason}");
+                eprintln!(
+                    "warning: the stability of this equilibrium is undecided ({reason}); \
+                     raise stability.elements or run `cosserat stability` on it"
+                );
+            }
+        },
         Err(e) => println!("stability not decided: {e}"),
     }
 }

@@ -31,7 +31,7 @@ use nalgebra::DMatrix;
 use nalgebra::DVector;
 
 use super::integrator::{Dop853, Tolerances};
-use super::newton::NewtonOptions;
+use super::newton::{Convergence, NewtonOptions};
 use crate::equations::{RodEquations, RodSample};
 
 /// Settings of the collocation method.
@@ -508,7 +508,6 @@ struct Grid<'a> {
     p: usize,
     /// 1 / state scale, per component.
     w: Vec<f64>,
-    moment_scale: f64,
     /// ∂y_0/∂u.
     sens: DMatrix<f64>,
     /// The n × n identity, column-major: the tangent vectors that make
@@ -553,7 +552,6 @@ impl<'a> Grid<'a> {
             n,
             p: eq.unknowns(),
             w: eq.state_scales().iter().map(|v| 1.0 / v).collect(),
-            moment_scale: eq.moment_scale(),
             sens: eq.initial_sensitivity(),
             ident: DMatrix::<f64>::identity(n, n).as_slice().to_vec(),
         }
@@ -774,7 +772,7 @@ impl<'a> Grid<'a> {
         let mut g = vec![0.0; p];
         self.eq
             .tip_residual(self.node_ref(x, &y0, self.intervals()), &mut g);
-        r.extend(g.iter().map(|v| v / self.moment_scale));
+        r.extend_from_slice(&g);
         r
     }
 
@@ -826,7 +824,7 @@ impl<'a> Grid<'a> {
             }
         }
         let y_tip = self.node(x, k);
-        let gt = self.eq.tip_residual_jacobian(&y_tip) / self.moment_scale;
+        let gt = self.eq.tip_residual_jacobian(&y_tip);
         for r in 0..p {
             for c in 0..n {
                 lin.band.add(n * k + r, p + n * (k - 1) + c, gt[(r, c)]);
@@ -948,6 +946,24 @@ impl<'a> Grid<'a> {
 
     /// A weighted Euclidean norm of a correction (δy_0 = S δu, nodes and
     /// stages, each component divided by its scale).
+    /// The typical magnitude of each unknown: the free initial values in
+    /// the scale of the state component they set, node states in the
+    /// state scales.
+    fn unknown_scales(&self) -> Vec<f64> {
+        let (n, p) = (self.n, self.p);
+        let total = p + n * self.intervals();
+        (0..total)
+            .map(|q| {
+                let row = if q < p {
+                    (0..n).find(|&r| self.sens[(r, q)] != 0.0).unwrap_or(0)
+                } else {
+                    (q - p) % n
+                };
+                1.0 / self.w[row]
+            })
+            .collect()
+    }
+
     fn step_norm(&self, dx: &[f64]) -> f64 {
         let (n, p) = (self.n, self.p);
         let head: f64 = (0..n)
@@ -1224,8 +1240,17 @@ fn damped_newton(
     }
     let mut lin = grid.new_linearization();
     let mut ws = Scratch::new(grid.n, grid.tab.m);
+    let test = Convergence::new(opts.tolerance, grid.unknown_scales());
     for iteration in 0..=opts.max_iterations {
-        if *history.last().unwrap() <= opts.tolerance {
+        let singular = |history| CollocationError::SingularJacobian {
+            iteration,
+            intervals,
+            history,
+        };
+        let linearized = grid.linearize(&x, &mut lin, &mut ws);
+        let step = grid.newton_correction(&lin, &f);
+        let step_ok = linearized && step.iter().all(|v| v.is_finite());
+        if step_ok && test.met(*history.last().unwrap(), &x, &step) {
             let mut out = polish(grid, x, f, history, lin, &mut ws);
             out.damped_steps = damped_steps;
             out.contraction = contraction;
@@ -1234,16 +1259,7 @@ fn damped_newton(
         if iteration == opts.max_iterations {
             break;
         }
-        let singular = |history| CollocationError::SingularJacobian {
-            iteration,
-            intervals,
-            history,
-        };
-        if !grid.linearize(&x, &mut lin, &mut ws) {
-            return Err(singular(history));
-        }
-        let step = grid.newton_correction(&lin, &f);
-        if step.iter().any(|v| !v.is_finite()) {
+        if !step_ok {
             return Err(singular(history));
         }
         let step_norm = grid.step_norm(&step);

@@ -1,6 +1,15 @@
 //! The damped Newton method shared by the BVP solvers: full steps where they
 //! reduce the residual, halved steps (Armijo backtracking on the residual
 //! norm) where they do not, and an error that says why when it fails.
+//!
+//! Convergence ([`Convergence`]) needs both a small residual, each equation
+//! measured in its own unit, and a small Newton correction, each unknown
+//! measured against its own magnitude: a residual test alone is fooled by a
+//! badly scaled equation (a stiffness of 1e10 made an unbent rod's tip
+//! moment look converged), a correction test alone by an ill-conditioned
+//! Jacobian; the correction is the affine-invariant measure of how far the
+//! iterate is from the root (Deuflhard, *Newton Methods for Nonlinear
+//! Problems*, Sec. 2.1).
 
 use nalgebra::{DMatrix, DVector};
 
@@ -18,12 +27,63 @@ pub trait NonlinearSystem {
         r: &mut DVector<f64>,
         jac: &mut DMatrix<f64>,
     ) -> Result<(), IntegrationError>;
+    /// The typical magnitude of each unknown in natural units (lengths L,
+    /// curvatures 1/L, directors 1, ...): a correction counts as small when
+    /// it is small against max(|x_i|, scale_i).
+    fn unknown_scales(&self) -> Vec<f64> {
+        vec![1.0; self.size()]
+    }
+}
+
+/// Newton's stopping test: the scaled residual at most the tolerance τ and
+/// the scaled correction at most √τ. The correction is first-order the
+/// error of the iterate; in the quadratic regime the next one is of the
+/// order of its square, so a correction above √τ means the residual test
+/// was fooled (a badly scaled equation, a start on the wrong root's
+/// shoulder) while one below it is consistent with a residual of τ. (Asking
+/// τ of the correction itself would demand more than round-off and the
+/// integrator's tolerance allow through an ill-conditioned Jacobian.)
+#[derive(Debug, Clone, PartialEq)]
+pub struct Convergence {
+    tolerance: f64,
+    scales: Vec<f64>,
+}
+
+impl Convergence {
+    /// The test with `tolerance` τ on the residual, √τ on the correction,
+    /// and the unknowns' typical magnitudes `scales` (each > 0).
+    pub fn new(tolerance: f64, scales: Vec<f64>) -> Self {
+        Convergence { tolerance, scales }
+    }
+
+    /// max_i |δ_i| / max(|x_i|, scale_i): the correction relative to each
+    /// unknown's magnitude, floored at its natural unit.
+    pub fn step_size(&self, x: &[f64], step: &[f64]) -> f64 {
+        x.iter()
+            .zip(step)
+            .zip(&self.scales)
+            .map(|((xi, di), si)| di.abs() / xi.abs().max(*si))
+            .fold(0.0, |m, v| if v.is_nan() { f64::NAN } else { m.max(v) })
+    }
+
+    /// Whether the residual (max-norm, already scaled per equation) is small
+    /// enough that a correction is worth testing.
+    pub fn residual_met(&self, residual: f64) -> bool {
+        residual <= self.tolerance
+    }
+
+    /// Both measures met.
+    pub fn met(&self, residual: f64, x: &[f64], step: &[f64]) -> bool {
+        self.residual_met(residual) && self.step_size(x, step) <= self.tolerance.sqrt()
+    }
 }
 
 /// Newton's settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NewtonOptions {
-    /// Converged when the max-norm of the scaled residual is at most this.
+    /// Converged when the max-norm of the scaled residual is at most this
+    /// and the largest Newton correction relative to its unknown at most its
+    /// square root ([`Convergence`]).
     pub tolerance: f64,
     /// Maximum number of Newton steps.
     pub max_iterations: usize,
@@ -120,30 +180,31 @@ pub fn solve<S: NonlinearSystem>(
         .map_err(NewtonFailure::BadStart)?;
     let (mut r_try, mut jac_try) = (DVector::zeros(n), DMatrix::zeros(n, n));
     let mut history = vec![max_norm(&r)];
+    let test = Convergence::new(opts.tolerance, system.unknown_scales());
     let mut damped_steps = 0;
     let (mut contraction, mut last_step_norm) = (0.0_f64, f64::NAN);
     for iteration in 0..=opts.max_iterations {
         let norm = *history.last().unwrap();
-        if norm <= opts.tolerance {
-            return Ok(NewtonReport {
-                x,
-                iterations: iteration,
-                history,
-                damped_steps,
-                contraction,
-                jacobian: jac,
-            });
+        let lu = jac.clone().lu();
+        let step = lu.solve(&(-&r)).filter(|d| d.iter().all(|v| v.is_finite()));
+        if let Some(step) = &step {
+            if test.met(norm, &x, step.as_slice()) {
+                return Ok(NewtonReport {
+                    x,
+                    iterations: iteration,
+                    history,
+                    damped_steps,
+                    contraction,
+                    jacobian: jac,
+                });
+            }
         }
         if iteration == opts.max_iterations {
             break;
         }
-        let lu = jac.clone().lu();
-        let Some(step) = lu.solve(&(-&r)) else {
+        let Some(step) = step else {
             return Err(NewtonFailure::SingularJacobian { iteration, history });
         };
-        if step.iter().any(|v| !v.is_finite()) {
-            return Err(NewtonFailure::SingularJacobian { iteration, history });
-        }
         // Affine-invariant damping (Deuflhard's natural monotonicity test):
         // accept λ when the simplified Newton correction at the trial point,
         // ‖J(x)⁻¹F(x + λδ)‖, is smaller than (1 − λ/4)‖δ‖. Unlike the

@@ -25,7 +25,6 @@ pub struct ShootingSystem<'a> {
     tol: Tolerances,
     dop: Dop853,
     scales: Vec<f64>,
-    moment_scale: f64,
     /// Segments as single Gauss–Legendre steps (the collocation equations
     /// of the segment mesh) instead of adaptive DOP853 integration.
     gauss: Option<Tableau>,
@@ -43,7 +42,6 @@ impl<'a> ShootingSystem<'a> {
             tol,
             dop: Dop853::new(eq.dim()),
             scales,
-            moment_scale: eq.moment_scale(),
             gauss: None,
             stats: IntegrationStats::default(),
         }
@@ -194,7 +192,7 @@ impl<'a> ShootingSystem<'a> {
                 let mut g = vec![0.0; p];
                 self.eq.tip_residual(&end, &mut g);
                 for i in 0..p {
-                    r[n * (k - 1) + i] = g[i] / self.moment_scale;
+                    r[n * (k - 1) + i] = g[i];
                 }
             }
         }
@@ -251,6 +249,23 @@ impl NonlinearSystem for ShootingSystem<'_> {
         self.eq.unknowns() + self.eq.dim() * (self.segments - 1)
     }
 
+    /// κ(0) (and the other free initial values) in the units of the state
+    /// component they set, node states in the state scales.
+    fn unknown_scales(&self) -> Vec<f64> {
+        let sens = self.eq.initial_sensitivity();
+        let mut scales: Vec<f64> = (0..self.eq.unknowns())
+            .map(|c| {
+                (0..sens.nrows())
+                    .find(|&r| sens[(r, c)] != 0.0)
+                    .map_or(1.0, |r| self.scales[r])
+            })
+            .collect();
+        for _ in 1..self.segments {
+            scales.extend_from_slice(&self.scales);
+        }
+        scales
+    }
+
     fn evaluate(
         &mut self,
         x: &[f64],
@@ -281,10 +296,10 @@ impl NonlinearSystem for ShootingSystem<'_> {
             } else {
                 let mut g = vec![0.0; p];
                 self.eq.tip_residual(&end, &mut g);
-                let gj = self.eq.tip_residual_jacobian(&end) * &phi / self.moment_scale;
+                let gj = self.eq.tip_residual_jacobian(&end) * &phi;
                 let row = n * (k - 1);
                 for i in 0..p {
-                    r[row + i] = g[i] / self.moment_scale;
+                    r[row + i] = g[i];
                     for c in 0..cols {
                         jac[(row + i, col + c)] = gj[(i, c)];
                     }

@@ -399,6 +399,10 @@ pub enum PointError {
     /// Newton at fixed parameter did not converge.
     #[error("Newton did not converge at p = {0}")]
     NoConvergence(f64),
+    /// [F_x F_p] bordered by the previous tangent is singular: no tangent
+    /// (the branch is degenerate there).
+    #[error("no tangent at p = {0}: the bordered Jacobian is singular")]
+    SingularTangent(f64),
 }
 
 /// The angle (rad) between the tip tangent and the clamp tangent.

@@ -22,6 +22,7 @@ pub use tracking::{Spectrum, Tracker};
 
 use nalgebra::{DMatrix, DVector, Vector3};
 
+use crate::bvp::newton::Convergence;
 use crate::bvp::{solve, SolverOptions, Strategy};
 use crate::equations::RodSample;
 use crate::model::{ModelChoice, ModelLevel};
@@ -362,14 +363,15 @@ impl<'a> Run<'a> {
     fn newton_at_fixed_p(&self, mut x: Vec<f64>, p: f64) -> Result<Vec<f64>, PointError> {
         let n = x.len();
         let (mut r, mut j) = (DVector::zeros(n), DMatrix::zeros(n, n));
+        let test = Convergence::new(self.opts.tolerance, vec![1.0; n]);
         for _ in 0..30 {
             self.family.residual(&x, p, &mut r, &mut j)?;
-            if r.amax() <= self.opts.tolerance {
-                return Ok(x);
-            }
             let Some(dx) = j.clone().lu().solve(&(-&r)) else {
                 break;
             };
+            if test.met(r.amax(), &x, dx.as_slice()) {
+                return Ok(x);
+            }
             x.iter_mut().zip(dx.iter()).for_each(|(a, b)| *a += b);
         }
         Err(PointError::NoConvergence(p))
@@ -402,7 +404,9 @@ impl<'a> Run<'a> {
         }
         let mut rhs = DVector::zeros(n + 1);
         rhs[n] = 1.0;
-        let t = bordered_solve(a, &rhs).unwrap_or_else(|| DVector::from_column_slice(previous));
+        let t = bordered_solve(a, &rhs)
+            .filter(|t| t.iter().all(|v| v.is_finite()) && t.norm() > 0.0)
+            .ok_or(PointError::SingularTangent(p))?;
         let t = t.normalize();
         Ok(t.as_slice().to_vec())
     }
@@ -413,6 +417,7 @@ impl<'a> Run<'a> {
         let mut z = pred.to_vec();
         let (mut r, mut fx) = (DVector::zeros(n), DMatrix::zeros(n, n));
         let fp = self.family.parameter_derivative(&z[..n], z[n])?;
+        let test = Convergence::new(self.opts.tolerance, vec![1.0; n + 1]);
         for it in 0..10 {
             if self
                 .family
@@ -426,9 +431,6 @@ impl<'a> Run<'a> {
                 .zip(z.iter().zip(pred))
                 .map(|(t, (a, b))| t * (a - b))
                 .sum();
-            if r.amax() <= self.opts.tolerance && arc.abs() <= 1e-13 {
-                return Ok(Some((z, it, fx)));
-            }
             let mut a = DMatrix::zeros(n + 1, n + 1);
             a.view_mut((0, 0), (n, n)).copy_from(&fx);
             a.view_mut((0, n), (n, 1)).copy_from(&fp);
@@ -441,6 +443,9 @@ impl<'a> Run<'a> {
             let Some(dz) = bordered_solve(a, &rhs) else {
                 return Ok(None);
             };
+            if arc.abs() <= 1e-13 && test.met(r.amax(), &z, dz.as_slice()) {
+                return Ok(Some((z, it, fx)));
+            }
             z.iter_mut().zip(dz.iter()).for_each(|(a, b)| *a += b);
         }
         Ok(None)

@@ -163,7 +163,15 @@ impl Tracker {
                     .map(|&i| pairs.vectors[i].clone())
                     .collect::<Vec<_>>(),
             );
-            block_morse.push(count_below_constrained(k, g, constraints, 0.0));
+            block_morse.push(
+                count_below_constrained(k, g, constraints, 0.0)
+                    .ok_or_else(|| {
+                        PointError::Eigen(format!(
+                            "the Morse index of the {} block cannot be counted (K singular to working precision)",
+                            self.blocks[bi].name()
+                        ))
+                    })?,
+            );
         }
         self.previous = Some(vectors.clone());
         let k = self.opts.eigenvalues;

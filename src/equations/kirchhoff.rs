@@ -157,7 +157,7 @@ impl KirchhoffEquations {
             reaction: st.reaction,
             couple: &self.rod.loads.tip_couple,
         };
-        conditions(support, &tip, self.moment_scale(), l, self.dim())
+        conditions(support, &tip, &self.rod.residual_scales(), self.dim())
     }
 }
 
@@ -272,9 +272,10 @@ impl RodEquations for KirchhoffEquations {
         let st = State::read(y);
         let m = self.rod.energy.moment(self.rod.length, &st.kappa);
         let c = self.rod.loads.tip_couple;
-        r[0] = m[0] - c.dot(&st.d1);
-        r[1] = m[1] - c.dot(&st.d2);
-        r[2] = m[2] - c.dot(&st.d3);
+        let unit = self.rod.residual_scales().moment;
+        r[0] = (m[0] - c.dot(&st.d1)) / unit[0];
+        r[1] = (m[1] - c.dot(&st.d2)) / unit[1];
+        r[2] = (m[2] - c.dot(&st.d3)) / unit[2];
     }
 
     /// ∂/∂κ = H(L); ∂(C·d3)/∂d1 = d2 × C, ∂(C·d3)/∂d2 = C × d1.
@@ -297,6 +298,10 @@ impl RodEquations for KirchhoffEquations {
             for i in 0..3 {
                 g[(i, 6 + j)] = h[(i, j)];
             }
+        }
+        let unit = self.rod.residual_scales().moment;
+        for i in 0..3 {
+            g.row_mut(i).scale_mut(1.0 / unit[i]);
         }
         g
     }
@@ -360,16 +365,12 @@ impl RodEquations for KirchhoffEquations {
         y
     }
 
-    fn moment_scale(&self) -> f64 {
-        self.rod.moment_scale()
-    }
-
     fn state_scales(&self) -> Vec<f64> {
         let l = self.rod.length;
         let mut scales = vec![1.0; self.dim()];
         scales[6..9].fill(1.0 / l);
         scales[9..12].fill(l);
-        scales[12..].fill(self.moment_scale() / l);
+        scales[12..].fill(self.rod.residual_scales().force);
         scales
     }
 }

@@ -58,7 +58,9 @@ pub trait RodEquations: Send + Sync {
         dy: &mut [f64],
         dphi: &mut [f64],
     );
-    /// The tip residuals g(y(L)).
+    /// The tip residuals g(y(L)), each dimensionless in its own unit
+    /// ([`crate::model::Rod::residual_scales`]), so that a max-norm test
+    /// measures every condition on its own scale.
     fn tip_residual(&self, y: &[f64], r: &mut [f64]);
     /// ∂g/∂y at y(L) (unknowns × dim).
     fn tip_residual_jacobian(&self, y: &[f64]) -> DMatrix<f64>;
@@ -75,8 +77,6 @@ pub trait RodEquations: Send + Sync {
     /// A state of the unloaded, straight rod at s: used where no better guess
     /// is available (multiple-shooting nodes after a blow-up).
     fn straight_state(&self, s: f64) -> Vec<f64>;
-    /// A moment scale (N·m) that makes residuals dimensionless.
-    fn moment_scale(&self) -> f64;
     /// A typical magnitude of each state component, to make matching and
     /// collocation residuals dimensionless: lengths L, curvatures 1/L,
     /// angles and directors 1.

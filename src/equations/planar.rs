@@ -98,13 +98,16 @@ impl PlanarEquations {
         k2
     }
 
-    /// The residuals (3) and Jacobian (3 × dim) of a supported tip, as
-    /// moments (positions × M_s/L, angles × M_s, forces × L). The support
+    /// The residuals (3) and Jacobian (3 × dim) of a supported tip, each
+    /// dimensionless in its own unit ([`crate::model::Rod::residual_scales`]:
+    /// positions over L, angles as they are, the axial force over the force
+    /// scale, the moment about d2 over B2/L). The support
     /// is planar (see [`crate::model::ModelChoice`]): targets in the plane,
     /// axes in the plane or, for rotation, along d2 (then free in-plane).
     fn supported_tip(&self, support: &TipSupport, y: &[f64]) -> (Vec<f64>, DMatrix<f64>) {
         let n = self.dim();
-        let (l, ms) = (self.rod.length, self.moment_scale());
+        let l = self.rod.length;
+        let scales = self.rod.residual_scales();
         let c = &self.rod.clamp;
         let (ex, ez) = (c.director(0), c.director(2));
         let target = support.position - c.position;
@@ -114,19 +117,20 @@ impl PlanarEquations {
         match support.translation {
             Freedom::Free => {}
             Freedom::Fixed => {
-                r.push(ms / l * (y[0] - px));
-                g[(0, 0)] = ms / l;
-                r.push(ms / l * (y[1] - pz));
-                g[(1, 1)] = ms / l;
+                r.push((y[0] - px) / l);
+                g[(0, 0)] = 1.0 / l;
+                r.push((y[1] - pz) / l);
+                g[(1, 1)] = 1.0 / l;
             }
             Freedom::Axial(a) => {
                 let (ax, az) = (a.dot(&ex), a.dot(&ez));
-                r.push(ms / l * (-(y[0] - px) * az + (y[1] - pz) * ax));
-                g[(0, 0)] = -ms / l * az;
-                g[(0, 1)] = ms / l * ax;
-                r.push(l * (y[4] * ax + y[5] * az));
-                g[(1, 4)] = l * ax;
-                g[(1, 5)] = l * az;
+                r.push((-(y[0] - px) * az + (y[1] - pz) * ax) / l);
+                g[(0, 0)] = -az / l;
+                g[(0, 1)] = ax / l;
+                let f = scales.force;
+                r.push((y[4] * ax + y[5] * az) / f);
+                g[(1, 4)] = ax / f;
+                g[(1, 5)] = az / f;
             }
         }
         let row = r.len();
@@ -134,14 +138,17 @@ impl PlanarEquations {
             Freedom::Fixed => {
                 let d3 = support.frame.column(2);
                 let target = d3.dot(&ex).atan2(d3.dot(&ez));
-                r.push(ms * (y[2] - target));
-                g[(row, 2)] = ms;
+                r.push(y[2] - target);
+                g[(row, 2)] = 1.0;
             }
             Freedom::Free | Freedom::Axial(_) => {
                 let kappa = Self::kappa(y[3]);
                 let e = &self.rod.energy;
-                r.push(e.moment(l, &kappa)[1] - self.rod.loads.tip_couple.dot(&c.director(1)));
-                g[(row, 3)] = e.stiffness(l, &kappa)[(1, 1)];
+                let m = scales.moment[1];
+                r.push(
+                    (e.moment(l, &kappa)[1] - self.rod.loads.tip_couple.dot(&c.director(1))) / m,
+                );
+                g[(row, 3)] = e.stiffness(l, &kappa)[(1, 1)] / m;
             }
         }
         g = g.rows(0, r.len()).into_owned();
@@ -232,7 +239,8 @@ impl RodEquations for PlanarEquations {
             return;
         }
         let m2 = self.rod.energy.moment(self.rod.length, &Self::kappa(y[3]))[1];
-        r[0] = m2 - self.rod.loads.tip_couple.dot(&self.rod.clamp.director(1));
+        let unit = self.rod.residual_scales().moment[1];
+        r[0] = (m2 - self.rod.loads.tip_couple.dot(&self.rod.clamp.director(1))) / unit;
     }
 
     fn tip_residual_jacobian(&self, y: &[f64]) -> DMatrix<f64> {
@@ -243,7 +251,8 @@ impl RodEquations for PlanarEquations {
             .rod
             .energy
             .stiffness(self.rod.length, &Self::kappa(y[3]))[(1, 1)];
-        DMatrix::from_row_slice(1, 4, &[0.0, 0.0, 0.0, h22])
+        let unit = self.rod.residual_scales().moment[1];
+        DMatrix::from_row_slice(1, 4, &[0.0, 0.0, 0.0, h22 / unit])
     }
 
     fn project(&self, _: &mut [f64]) {}
@@ -303,14 +312,10 @@ impl RodEquations for PlanarEquations {
         y
     }
 
-    fn moment_scale(&self) -> f64 {
-        self.rod.moment_scale()
-    }
-
     fn state_scales(&self) -> Vec<f64> {
         let l = self.rod.length;
         let mut scales = vec![l, l, 1.0, 1.0 / l];
-        scales.resize(self.dim(), self.moment_scale() / l);
+        scales.resize(self.dim(), self.rod.residual_scales().force);
         scales
     }
 }

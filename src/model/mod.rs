@@ -17,6 +17,6 @@ pub use energy::{LinearElastic, QuarticStiffening, StoredEnergy};
 pub use level::{ModelChoice, ModelLevel};
 pub use loads::DeadLoads;
 pub use profile::Profile;
-pub use rod::{Clamp, Rod};
+pub use rod::{Clamp, ResidualScales, Rod};
 pub use shear::Shearable;
 pub use support::{across, Freedom, TipSupport};

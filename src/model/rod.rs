@@ -45,6 +45,17 @@ impl Clamp {
     }
 }
 
+/// The units in which tip residuals are measured ([`Rod::residual_scales`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ResidualScales {
+    /// Moment about each body axis d_i (N·m).
+    pub moment: Vector3<f64>,
+    /// Force (N).
+    pub force: f64,
+    /// Length (m).
+    pub length: f64,
+}
+
 /// A rod clamped at s = 0 under dead loads, free at s = L or held there by
 /// a [`TipSupport`].
 #[derive(Debug, Clone)]
@@ -62,13 +73,57 @@ pub struct Rod {
 }
 
 impl Rod {
-    /// A characteristic moment (N·m) for scaling residuals: the larger of the
-    /// bending moment B/L that curves the rod by one radian and the moments
-    /// of the loads.
+    /// A characteristic moment (N·m) of the whole rod: the larger of the
+    /// largest bending moment B/L that curves the rod by one radian and the
+    /// moments of the loads. Only for order-of-magnitude checks; residuals
+    /// are scaled per equation by [`Rod::residual_scales`].
     pub fn moment_scale(&self) -> f64 {
         let b = self.energy.stiffness(0.0, &Vector3::zeros());
         let stiff = b.diagonal().max() / self.length;
         stiff.max(self.loads.moment_scale(self.length))
+    }
+
+    /// The scale of each kind of tip residual, one per equation so that no
+    /// stiffness ratio can hide an unmet condition: the body moment about
+    /// d_i is measured in H_ii(L)/L (an error of one unit is a curvature
+    /// error of 1/L in that component), or in the loads' moment or the
+    /// intrinsic moment |M_i(s, κ = 0)| of that component where those are
+    /// larger (the integrated curvature is only as accurate as the
+    /// integrator's relative tolerance times its size, and so is a moment
+    /// residual measured in anything smaller); forces in the smallest of
+    /// these over L or the loads' force; positions in L; angles are already
+    /// dimensionless.
+    pub fn residual_scales(&self) -> ResidualScales {
+        let l = self.length;
+        let h = self.energy.stiffness(l, &Vector3::zeros()).diagonal();
+        let loads = self.loads.moment_scale(l);
+        let largest = h.max();
+        let intrinsic = self.intrinsic_moment();
+        let moment = Vector3::from_fn(|i, _| {
+            let bend = if h[i] > 0.0 { h[i] } else { largest };
+            (bend / l)
+                .max(loads)
+                .max(intrinsic[i])
+                .max(f64::MIN_POSITIVE)
+        });
+        let load_force = self.loads.tip_force.norm() + self.loads.distributed_force.norm() * l;
+        ResidualScales {
+            moment,
+            force: (moment.min() / l).max(load_force),
+            length: l,
+        }
+    }
+
+    /// max over s of |M_i(s, κ = 0)|: the moment an intrinsically curved rod
+    /// carries when straightened (B_i |κ⁰_i| for the linear energy), on 65
+    /// points along the rod.
+    fn intrinsic_moment(&self) -> Vector3<f64> {
+        (0..=64)
+            .map(|j| {
+                let s = self.length * f64::from(j) / 64.0;
+                self.energy.moment(s, &Vector3::zeros()).abs()
+            })
+            .fold(Vector3::zeros(), |a, m| a.sup(&m))
     }
 
     /// The same rod under loads scaled by `factor`.

@@ -119,18 +119,19 @@ impl Bordered {
     }
 }
 
-/// The number of eigenvalues below σ of (K, G) on null C (0 when K − σG
-/// has zero pivots at σ and at every nudge, as [`count_below`]).
+/// The number of eigenvalues below σ of (K, G) on null C, or None when it
+/// cannot be decided (K − σG has zero pivots at σ and at every nudge):
+/// undecided, never a default count.
 pub fn count_below_constrained(
     k: &SymmetricBanded,
     g: &SymmetricBanded,
     c: &Constraints,
     sigma: f64,
-) -> usize {
+) -> Option<usize> {
     if c.count() == 0 {
         return count_below(k, g, sigma);
     }
-    try_count_below_constrained(k, g, c, sigma).unwrap_or(0)
+    try_count_below_constrained(k, g, c, sigma)
 }
 
 /// The count, or None when it cannot be decided (persistent zero pivots).
@@ -290,7 +291,7 @@ mod tests {
             assert!(c.apply(v).norm() < 1e-10);
         }
         let sigma = 0.5 * (dense.values[2] + dense.values[3]);
-        assert_eq!(count_below_constrained(&k, &g, &c, sigma), 3);
+        assert_eq!(count_below_constrained(&k, &g, &c, sigma), Some(3));
         // The constraints raise the spectrum (interlacing).
         let free = lowest_eigenpairs_near(&k, &g, 1, None).unwrap();
         assert!(sparse.values[0] > free.values[0]);

@@ -39,20 +39,12 @@ pub enum EigenError {
 pub const DENSE_LIMIT: usize = 48;
 
 /// The number of eigenvalues of (K, G) below σ, from the inertia of K − σG
-/// (a zero pivot nudges σ up by a relative 1e-10 of the spectrum's scale;
-/// should every nudge break down too, the count is reported as 0).
-pub fn count_below(k: &SymmetricBanded, g: &SymmetricBanded, sigma: f64) -> usize {
-    try_count_below(k, g, sigma).unwrap_or(0)
-}
-
-/// [`count_below`], or None when K − σG has a zero pivot at σ and at every
-/// nudge: callers that must stay below the spectrum treat that as "not
-/// below" no longer.
-pub(super) fn try_count_below(
-    k: &SymmetricBanded,
-    g: &SymmetricBanded,
-    sigma: f64,
-) -> Option<usize> {
+/// (Sylvester's law: K − σG ≅ D of its LDLᵀ factors). A zero pivot nudges σ
+/// up by a relative 1e-10 of the spectrum's scale; should every nudge break
+/// down too, a problem of at most [`DENSE_INERTIA_LIMIT`] unknowns counts the
+/// eigenvalues of the dense K − σG (congruent to the pencil's shifted
+/// spectrum), and a larger one is None: undecided, never a default count.
+pub fn count_below(k: &SymmetricBanded, g: &SymmetricBanded, sigma: f64) -> Option<usize> {
     let nudge = 1e-10 * diagonal_ratio(k, g);
     let mut s = sigma;
     for _ in 0..8 {
@@ -61,7 +53,31 @@ pub(super) fn try_count_below(
             Err(PivotBreakdown { .. }) => s += nudge,
         }
     }
-    None
+    dense_count_below(k, g, sigma, nudge)
+}
+
+/// Size up to which an undecidable LDLᵀ inertia is recounted densely.
+pub const DENSE_INERTIA_LIMIT: usize = 1500;
+
+/// The count from the eigenvalues of the dense K − σG, or None when one of
+/// them is within the nudge of zero (σ sits on an eigenvalue) or the
+/// problem is too large to factor densely.
+fn dense_count_below(
+    k: &SymmetricBanded,
+    g: &SymmetricBanded,
+    sigma: f64,
+    nudge: f64,
+) -> Option<usize> {
+    if k.size() > DENSE_INERTIA_LIMIT {
+        return None;
+    }
+    let shifted = k.to_dense() - g.to_dense() * sigma;
+    let values = shifted.symmetric_eigenvalues();
+    let gap = nudge * g.to_dense().diagonal().amax();
+    if values.iter().any(|v| !v.is_finite() || v.abs() <= gap) {
+        return None;
+    }
+    Some(values.iter().filter(|v| **v < 0.0).count())
 }
 
 /// The `count` lowest eigenpairs of K v = λ G v.
@@ -165,7 +181,7 @@ pub(super) fn diagonal_ratio(k: &SymmetricBanded, g: &SymmetricBanded) -> f64 {
 }
 
 fn shift_below_spectrum(k: &SymmetricBanded, g: &SymmetricBanded) -> f64 {
-    shift_below(diagonal_ratio(k, g), |s| try_count_below(k, g, s))
+    shift_below(diagonal_ratio(k, g), |s| count_below(k, g, s))
 }
 
 /// A shift σ < λ_1 close to λ_1, from Sturm counts `count(σ)` (None when

@@ -63,6 +63,10 @@ pub enum StabilityError {
     /// A scene the second variation is not implemented for.
     #[error("not implemented: {0}")]
     Unsupported(String),
+    /// The inertia of K could not be decided (K has a zero pivot at every
+    /// nudge of the shift and is too large to recount densely).
+    #[error("undecided: the inertia of the {0} block cannot be counted (K is singular to working precision: the equilibrium sits on a critical point)")]
+    Undecided(&'static str),
 }
 
 /// The spectrum of one block of K.
@@ -130,7 +134,8 @@ pub fn block_spectrum(
             .iter()
             .map(|v| fe.nodal_rotations(block, v))
             .collect(),
-        morse_index: count_below_constrained(&k, &g, constraints, 0.0),
+        morse_index: count_below_constrained(&k, &g, constraints, 0.0)
+            .ok_or(StabilityError::Undecided(block.name()))?,
     })
 }
 
@@ -212,4 +217,158 @@ pub fn analyze(
         stable: morse_index == 0,
         nodes: fe.nodes(),
     })
+}
+
+/// A stability verdict that states its own certainty.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Verdict {
+    /// K positive definite on meshes that agree, every computed eigenvalue's
+    /// sign beyond its discretization error.
+    Stable,
+    /// K has this many negative eigenvalues, on meshes that agree.
+    Unstable {
+        /// The Morse index.
+        morse_index: usize,
+    },
+    /// The meshes tried disagree, or an eigenvalue is within its
+    /// discretization error of zero: the answer is not known.
+    Undecided {
+        /// Why.
+        reason: String,
+    },
+}
+
+/// The verdict of [`decide`] with the evidence behind it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Decision {
+    /// Stable, unstable or undecided.
+    pub verdict: Verdict,
+    /// The analysis on the finest mesh used.
+    pub stability: Option<Stability>,
+    /// Elements of the finest mesh.
+    pub elements: usize,
+    /// The largest change of a computed eigenvalue between the last two
+    /// meshes: the discretization error estimate of the coarser one, an
+    /// upper bound for the finer (eigenvalues converge at order 2p).
+    pub eigenvalue_error: f64,
+}
+
+/// Meshes tried by [`decide`]: `opts.elements` doubled up to this many
+/// times.
+pub const REFINEMENTS: usize = 5;
+
+/// The stability of an equilibrium on a mesh resolved for its shape:
+/// [`analyze`] on N, 2N, 4N, … elements (N from `opts`) until two
+/// successive meshes give the same Morse index in every block and no
+/// computed eigenvalue lies within its change between them of zero; the
+/// eigenvalue just above the Morse index is always among those computed,
+/// so that the sign nearest to changing is the one checked. Undecided when
+/// that does not happen within [`REFINEMENTS`] doublings, or when the
+/// inertia itself cannot be counted.
+pub fn decide(
+    rod: &Rod,
+    eq: &Equilibrium,
+    solver: &SolverOptions,
+    opts: &StabilityOptions,
+) -> Result<Decision, StabilityError> {
+    let mut opts = *opts;
+    let mut previous: Option<Stability> = None;
+    let mut last_error = f64::INFINITY;
+    for _ in 0..=REFINEMENTS {
+        let current = match analyze(rod, eq, solver, &opts) {
+            Ok(st) => st,
+            Err(StabilityError::Undecided(block)) => {
+                return Ok(undecided(
+                    format!(
+                        "the inertia of the {block} block cannot be counted on {} elements",
+                        opts.elements
+                    ),
+                    previous,
+                    opts.elements,
+                ))
+            }
+            Err(e) => return Err(e),
+        };
+        if let Some(prev) = &previous {
+            if let Some(error) = settled(prev, &current) {
+                let verdict = if current.morse_index == 0 {
+                    Verdict::Stable
+                } else {
+                    Verdict::Unstable {
+                        morse_index: current.morse_index,
+                    }
+                };
+                return Ok(Decision {
+                    verdict,
+                    stability: Some(current),
+                    elements: opts.elements,
+                    eigenvalue_error: error,
+                });
+            }
+            last_error = eigenvalue_change(prev, &current);
+        }
+        let most = current
+            .blocks
+            .iter()
+            .map(|b| b.morse_index)
+            .max()
+            .unwrap_or(0);
+        opts.eigenvalues = opts.eigenvalues.max(most + 1);
+        previous = Some(current);
+        opts.elements *= 2;
+    }
+    let elements = opts.elements / 2;
+    let mut decision = undecided(
+        format!("the Morse index or the sign of an eigenvalue still changes between {} and {elements} elements", elements / 2),
+        previous,
+        elements,
+    );
+    decision.eigenvalue_error = last_error;
+    Ok(decision)
+}
+
+fn undecided(reason: String, stability: Option<Stability>, elements: usize) -> Decision {
+    Decision {
+        verdict: Verdict::Undecided { reason },
+        stability,
+        elements,
+        eigenvalue_error: f64::INFINITY,
+    }
+}
+
+/// The eigenvalue error estimate when `fine` confirms `coarse` (same Morse
+/// index in every block, every computed eigenvalue of `fine` farther from
+/// zero than its change), else None.
+fn settled(coarse: &Stability, fine: &Stability) -> Option<f64> {
+    let same_index = coarse
+        .blocks
+        .iter()
+        .zip(&fine.blocks)
+        .all(|(a, b)| a.morse_index == b.morse_index && b.eigenvalues.len() > b.morse_index);
+    if !same_index {
+        return None;
+    }
+    let mut worst: f64 = 0.0;
+    for (a, b) in coarse.blocks.iter().zip(&fine.blocks) {
+        for (x, y) in a.eigenvalues.iter().zip(&b.eigenvalues) {
+            let change = (x - y).abs();
+            // (a NaN on either side is not a settled sign either)
+            if y.abs().partial_cmp(&change) != Some(std::cmp::Ordering::Greater) {
+                return None;
+            }
+            worst = worst.max(change);
+        }
+    }
+    Some(worst)
+}
+
+/// The largest change of a computed eigenvalue between two meshes.
+fn eigenvalue_change(coarse: &Stability, fine: &Stability) -> f64 {
+    coarse
+        .blocks
+        .iter()
+        .zip(&fine.blocks)
+        .flat_map(|(a, b)| a.eigenvalues.iter().zip(&b.eigenvalues))
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
 }
