@@ -137,14 +137,9 @@ fn held_frame_is_not_met_by_the_flipped_frame() {
     assert!(converged >= 3, "only {converged} starts converged");
 }
 
-/// A looped equilibrium of a long soft cantilever (L = 30, k = F L²/B = 2700,
-/// all loads at once): the verdict comes from a mesh refined until the
-/// Morse index settles, and agrees with the index on a far finer mesh of
-/// higher order (a convergence study, independent of the refinement rule).
-/// The old fixed 40-element mesh called such shapes stable.
-#[test]
-fn verdict_comes_from_a_resolved_mesh() {
-    use cosserat::stability::{analyze, decide, StabilityOptions, Verdict};
+/// The looped equilibrium that single shooting reaches when all the load of
+/// a long soft cantilever (L = 30, k = 2700) is applied at once.
+fn looped_equilibrium() -> (Rod, SolverOptions, cosserat::bvp::Equilibrium) {
     let mut rod = cantilever(10.0, 10.0);
     rod.length = 30.0;
     let model = ModelChoice::for_rod(&rod);
@@ -153,6 +148,18 @@ fn verdict_comes_from_a_resolved_mesh() {
         ..Default::default()
     };
     let eq = solve(&rod, &model, &opts).unwrap();
+    (rod, opts, eq)
+}
+
+/// A looped equilibrium of a long soft cantilever (L = 30, k = F L²/B = 2700,
+/// all loads at once): the verdict comes from a mesh refined until the
+/// Morse index settles, and agrees with the index on a far finer mesh of
+/// higher order (a convergence study, independent of the refinement rule).
+/// The old fixed 40-element mesh called such shapes stable.
+#[test]
+fn verdict_comes_from_a_resolved_mesh() {
+    use cosserat::stability::{analyze, decide, StabilityOptions, Verdict};
+    let (rod, opts, eq) = looped_equilibrium();
     let decision = decide(&rod, &eq, &opts, &StabilityOptions::default()).unwrap();
     let fine = analyze(
         &rod,
@@ -183,14 +190,7 @@ fn verdict_comes_from_a_resolved_mesh() {
 #[test]
 fn coarse_verdict_is_never_a_default() {
     use cosserat::stability::{decide, StabilityOptions, Verdict};
-    let mut rod = cantilever(10.0, 10.0);
-    rod.length = 30.0;
-    let model = ModelChoice::for_rod(&rod);
-    let opts = SolverOptions {
-        strategy: Strategy::Direct,
-        ..Default::default()
-    };
-    let eq = solve(&rod, &model, &opts).unwrap();
+    let (rod, opts, eq) = looped_equilibrium();
     let decision = decide(
         &rod,
         &eq,
