@@ -45,7 +45,7 @@ pub fn run(command: BenchCommand) -> ExitCode {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => {
                 eprintln!("error: {e}");
-                ExitCode::from(1)
+                ExitCode::from(3)
             }
         },
     }

@@ -120,9 +120,9 @@ pub enum Command {
         /// Compute shard i of n (0 ≤ i < n): every n-th line of the grid.
         #[arg(long, value_name = "I/N")]
         shard: Option<String>,
-        /// Worker threads (default: all cores).
-        #[arg(long)]
-        threads: Option<usize>,
+        /// Worker threads (default: all cores; at most 4 per core).
+        #[arg(long, value_parser = clap::value_parser!(u16).range(1..=1024))]
+        threads: Option<u16>,
         /// Go on with an interrupted or killed sweep saved in the output file.
         #[arg(long)]
         resume: bool,
@@ -161,6 +161,9 @@ pub enum Command {
         /// Vertical axis: tip_x, tip_y, tip_z, norm or tip_angle.
         #[arg(long, default_value = "tip_x")]
         measure: String,
+        /// Overwrite an existing figure.
+        #[arg(long)]
+        force: bool,
     },
     /// Benchmarks: `cosserat bench work-precision [-o DIR]`.
     Bench {

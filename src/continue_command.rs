@@ -4,19 +4,26 @@
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use cosserat::continuation::{continuation, Diagram, Progress};
-use cosserat::io::{check_target, read_saved, write_diagram, Problem, MEASURES};
+use cosserat::io::target::replace_atomically;
+use cosserat::io::{read_saved, write_diagram, Problem, MEASURES};
 use cosserat::plot::{draw, read_diagram};
 use indicatif::{ProgressBar, ProgressStyle};
 
-use crate::fail;
+use crate::exit::{fail, BAD_INPUT, INTERRUPTED, NO_RESULT, OUTPUT};
+use crate::signals;
 
 /// How often a growing diagram is saved.
 const CHECKPOINT: Duration = Duration::from_secs(2);
+
+/// A string key of the `[continuation]` table of the effective problem
+/// text (the parsed value, never a scan of the raw text).
+fn section_key(text: &str, key: &str) -> Option<String> {
+    let table: toml::Table = toml::from_str(text).ok()?;
+    Some(table.get("continuation")?.get(key)?.as_str()?.to_string())
+}
 
 /// Runs the continuation of a problem file.
 pub fn run_continue(
@@ -29,22 +36,28 @@ pub fn run_continue(
 ) -> ExitCode {
     let problem = match Problem::from_path(&path, set) {
         Ok(p) => p,
-        Err(e) => return fail(2, format!("{}: {e}", path.display())),
+        Err(e) => return fail(BAD_INPUT, format!("{}: {e}", path.display())),
     };
     let Some((family, opts)) = &problem.continuation else {
         return fail(
-            2,
+            BAD_INPUT,
             format!(
                 "{}: continuation: the problem has no [continuation] table",
                 path.display()
             ),
         );
     };
+    let mut outputs: Vec<&Path> = vec![&output];
+    outputs.extend(plot.as_deref());
+    let _claims = match crate::claim_outputs(&outputs, &[&path], force || resume) {
+        Ok(c) => c,
+        Err(code) => return code,
+    };
     let saved = if resume && output.exists() {
         match read_saved(&output) {
             Ok((text, _)) if text != problem.text => {
                 return fail(
-                    2,
+                    BAD_INPUT,
                     format!(
                         "{}: made from a different problem (or other --set values); cannot resume",
                         output.display()
@@ -56,29 +69,24 @@ pub fn run_continue(
                 return ExitCode::SUCCESS;
             }
             Ok((_, saved)) => Some(saved),
-            Err(e) => return fail(2, format!("{}: cannot resume: {e}", output.display())),
+            Err(e) => {
+                return fail(
+                    BAD_INPUT,
+                    format!("{}: cannot resume: {e}", output.display()),
+                )
+            }
         }
     } else {
-        if let Err(e) = check_target(&output, force) {
-            return fail(2, e);
+        if resume && !force {
+            println!(
+                "nothing to resume: {} does not exist; starting",
+                output.display()
+            );
         }
         None
     };
-    let parameter_name = problem
-        .text
-        .lines()
-        .find(|l| l.trim_start().starts_with("parameter"))
-        .map_or_else(
-            || format!("{:?}", family.parameter()),
-            |l| {
-                l.split('=')
-                    .nth(1)
-                    .unwrap_or("")
-                    .trim()
-                    .trim_matches('"')
-                    .to_string()
-            },
-        );
+    let parameter_name = section_key(&problem.text, "parameter")
+        .unwrap_or_else(|| format!("{:?}", family.parameter()));
     println!("problem   {}", path.display());
     println!(
         "model     {} ({})",
@@ -89,22 +97,10 @@ pub fn run_continue(
         "continue  {parameter_name} from {} in [{}, {}]",
         opts.start, opts.bounds.0, opts.bounds.1
     );
-    let interrupted = Arc::new(AtomicBool::new(false));
-    {
-        let flag = interrupted.clone();
-        let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
-    }
-    let bar = if std::io::stderr().is_terminal() {
-        let b = ProgressBar::new_spinner();
-        b.set_style(
-            ProgressStyle::with_template("{spinner} {msg} [{elapsed}]").expect("a valid template"),
-        );
-        b
-    } else {
-        ProgressBar::hidden()
-    };
+    let bar = spinner();
     let start = Instant::now();
     let mut last_save = Instant::now();
+    let mut checkpoint_error = None;
     let mut monitor = |progress: Progress, diagram: &Diagram| {
         bar.set_message(format!(
             "{} points, branch {}, parameter {:.6}",
@@ -112,10 +108,12 @@ pub fn run_continue(
         ));
         bar.tick();
         if last_save.elapsed() >= CHECKPOINT {
-            let _ = write_diagram(&output, &problem.text, &parameter_name, diagram, true);
+            if let Err(e) = write_diagram(&output, &problem.text, &parameter_name, diagram, true) {
+                checkpoint_error.get_or_insert_with(|| e.to_string());
+            }
             last_save = Instant::now();
         }
-        !interrupted.load(Ordering::SeqCst)
+        !signals::requested()
     };
     if let Some(saved) = &saved {
         let points: usize = saved.branches.iter().map(|b| b.parameter.len()).sum();
@@ -129,37 +127,79 @@ pub fn run_continue(
         Some(saved) => cosserat::continuation::resume(family, opts, saved, &mut monitor),
         None => continuation(family, opts, &mut monitor),
     };
+    bar.finish_and_clear();
+    if let Some(e) = checkpoint_error {
+        eprintln!("warning: a checkpoint was not written: {e}");
+    }
     let diagram = match outcome {
         Ok(d) => d,
-        Err(e) => return fail(2, e),
+        Err(e) => return fail(NO_RESULT, e),
     };
-    bar.finish_and_clear();
     let elapsed = start.elapsed();
     report(&diagram);
     println!("time      {:.1} ms", elapsed.as_secs_f64() * 1e3);
     if let Err(e) = write_diagram(&output, &problem.text, &parameter_name, &diagram, true) {
-        return fail(1, e);
+        return fail(OUTPUT, e);
     }
     println!("written   {}", output.display());
-    if let Some(png) = plot {
-        // The validated `[continuation] measure` of the problem text.
-        let table: Option<toml::Table> = toml::from_str(&problem.text).ok();
-        let measure = table
-            .as_ref()
-            .and_then(|t| t.get("continuation")?.get("measure")?.as_str())
-            .unwrap_or("tip_x");
-        if let Err(e) = plot_file(&output, measure, &png) {
-            return fail(1, e);
-        }
-    }
     if diagram.stop_reason == "interrupted" {
         eprintln!(
-            "interrupted: every point computed so far is in {}",
+            "interrupted: every point computed so far is in {}; go on with --resume",
             output.display()
         );
-        return ExitCode::from(130);
+        return ExitCode::from(INTERRUPTED);
+    }
+    if let Some(png) = plot {
+        let measure = section_key(&problem.text, "measure").unwrap_or_else(|| "tip_x".into());
+        if let Err(e) = plot_file(&output, &measure, &png) {
+            return fail(OUTPUT, e);
+        }
     }
     ExitCode::SUCCESS
+}
+
+/// A spinner on a terminal; plain lines every few seconds elsewhere are
+/// left to the checkpoints.
+fn spinner() -> ProgressBar {
+    if !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let b = ProgressBar::new_spinner();
+    b.set_style(
+        ProgressStyle::with_template("{spinner} {msg} [{elapsed}]").expect("a valid template"),
+    );
+    b
+}
+
+/// `cosserat plot`: the chart of a diagram file, claimed like every output
+/// (never the input, never a non-regular file, `--force` to replace).
+pub fn run_plot(diagram: &Path, measure: &str, output: &Path, force: bool) -> ExitCode {
+    if !MEASURES.contains(&measure) {
+        return fail(
+            BAD_INPUT,
+            format!("--measure: unknown measure `{measure}`; expected one of {MEASURES:?}"),
+        );
+    }
+    let _claims = match crate::claim_outputs(&[output], &[diagram], force) {
+        Ok(c) => c,
+        Err(code) => return code,
+    };
+    let data = match read_diagram(diagram) {
+        Ok(d) => d,
+        Err(e) => {
+            return fail(
+                BAD_INPUT,
+                format!("{}: not a diagram file: {e}", diagram.display()),
+            )
+        }
+    };
+    match replace_atomically(output, |tmp| draw(&data, measure, tmp)) {
+        Ok(()) => {
+            println!("plotted   {}", output.display());
+            ExitCode::SUCCESS
+        }
+        Err(e) => fail(OUTPUT, e),
+    }
 }
 
 fn report(d: &Diagram) {
@@ -192,7 +232,7 @@ fn report(d: &Diagram) {
     }
 }
 
-/// Draws a diagram file.
+/// Draws a diagram file (the output already claimed by the caller).
 pub fn plot_file(input: &Path, measure: &str, out: &Path) -> Result<(), String> {
     if !MEASURES.contains(&measure) {
         return Err(format!(
@@ -200,7 +240,7 @@ pub fn plot_file(input: &Path, measure: &str, out: &Path) -> Result<(), String> 
         ));
     }
     let data = read_diagram(input).map_err(|e| format!("{}: {e}", input.display()))?;
-    draw(&data, measure, out).map_err(|e| format!("{}: {e}", out.display()))?;
+    replace_atomically(out, |tmp| draw(&data, measure, tmp))?;
     println!("plotted   {}", out.display());
     Ok(())
 }

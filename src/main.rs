@@ -1,23 +1,31 @@
-//! The `cosserat` command.
-//!
-//! Exit codes: 0 success, 2 bad input or a solver that did not converge
-//! (nothing is written then), 1 an unexpected failure writing output.
+//! The `cosserat` command. Exit codes: [`exit`] (one table, also in the
+//! README); SIGINT, SIGTERM and SIGHUP: [`signals`].
 
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 mod continue_command;
+mod exit;
 mod optimize_command;
+mod signals;
 mod sweep_command;
 
 use clap::Parser;
 use cosserat::bvp::{solve, Equilibrium};
 use cosserat::cli::{Cli, Command};
-use cosserat::io::{check_target, write_equilibrium, write_stability, Problem, StabilityResult};
+use cosserat::io::target::{claim, Claim};
+use cosserat::io::{write_equilibrium, write_stability, Problem, StabilityResult};
 use cosserat::stability::{analyze, critical_load, CriticalLoad, Stability};
+use exit::{fail, BAD_INPUT, NO_RESULT, OUTPUT};
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    signals::install(match cli.command {
+        Command::Continue { .. } | Command::Optimize { .. } | Command::Sweep { .. } => {
+            signals::Mode::NextPoint
+        }
+        _ => signals::Mode::Immediate,
+    });
     match cli.command {
         Command::Solve {
             problem,
@@ -95,33 +103,52 @@ fn main() -> ExitCode {
             diagram,
             output,
             measure,
-        } => match continue_command::plot_file(&diagram, &measure, &output) {
-            Ok(()) => ExitCode::SUCCESS,
-            Err(e) => fail(2, e),
-        },
+            force,
+        } => continue_command::run_plot(&diagram, &measure, &output, force),
         Command::Bench { which } => cosserat::bench::run(which),
         Command::Validate(args) => cosserat::validate::run_cli(args),
     }
 }
 
-/// Reads the problem and checks the output target before any work.
+/// Reads the problem and claims the output before any work.
 fn prepare(
     path: &std::path::Path,
     output: &Option<PathBuf>,
     set: &[String],
     force: bool,
-) -> Result<Problem, ExitCode> {
-    let problem =
-        Problem::from_path(path, set).map_err(|e| fail(2, format!("{}: {e}", path.display())))?;
-    if let Some(out) = output {
-        check_target(out, force).map_err(|e| fail(2, e))?;
-    }
+) -> Result<(Problem, Option<Claim>), ExitCode> {
+    let problem = Problem::from_path(path, set)
+        .map_err(|e| fail(BAD_INPUT, format!("{}: {e}", path.display())))?;
+    let claimed = output
+        .as_ref()
+        .map(|out| claim(out, &[path], force).map(hold))
+        .transpose()
+        .map_err(|e| fail(BAD_INPUT, e))?;
     println!("problem   {}", path.display());
-    Ok(problem)
+    Ok((problem, claimed))
+}
+
+/// Registers a claim's scratch files for removal on an immediate stop.
+pub(crate) fn hold(claim: Claim) -> Claim {
+    for f in claim.scratch_files() {
+        signals::litter(f);
+    }
+    claim
+}
+
+/// Claims every output of a command (none named twice, none an input).
+pub(crate) fn claim_outputs(
+    outputs: &[&std::path::Path],
+    inputs: &[&std::path::Path],
+    replace: bool,
+) -> Result<Vec<Claim>, ExitCode> {
+    cosserat::io::target::claim_all(outputs, inputs, replace)
+        .map(|claims| claims.into_iter().map(hold).collect())
+        .map_err(|e| fail(BAD_INPUT, e))
 }
 
 fn run_stability(path: PathBuf, output: Option<PathBuf>, set: &[String], force: bool) -> ExitCode {
-    let problem = match prepare(&path, &output, set, force) {
+    let (problem, _claim) = match prepare(&path, &output, set, force) {
         Ok(p) => p,
         Err(code) => return code,
     };
@@ -136,7 +163,7 @@ fn run_stability(path: PathBuf, output: Option<PathBuf>, set: &[String], force: 
                 report_critical(&c);
                 StabilityResult::FixedShape(c)
             }
-            Err(e) => return fail(2, e),
+            Err(e) => return fail(NO_RESULT, e),
         },
         None => {
             println!(
@@ -146,20 +173,20 @@ fn run_stability(path: PathBuf, output: Option<PathBuf>, set: &[String], force: 
             );
             let eq = match solve(&problem.rod, &problem.model, &problem.options) {
                 Ok(eq) => eq,
-                Err(e) => return fail(2, e),
+                Err(e) => return fail(NO_RESULT, e),
             };
             match analyze(&problem.rod, &eq, &problem.options, opts) {
                 Ok(st) => {
                     report_spectrum(&st);
                     StabilityResult::Equilibrium(Box::new(eq), st)
                 }
-                Err(e) => return fail(2, e),
+                Err(e) => return fail(NO_RESULT, e),
             }
         }
     };
     if let Some(out) = output {
-        if let Err(e) = write_stability(&out, &problem.text, &result, force) {
-            return fail(1, e);
+        if let Err(e) = write_stability(&out, &problem.text, &result, true) {
+            return fail(OUTPUT, e);
         }
         println!("written   {}", out.display());
     }
@@ -199,19 +226,14 @@ fn report_critical(c: &CriticalLoad) {
     }
 }
 
-pub(crate) fn fail(code: u8, message: impl std::fmt::Display) -> ExitCode {
-    eprintln!("error: {message}");
-    ExitCode::from(code)
-}
-
 fn run_solve(path: PathBuf, output: Option<PathBuf>, set: &[String], force: bool) -> ExitCode {
-    let problem = match prepare(&path, &output, set, force) {
+    let (problem, _claim) = match prepare(&path, &output, set, force) {
         Ok(p) => p,
         Err(code) => return code,
     };
     if problem.shape.is_some() {
         return fail(
-            2,
+            BAD_INPUT,
             "a fixed-shape scene ([shape]) has no fixed intrinsic curvature to solve for; \
              use `cosserat stability`",
         );
@@ -224,7 +246,7 @@ fn run_solve(path: PathBuf, output: Option<PathBuf>, set: &[String], force: bool
     println!("energy    {}", problem.rod.energy.name());
     let eq = match solve(&problem.rod, &problem.model, &problem.options) {
         Ok(eq) => eq,
-        Err(e) => return fail(2, e),
+        Err(e) => return fail(NO_RESULT, e),
     };
     report(&eq);
     verdict(&problem, &eq);
@@ -233,7 +255,7 @@ fn run_solve(path: PathBuf, output: Option<PathBuf>, set: &[String], force: bool
         // Belt and braces: solve() returns only converged results, but a
         // result whose residual exceeds the tolerance is never written.
         return fail(
-            2,
+            NO_RESULT,
             format!(
                 "residual {:.3e} exceeds the tolerance {tolerance:.1e}",
                 eq.residual
@@ -241,8 +263,8 @@ fn run_solve(path: PathBuf, output: Option<PathBuf>, set: &[String], force: bool
         );
     }
     if let Some(out) = output {
-        if let Err(e) = write_equilibrium(&out, &eq, &problem.text, force) {
-            return fail(1, e);
+        if let Err(e) = write_equilibrium(&out, &eq, &problem.text, true) {
+            return fail(OUTPUT, e);
         }
         println!("written   {}", out.display());
     }

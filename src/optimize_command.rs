@@ -7,13 +7,15 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use cosserat::arm_chart::{draw_arm, ArmChart};
-use cosserat::io::{check_target, read_search, write_arm_study, ArmStudy, Problem};
+use cosserat::io::target::{replace_atomically, Claim};
+use cosserat::io::{read_search, write_arm_study, ArmStudy, Problem};
 use cosserat::optimize::{
     ArmOptimum, ArmProblem, ArmScene, ArmWeight, ClosestStraight, ReachMap, SearchOptions,
     SearchProgress, StraightArm,
 };
 
-use crate::fail;
+use crate::exit::{fail, BAD_INPUT, INTERRUPTED, NO_RESULT, OUTPUT};
+use crate::signals;
 
 /// How often a running search is saved (a kill loses at most this much).
 const CHECKPOINT: std::time::Duration = std::time::Duration::from_secs(2);
@@ -59,13 +61,17 @@ pub fn run_optimize(run: OptimizeRun) -> ExitCode {
     let path = &run.path;
     let problem = match Problem::from_path(path, &run.set) {
         Ok(p) => p,
-        Err(e) => return fail(2, format!("{}: {e}", path.display())),
+        Err(e) => return fail(BAD_INPUT, format!("{}: {e}", path.display())),
+    };
+    let _claims = match claim_outputs(&run) {
+        Ok(c) => c,
+        Err(code) => return code,
     };
     let (Some((arm, search, straight)), Some((scene, map_samples))) =
         (&problem.arm, &problem.arm_scene)
     else {
         return fail(
-            2,
+            BAD_INPUT,
             format!("{}: arm: the problem has no [arm] table", path.display()),
         );
     };
@@ -82,7 +88,7 @@ pub fn run_optimize(run: OptimizeRun) -> ExitCode {
             format!(" that the actuator limit arm.max_curvature = {k} can hold")
         });
         return fail(
-            2,
+            NO_RESULT,
             format!(
                 "arm.bounds: no design with a finite critical load{limit} was found in the bounds"
             ),
@@ -132,12 +138,7 @@ fn run_search(
     scene: &ArmScene,
     progress: SearchProgress,
 ) -> (Option<ArmOptimum>, SearchProgress, bool) {
-    let interrupted = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
-    {
-        let flag = interrupted.clone();
-        let _ = ctrlc::set_handler(move || flag.store(true, std::sync::atomic::Ordering::SeqCst));
-    }
-    let stop = || interrupted.load(std::sync::atomic::Ordering::SeqCst);
+    let stop = signals::requested;
     let mut last_save = Instant::now();
     let mut checkpoint = |p: &SearchProgress| {
         if last_save.elapsed() < CHECKPOINT {
@@ -215,7 +216,7 @@ fn write_study(
             progress: Some(progress),
             stop_reason: "completed",
         };
-        write_arm_study(out, text, &study, true).map_err(|e| fail(1, e))?;
+        write_arm_study(out, text, &study, true).map_err(|e| fail(OUTPUT, e))?;
         println!("written   {}", out.display());
     }
     if let Some(out) = &run.plot {
@@ -225,14 +226,35 @@ fn write_study(
             closest: extras.closest.as_ref(),
             straight,
         };
-        draw_arm(&chart, out).map_err(|e| fail(1, format!("{}: {e}", out.display())))?;
+        replace_atomically(out, |tmp| draw_arm(&chart, tmp)).map_err(|e| fail(OUTPUT, e))?;
         println!("plotted   {}", out.display());
     }
     Ok(())
 }
 
+/// Claims every file the run will write (the study, the paths and the
+/// charts beside them, the figure) before any work.
+fn claim_outputs(run: &OptimizeRun) -> Result<Vec<Claim>, ExitCode> {
+    let charts: Vec<PathBuf> = [&run.loading_path, &run.control_path, &run.holding_path]
+        .into_iter()
+        .flatten()
+        .map(|p| p.with_extension("png"))
+        .collect();
+    let outputs: Vec<&Path> = run
+        .output
+        .iter()
+        .chain(&run.loading_path)
+        .chain(&run.control_path)
+        .chain(&run.holding_path)
+        .chain(&run.plot)
+        .chain(&charts)
+        .map(PathBuf::as_path)
+        .collect();
+    crate::claim_outputs(&outputs, &[&run.path], run.force || run.resume)
+}
+
 /// The search progress to start from: fresh, or what an interrupted run
-/// kept in the output file (`--resume`). Checks every target first.
+/// kept in the output file (`--resume`).
 fn start_from(
     run: &OptimizeRun,
     problem: &Problem,
@@ -241,27 +263,19 @@ fn start_from(
 ) -> Result<SearchProgress, ExitCode> {
     let resumable = run.resume && run.output.as_ref().is_some_and(|o| o.exists());
     if run.resume && run.output.is_none() {
-        return Err(fail(2, "--resume needs the output file (-o) of the run"));
-    }
-    let targets = run
-        .output
-        .iter()
-        .filter(|_| !resumable)
-        .chain(&run.loading_path)
-        .chain(&run.control_path)
-        .chain(&run.holding_path)
-        .chain(&run.plot);
-    for out in targets {
-        check_target(out, run.force).map_err(|e| fail(2, e))?;
+        return Err(fail(
+            BAD_INPUT,
+            "--resume needs the output file (-o) of the run",
+        ));
     }
     let Some(out) = run.output.as_ref().filter(|_| resumable) else {
         return Ok(SearchProgress::default());
     };
-    let saved =
-        read_search(out).map_err(|e| fail(2, format!("{}: cannot resume: {e}", out.display())))?;
+    let saved = read_search(out)
+        .map_err(|e| fail(BAD_INPUT, format!("{}: cannot resume: {e}", out.display())))?;
     if saved.problem != problem.text {
         return Err(fail(
-            2,
+            BAD_INPUT,
             format!(
                 "{}: made from a different problem (or other --set values); cannot resume",
                 out.display()
@@ -319,14 +333,14 @@ fn keep_interrupted(
     );
     if let Some(out) = &run.output {
         if let Err(e) = write_arm_study(out, text, &interrupted_study(opt, progress), true) {
-            return fail(1, e);
+            return fail(OUTPUT, e);
         }
         eprintln!(
             "interrupted: the best design so far is in {}; go on with --resume",
             out.display()
         );
     }
-    ExitCode::from(130)
+    ExitCode::from(INTERRUPTED)
 }
 
 fn report_optimum(opt: &ArmOptimum, time: f64) {
@@ -417,10 +431,10 @@ fn write_path(
     };
     let diagram = match diagram {
         Ok(d) => d,
-        Err(e) => return fail(2, format!("{} path: {e}", kind.name)),
+        Err(e) => return fail(NO_RESULT, format!("{} path: {e}", kind.name)),
     };
     let Some(last) = diagram.branches.first().and_then(|b| b.points.last()) else {
-        return fail(2, format!("{} path: no point", kind.name));
+        return fail(NO_RESULT, format!("{} path: no point", kind.name));
     };
     let scale = opt.scene.length(opt.design.gamma);
     let designed = opt.loaded_shape.last().map(|r| r.map(|v| v / scale));
@@ -446,11 +460,11 @@ fn write_path(
         );
     }
     if let Err(e) = cosserat::io::write_diagram(out, &problem.text, kind.axis, &diagram, true) {
-        return fail(1, e);
+        return fail(OUTPUT, e);
     }
     let chart = out.with_extension("png");
     if let Err(e) = crate::continue_command::plot_file(out, "tip_z", &chart) {
-        return fail(1, e);
+        return fail(OUTPUT, e);
     }
     println!("written   {}", out.display());
     ExitCode::SUCCESS

@@ -5,15 +5,16 @@
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
-use cosserat::io::{check_target, read_sweep, write_sweep, Problem, Sweep, SweepHeader};
+use cosserat::io::target::{replace_atomically, Claim};
+use cosserat::io::{read_sweep, write_sweep, Problem, Sweep, SweepHeader};
 use cosserat::sweep::{figure, run, ArmJob, Job, Record, Shard, SolveJob, SweepPlan};
 use indicatif::{ProgressBar, ProgressStyle};
 
-use crate::fail;
+use crate::exit::{fail, BAD_INPUT, INTERRUPTED, OUTPUT};
+use crate::signals;
 
 /// How often a running sweep saves its finished points.
 const CHECKPOINT: Duration = Duration::from_secs(1);
@@ -23,7 +24,7 @@ pub struct SweepArgs {
     pub path: PathBuf,
     pub output: PathBuf,
     pub shard: Option<String>,
-    pub threads: Option<usize>,
+    pub threads: Option<u16>,
     pub resume: bool,
     pub plot: Option<PathBuf>,
     pub set: Vec<String>,
@@ -37,6 +38,8 @@ struct Setup {
     shard: Shard,
     done: Vec<Record>,
     job: Box<dyn Job>,
+    threads: usize,
+    _claims: Vec<Claim>,
 }
 
 /// Runs a sweep.
@@ -52,7 +55,8 @@ pub fn run_sweep(args: SweepArgs) -> ExitCode {
 /// `[sweep]` table, every grid point's problem, the shard, the output (or
 /// the file to resume). Ok(None): nothing left to do.
 fn prepare(args: &SweepArgs) -> Result<Option<Setup>, ExitCode> {
-    let at = |e: &dyn std::fmt::Display| fail(2, format!("{}: {e}", args.path.display()));
+    let at = |e: &dyn std::fmt::Display| fail(BAD_INPUT, format!("{}: {e}", args.path.display()));
+    let threads = threads(args.threads)?;
     let problem = Problem::from_path(&args.path, &args.set).map_err(|e| at(&e))?;
     let mut sweep = problem
         .sweep
@@ -61,7 +65,7 @@ fn prepare(args: &SweepArgs) -> Result<Option<Setup>, ExitCode> {
     // Warm starts are for the arm's search; solves run point by point.
     sweep.warm_start &= problem.arm.is_some();
     let shard = match &args.shard {
-        Some(s) => Shard::parse(s).map_err(|e| fail(2, e))?,
+        Some(s) => Shard::parse(s).map_err(|e| fail(BAD_INPUT, format!("--shard: {e}")))?,
         None => Shard::ALL,
     };
     let plan = SweepPlan {
@@ -86,13 +90,15 @@ fn prepare(args: &SweepArgs) -> Result<Option<Setup>, ExitCode> {
         None => Box::new(SolveJob),
     };
     let expected = header(&problem, &sweep, shard, job.kind(), "running");
+    let mut outputs: Vec<&Path> = vec![&args.output];
+    outputs.extend(args.plot.as_deref());
+    let claims = crate::claim_outputs(&outputs, &[&args.path], args.force || args.resume)?;
     let done = if args.resume && args.output.exists() {
         match resumable(&args.output, &expected)? {
             Some(done) => done,
             None => return Ok(None),
         }
     } else {
-        check_target(&args.output, args.force).map_err(|e| fail(2, e))?;
         vec![]
     };
     Ok(Some(Setup {
@@ -101,7 +107,25 @@ fn prepare(args: &SweepArgs) -> Result<Option<Setup>, ExitCode> {
         shard,
         done,
         job,
+        threads,
+        _claims: claims,
     }))
+}
+
+/// The worker threads asked for (0: one per core), at most four per core.
+fn threads(asked: Option<u16>) -> Result<usize, ExitCode> {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    match asked.map(usize::from) {
+        None => Ok(0),
+        Some(n) if n <= 4 * cores => Ok(n),
+        Some(n) => Err(fail(
+            BAD_INPUT,
+            format!(
+                "--threads {n}: this machine has {cores} cores; more than {} threads only slow a sweep down",
+                4 * cores
+            ),
+        )),
+    }
 }
 
 fn header(problem: &Problem, sweep: &Sweep, shard: Shard, kind: &str, reason: &str) -> SweepHeader {
@@ -124,8 +148,8 @@ fn header(problem: &Problem, sweep: &Sweep, shard: Shard, kind: &str, reason: &s
 /// The finished points of a saved sweep of the same problem, grid and
 /// shard; None when it is complete.
 fn resumable(path: &Path, expected: &SweepHeader) -> Result<Option<Vec<Record>>, ExitCode> {
-    let (saved, records) =
-        read_sweep(path).map_err(|e| fail(2, format!("{}: cannot resume: {e}", path.display())))?;
+    let (saved, records) = read_sweep(path)
+        .map_err(|e| fail(BAD_INPUT, format!("{}: cannot resume: {e}", path.display())))?;
     let same = saved.problem == expected.problem
         && saved.kind == expected.kind
         && saved.keys == expected.keys
@@ -133,7 +157,7 @@ fn resumable(path: &Path, expected: &SweepHeader) -> Result<Option<Vec<Record>>,
         && saved.shard == expected.shard;
     if !same {
         return Err(fail(
-            2,
+            BAD_INPUT,
             format!(
                 "{}: made from a different problem, grid or shard (or other --set values); \
                  cannot resume",
@@ -185,14 +209,6 @@ fn announce(args: &SweepArgs, setup: &Setup, members: usize) {
     );
 }
 
-/// Sets a flag on Ctrl-C.
-fn interrupt_flag() -> Arc<AtomicBool> {
-    let interrupted = Arc::new(AtomicBool::new(false));
-    let flag = interrupted.clone();
-    let _ = ctrlc::set_handler(move || flag.store(true, Ordering::SeqCst));
-    interrupted
-}
-
 /// Runs the points, checkpointing every second; writes the final file.
 fn execute(args: &SweepArgs, setup: Setup) -> ExitCode {
     let plan = SweepPlan {
@@ -202,7 +218,6 @@ fn execute(args: &SweepArgs, setup: Setup) -> ExitCode {
     };
     let members = plan.members().len();
     announce(args, &setup, members);
-    let interrupted = interrupt_flag();
     let before = setup.done.len();
     let bar = progress_bar(members, before);
     let kind = setup.job.kind();
@@ -221,18 +236,23 @@ fn execute(args: &SweepArgs, setup: Setup) -> ExitCode {
         }
     };
     let start = Instant::now();
-    let threads = args.threads.unwrap_or(0);
+    let threads = setup.threads;
     let done = setup.done.clone();
     let records = match run(
         &plan,
         setup.job.as_ref(),
         threads,
         done,
-        &interrupted,
+        signals::flag(),
         &on_point,
     ) {
         Ok(r) => r,
-        Err(e) => return fail(1, format!("thread pool: {e}")),
+        Err(e) => {
+            return fail(
+                BAD_INPUT,
+                format!("--threads {threads}: no thread pool: {e}"),
+            )
+        }
     };
     bar.finish_and_clear();
     let elapsed = start.elapsed().as_secs_f64();
@@ -242,7 +262,7 @@ fn execute(args: &SweepArgs, setup: Setup) -> ExitCode {
         elapsed / computed.max(1) as f64,
         rayon_threads(threads)
     );
-    let stopped = interrupted.load(Ordering::SeqCst) && records.len() < members;
+    let stopped = signals::requested() && records.len() < members;
     finish(args, running, &records, stopped)
 }
 
@@ -255,7 +275,7 @@ fn finish(args: &SweepArgs, running: SweepHeader, records: &[Record], stopped: b
         ..running
     };
     if let Err(e) = write_sweep(&args.output, &header, records, true) {
-        return fail(1, e);
+        return fail(OUTPUT, e);
     }
     summarize(&header, records);
     println!("written   {}", args.output.display());
@@ -266,7 +286,7 @@ fn finish(args: &SweepArgs, running: SweepHeader, records: &[Record], stopped: b
             header.members,
             args.output.display()
         );
-        return ExitCode::from(130);
+        return ExitCode::from(INTERRUPTED);
     }
     match &args.plot {
         Some(out) => plot(out, &header, records),
@@ -333,33 +353,42 @@ fn summarize(header: &SweepHeader, records: &[Record]) {
 }
 
 fn plot(out: &Path, header: &SweepHeader, records: &[Record]) -> ExitCode {
-    match figure::draw(out, header, records) {
+    match replace_atomically(out, |tmp| figure::draw(tmp, header, records)) {
         Ok(()) => {
             println!("plotted   {}", out.display());
             ExitCode::SUCCESS
         }
-        Err(e) => fail(2, e),
+        Err(e) => fail(OUTPUT, e),
     }
 }
 
 /// Joins shard files of one sweep; refuses files of different problems or
 /// grids and overlapping points (exit 2, nothing written).
 pub fn run_merge(inputs: &[PathBuf], output: &Path, chart: Option<&Path>, force: bool) -> ExitCode {
-    if let Err(e) = check_target(output, force) {
-        return fail(2, e);
-    }
+    let mut outputs: Vec<&Path> = vec![output];
+    outputs.extend(chart);
+    let sources: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
+    let _claims = match crate::claim_outputs(&outputs, &sources, force) {
+        Ok(c) => c,
+        Err(code) => return code,
+    };
     let mut merged: Option<SweepHeader> = None;
     let mut records: Vec<Record> = vec![];
     let mut complete = true;
     for path in inputs {
         let (h, r) = match read_sweep(path) {
             Ok(x) => x,
-            Err(e) => return fail(2, format!("{}: not a sweep file: {e}", path.display())),
+            Err(e) => {
+                return fail(
+                    BAD_INPUT,
+                    format!("{}: not a sweep file: {e}", path.display()),
+                )
+            }
         };
         if let Some(m) = &merged {
             if let Some(what) = mismatch(m, &h) {
                 return fail(
-                    2,
+                    BAD_INPUT,
                     format!(
                         "{}: {what} differs from {}",
                         path.display(),
@@ -372,7 +401,7 @@ pub fn run_merge(inputs: &[PathBuf], output: &Path, chart: Option<&Path>, force:
         let seen: std::collections::BTreeSet<usize> = records.iter().map(|r| r.index).collect();
         if let Some(dup) = r.iter().find(|x| seen.contains(&x.index)) {
             return fail(
-                2,
+                BAD_INPUT,
                 format!(
                     "{}: point {} is also in an earlier file (overlapping shards)",
                     path.display(),
@@ -384,7 +413,7 @@ pub fn run_merge(inputs: &[PathBuf], output: &Path, chart: Option<&Path>, force:
         merged.get_or_insert(h);
     }
     let Some(mut header) = merged else {
-        return fail(2, "merge: no input files");
+        return fail(BAD_INPUT, "merge: no input files");
     };
     records.sort_by_key(|r| r.index);
     header.shard = "merged".into();
@@ -394,8 +423,8 @@ pub fn run_merge(inputs: &[PathBuf], output: &Path, chart: Option<&Path>, force:
     } else {
         "partial".into()
     };
-    if let Err(e) = write_sweep(output, &header, &records, force) {
-        return fail(1, e);
+    if let Err(e) = write_sweep(output, &header, &records, true) {
+        return fail(OUTPUT, e);
     }
     println!(
         "merged    {} files, {} of {} points ({}) into {}",

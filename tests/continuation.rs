@@ -459,11 +459,42 @@ fn killed_run_leaves_its_last_checkpoint() {
     let points = read_f64(&f.group("branches/0").unwrap(), "parameter");
     assert!(points.len() > 5, "{} points kept", points.len());
     assert!(points.windows(2).all(|w| w[1] > w[0]), "points in order");
+    let reason = f
+        .attr("stop_reason")
+        .unwrap()
+        .read_scalar::<hdf5::types::VarLenUnicode>()
+        .unwrap();
+    assert_eq!(
+        reason.as_str(),
+        "in progress",
+        "a checkpoint is never marked completed"
+    );
+    drop(f);
+    // The lock of the killed process does not block the resumed run, which
+    // goes on from the checkpoint (more points) and cleans up after itself.
+    let mut child = slow_euler(&out, "0.0005", &["--resume"]).spawn().unwrap();
+    let status = interrupt_after(&mut child, 3000);
+    assert_eq!(status.code(), Some(130));
+    let f = hdf5::File::open(&out).unwrap();
+    let more = read_f64(&f.group("branches/0").unwrap(), "parameter");
+    assert!(
+        more.len() > points.len(),
+        "{} → {}",
+        points.len(),
+        more.len()
+    );
+    assert_eq!(more[..points.len()], points[..], "the kept points are kept");
+    let left: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left.len(), 1, "no lock or temporary file left: {left:?}");
     std::fs::remove_dir_all(dir).unwrap();
 }
 
-/// Interrupt a run, resume it, and get the diagram an uninterrupted run
-/// draws: the same branches, points and special points.
+/// Interrupt a run (SIGINT, then SIGTERM, then SIGHUP), resume it each
+/// time, and get the file an uninterrupted run writes: the same datasets,
+/// bit for bit.
 #[test]
 fn interrupted_run_resumes_to_the_same_diagram() {
     let dir = std::env::temp_dir().join(format!("cosserat-resume-{}", std::process::id()));
@@ -477,40 +508,32 @@ fn interrupted_run_resumes_to_the_same_diagram() {
         Some(130),
         "the run should still be going at 1.5 s"
     );
+    for signal in ["-TERM", "-HUP"] {
+        let mut child = command(&partial, &["--resume"]).spawn().unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(700));
+        let _ = std::process::Command::new("kill")
+            .args([signal, &child.id().to_string()])
+            .status();
+        let code = child.wait().unwrap().code();
+        assert!(matches!(code, Some(0 | 130)), "{signal}: {code:?}");
+    }
     assert!(command(&partial, &["--resume"]).status().unwrap().success());
     assert!(command(&full, &[]).status().unwrap().success());
-    let (a, b) = (
-        hdf5::File::open(&partial).unwrap(),
-        hdf5::File::open(&full).unwrap(),
-    );
-    for f in [&a, &b] {
-        let reason = f
+    for f in [&partial, &full] {
+        let reason = hdf5::File::open(f)
+            .unwrap()
             .attr("stop_reason")
             .unwrap()
             .read_scalar::<hdf5::types::VarLenUnicode>()
             .unwrap();
         assert_eq!(reason.as_str(), "completed");
     }
-    for i in 0..3 {
-        let path = format!("branches/{i}");
-        let (pa, pb) = (
-            read_f64(&a.group(&path).unwrap(), "parameter"),
-            read_f64(&b.group(&path).unwrap(), "parameter"),
-        );
-        assert_eq!(pa.len(), pb.len(), "branch {i}");
-        assert!(
-            pa.iter()
-                .zip(&pb)
-                .all(|(x, y)| (x - y).abs() <= 1e-9 * y.abs().max(1.0)),
-            "branch {i}"
-        );
-    }
-    let (sa, sb) = (
-        read_f64(&a.group("special_points").unwrap(), "parameter"),
-        read_f64(&b.group("special_points").unwrap(), "parameter"),
-    );
-    assert_eq!(sa.len(), sb.len());
-    assert!(sa.iter().zip(&sb).all(|(x, y)| (x - y).abs() <= 1e-9));
+    support::h5::assert_same_datasets(&partial, &full);
+    let left: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left.len(), 2, "no lock or temporary file left: {left:?}");
     std::fs::remove_dir_all(dir).unwrap();
 }
 

@@ -182,29 +182,18 @@ impl Run<'_> {
         let (_, x, p, tangent) = best;
         let stored: Vec<f64> = tangent.iter().map(|v| v * sign).collect();
         let (eigenvalue, null_mode) = self.tracker.nearest_zero(self.family, &x, p, block).ok()?;
+        // |det F_x| relative to its size at the two neighbours; NaN (not a
+        // default) where a determinant cannot be evaluated.
         let det_here = self.det(&x, p).unwrap_or(f64::NAN);
         let det_scale = self
             .det(&a.unknowns, a.parameter)
-            .unwrap_or(1.0)
+            .unwrap_or(f64::NAN)
             .abs()
-            .max(self.det(&b.unknowns, b.parameter).unwrap_or(1.0).abs());
+            .max(self.det(&b.unknowns, b.parameter).unwrap_or(f64::NAN).abs());
         let mut tracker = self.tracker.clone();
         tracker.reset();
         let spectrum = tracker.measure(self.family, &x, p).ok()?;
-        let tip = spectrum.tip.clone();
-        let tip_angle = super::tip_angle(&self.family.rod_at(p).ok()?.clamp.frame, &tip);
-        let point = Point {
-            parameter: p,
-            unknowns: x,
-            tangent: stored,
-            tip_angle,
-            tip,
-            eigenvalues: spectrum.values,
-            morse_index: spectrum.morse_index,
-            stable: spectrum.morse_index == 0,
-            norm: spectrum.curvature_norm,
-            shape: spectrum.shape,
-        };
+        let point = self.point_from(x, p, stored, spectrum).ok()?;
         let _ = n;
         Some(SpecialPoint {
             kind,

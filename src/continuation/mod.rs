@@ -157,8 +157,15 @@ pub struct Branch {
     pub points: Vec<Point>,
     /// The special point it was switched from.
     pub parent: Option<usize>,
-    /// Why it ended.
+    /// Why it ended ("in progress" while it is followed).
     pub stop_reason: String,
+    /// The direction of travel: +1 along the stored tangents, −1 against
+    /// them (the backward half of a `both_directions` start).
+    pub direction: f64,
+    /// The arclength step the next point would be tried with: with the
+    /// points and the direction, all a resumed run needs to go on exactly
+    /// as an uninterrupted one.
+    pub next_step: f64,
 }
 
 /// A bifurcation diagram.
@@ -172,9 +179,13 @@ pub struct Diagram {
     pub eigenvalue_names: Vec<String>,
     /// Finite-element nodes of the null modes.
     pub nodes: Vec<f64>,
-    /// Why the whole run ended ("completed", "interrupted", an error).
+    /// Why the whole run ended: "in progress" while it runs (what a
+    /// checkpoint records), then "completed" or "interrupted".
     pub stop_reason: String,
 }
+
+/// The run's stop reason while it runs.
+pub const IN_PROGRESS: &str = "in progress";
 
 /// Why continuation could not start.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -217,7 +228,7 @@ pub fn continuation(
         special_points: vec![],
         eigenvalue_names: run.tracker.names(),
         nodes: run.tracker.nodes(),
-        stop_reason: "completed".into(),
+        stop_reason: IN_PROGRESS.into(),
     };
     // (start point, direction sign, parent special point, depth)
     let mut queue = vec![(first, 1.0, None::<usize>, 0usize)];
@@ -234,20 +245,24 @@ pub fn continuation(
 type Pending = (Point, f64, Option<usize>, usize);
 
 /// Follows queued branches, switching at their branch points to the
-/// configured depth, until the queue is empty or the monitor interrupts.
+/// configured depth, until the queue is empty ("completed") or the monitor
+/// interrupts ("interrupted").
 fn drain(
     run: &mut Run,
     diagram: &mut Diagram,
     mut queue: Vec<Pending>,
     monitor: &mut dyn FnMut(Progress, &Diagram) -> bool,
 ) {
+    diagram.stop_reason = IN_PROGRESS.into();
     while !queue.is_empty() {
         let (start, sign, parent, depth) = queue.remove(0);
         let index = diagram.branches.len();
         diagram.branches.push(Branch {
             points: vec![],
             parent,
-            stop_reason: "in progress".into(),
+            stop_reason: IN_PROGRESS.into(),
+            direction: sign,
+            next_step: run.opts.step,
         });
         if let Some(sp) = parent {
             diagram.special_points[sp].children.push(index);
@@ -260,6 +275,7 @@ fn drain(
         }
         queue.extend(run.switches(diagram, &outcome.special_points, depth));
     }
+    diagram.stop_reason = "completed".into();
 }
 
 impl Run<'_> {
@@ -459,6 +475,17 @@ impl<'a> Run<'a> {
         tangent: Vec<f64>,
     ) -> Result<Point, ContinuationError> {
         let spectrum = self.tracker.measure(self.family, &x, p)?;
+        self.point_from(x, p, tangent, spectrum)
+    }
+
+    /// A complete point from its measured spectrum.
+    fn point_from(
+        &self,
+        x: Vec<f64>,
+        p: f64,
+        tangent: Vec<f64>,
+        spectrum: Spectrum,
+    ) -> Result<Point, ContinuationError> {
         let tip = spectrum.tip.clone();
         let tip_angle = tip_angle(
             &self.family.rod_at(p).map_err(PointError::from)?.clamp.frame,
@@ -561,21 +588,41 @@ impl<'a> Run<'a> {
         monitor: &mut dyn FnMut(Progress, &Diagram) -> bool,
     ) -> Outcome {
         self.tracker.reset();
-        let mut specials = vec![];
-        let end = |specials: Vec<usize>, reason: String, interrupted: bool| Outcome {
-            special_points: specials,
-            stop_reason: reason,
-            interrupted,
-        };
         match self.point(
             start.unknowns.clone(),
             start.parameter,
             start.tangent.clone(),
         ) {
             Ok(p) => diagram.branches[branch].points.push(p),
-            Err(e) => return end(specials, format!("start point failed: {e}"), false),
+            Err(e) => {
+                return Outcome {
+                    special_points: vec![],
+                    stop_reason: format!("start point failed: {e}"),
+                    interrupted: false,
+                }
+            }
         }
-        let mut ds = self.opts.step;
+        diagram.branches[branch].next_step = self.opts.step;
+        self.walk(sign, branch, diagram, monitor)
+    }
+
+    /// Steps on from the last point of `diagram.branches[branch]` (the
+    /// tracker holding that point's modes) with the branch's next step,
+    /// until a stop reason or an interrupt.
+    fn walk(
+        &mut self,
+        sign: f64,
+        branch: usize,
+        diagram: &mut Diagram,
+        monitor: &mut dyn FnMut(Progress, &Diagram) -> bool,
+    ) -> Outcome {
+        let mut specials = vec![];
+        let end = |specials: Vec<usize>, reason: String, interrupted: bool| Outcome {
+            special_points: specials,
+            stop_reason: reason,
+            interrupted,
+        };
+        let mut ds = diagram.branches[branch].next_step;
         loop {
             let points = &diagram.branches[branch].points;
             let last = points.last().expect("a branch has its start point").clone();
@@ -612,6 +659,7 @@ impl<'a> Run<'a> {
             if iterations <= 3 {
                 ds = (ds * 1.5).min(self.opts.max_step);
             }
+            diagram.branches[branch].next_step = ds;
             let progress = Progress {
                 points: self.total_points,
                 branch,

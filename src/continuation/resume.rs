@@ -1,7 +1,10 @@
 //! Resuming an interrupted continuation from what its diagram file kept:
 //! every saved point is rebuilt from its unknowns and tangent (tip,
-//! spectrum, Morse index recomputed), the interrupted branch goes on from
-//! its last point, and branch points not yet switched are switched.
+//! spectrum, Morse index recomputed, the eigenvalue tracker replayed along
+//! the branch in order), the interrupted branch goes on from its last point
+//! in its own direction with its own next step, and branch points not yet
+//! switched are switched — in the order of an uninterrupted run, so that
+//! the resumed diagram is the uninterrupted one, bit for bit.
 
 use super::{
     drain, Branch, ContinuationError, Diagram, Pending, Point, Run, SpecialKind, SpecialPoint,
@@ -22,6 +25,10 @@ pub struct SavedBranch {
     pub parent: Option<usize>,
     /// Why it ended ("interrupted" and "in progress" are resumed).
     pub stop_reason: String,
+    /// The direction of travel along the stored tangents (±1).
+    pub direction: f64,
+    /// The arclength step the next point would be tried with.
+    pub next_step: f64,
 }
 
 /// One saved special point.
@@ -59,7 +66,60 @@ pub struct SavedDiagram {
 }
 
 fn unfinished(reason: &str) -> bool {
-    reason == "interrupted" || reason == "in progress"
+    reason == "interrupted" || reason == super::IN_PROGRESS
+}
+
+impl SavedDiagram {
+    /// Checks that the saved run is one a run of `family` could have made:
+    /// sizes, references between branches and special points, directions.
+    pub fn check(&self, family: &Family) -> Result<(), String> {
+        let n = family.size();
+        let row = |v: &[f64], width: usize, what: &str| {
+            if v.len() == width && v.iter().all(|x| x.is_finite()) {
+                Ok(())
+            } else {
+                Err(format!(
+                    "{what}: expected {width} finite numbers, found {}",
+                    v.len()
+                ))
+            }
+        };
+        for (i, b) in self.branches.iter().enumerate() {
+            let m = b.parameter.len();
+            if b.unknowns.len() != m || b.tangent.len() != m {
+                return Err(format!("branch {i}: datasets of different lengths"));
+            }
+            for (x, t) in b.unknowns.iter().zip(&b.tangent) {
+                row(x, n, &format!("branch {i} unknowns"))?;
+                row(t, n + 1, &format!("branch {i} tangent"))?;
+            }
+            row(&b.parameter, m, &format!("branch {i} parameter"))?;
+            if !(b.direction == 1.0 || b.direction == -1.0)
+                || !(b.next_step.is_finite() && b.next_step > 0.0)
+            {
+                return Err(format!(
+                    "branch {i}: no direction (±1) or next step (> 0): \
+                     a file of an older cosserat, which cannot be resumed"
+                ));
+            }
+            if b.parent.is_some_and(|p| p >= self.specials.len()) {
+                return Err(format!(
+                    "branch {i}: its parent special point does not exist"
+                ));
+            }
+        }
+        for (i, sp) in self.specials.iter().enumerate() {
+            let points = self.branches.get(sp.branch).map(|b| b.parameter.len());
+            if points.is_none_or(|m| sp.index >= m) {
+                return Err(format!(
+                    "special point {i}: its branch point does not exist"
+                ));
+            }
+            row(&sp.unknowns, n, &format!("special point {i} unknowns"))?;
+            row(&sp.tangent, n + 1, &format!("special point {i} tangent"))?;
+        }
+        Ok(())
+    }
 }
 
 /// Continues a saved run to its end.
@@ -69,28 +129,39 @@ pub fn resume(
     saved: &SavedDiagram,
     monitor: &mut dyn FnMut(super::Progress, &Diagram) -> bool,
 ) -> Result<Diagram, ContinuationError> {
+    saved
+        .check(family)
+        .map_err(|message| ContinuationError::Start {
+            p: opts.start,
+            message: format!("the saved diagram cannot be resumed: {message}"),
+        })?;
     let mut run = Run::new(family, opts);
     let mut diagram = Diagram {
         branches: vec![],
         special_points: vec![],
         eigenvalue_names: run.tracker.names(),
         nodes: run.tracker.nodes(),
-        stop_reason: "completed".into(),
+        stop_reason: super::IN_PROGRESS.into(),
     };
+    for s in &saved.specials {
+        diagram.special_points.push(rebuild_special(&run, s)?);
+    }
+    // Each branch replayed in order: the tracker ends holding the modes of
+    // the last point, as in the run that was interrupted.
     for b in &saved.branches {
         run.tracker.reset();
         let mut points = Vec::with_capacity(b.parameter.len());
         for ((p, x), t) in b.parameter.iter().zip(&b.unknowns).zip(&b.tangent) {
             points.push(run.point(x.clone(), *p, t.clone())?);
         }
+        run.total_points += points.len().saturating_sub(1);
         diagram.branches.push(Branch {
             points,
             parent: b.parent,
             stop_reason: b.stop_reason.clone(),
+            direction: b.direction,
+            next_step: b.next_step,
         });
-    }
-    for s in &saved.specials {
-        diagram.special_points.push(rebuild_special(&mut run, s)?);
     }
     for (i, b) in saved.branches.iter().enumerate() {
         if let Some(sp) = b.parent {
@@ -102,8 +173,8 @@ pub fn resume(
         if unfinished(&diagram.branches[last].stop_reason)
             && !diagram.branches[last].points.is_empty()
         {
-            let start = diagram.branches[last].points.pop().expect("non-empty");
-            let outcome = run.follow(start, 1.0, last, &mut diagram, monitor);
+            let sign = diagram.branches[last].direction;
+            let outcome = run.walk(sign, last, &mut diagram, monitor);
             diagram.branches[last].stop_reason = outcome.stop_reason.clone();
             if outcome.interrupted {
                 diagram.stop_reason = "interrupted".into();
@@ -164,9 +235,13 @@ fn depth(diagram: &Diagram, mut branch: usize) -> usize {
     d
 }
 
-fn rebuild_special(run: &mut Run, s: &SavedSpecial) -> Result<SpecialPoint, ContinuationError> {
-    run.tracker.reset();
-    let point: Point = run.point(s.unknowns.clone(), s.parameter, s.tangent.clone())?;
+/// A saved special point measured as when it was located: with a fresh
+/// tracker, leaving the run's tracker alone.
+fn rebuild_special(run: &Run, s: &SavedSpecial) -> Result<SpecialPoint, ContinuationError> {
+    let mut tracker = run.tracker.clone();
+    tracker.reset();
+    let spectrum = tracker.measure(run.family, &s.unknowns, s.parameter)?;
+    let point = run.point_from(s.unknowns.clone(), s.parameter, s.tangent.clone(), spectrum)?;
     let (_, null_mode) = run
         .tracker
         .nearest_zero(run.family, &s.unknowns, s.parameter, s.block)?;

@@ -3,8 +3,9 @@
 //! Layout (a contract, see README.md): `/branches/<i>/parameter` (m),
 //! `tip_position` (m×3), `eigenvalues` (m×k), `stable` (m), `morse_index`
 //! (m), `norm` (m), `shapes` (m×21×3), `unknowns` (m×n) and `tangent`
-//! (m×(n+1)) of the discretization, attributes `parent` and
-//! `stop_reason`; `/special_points/kind` (strings), `branch`, `index`,
+//! (m×(n+1)) of the discretization, attributes `parent`, `stop_reason`,
+//! `direction` (±1: travel along or against the stored tangents) and
+//! `next_step` (the arclength step a resumed run goes on with); `/special_points/kind` (strings), `branch`, `index`,
 //! `parameter`, `tip_position` (s×3), `block`, `symmetry_breaking`,
 //! `null_vectors` (s×nodes×3), `singularity` (s×2); the problem text as the
 //! root attribute `problem`, the run's `stop_reason` and the parameter name
@@ -104,6 +105,12 @@ fn write_branches(file: &hdf5::File, d: &Diagram) -> hdf5::Result<()> {
             .create("parent")?
             .write_scalar(&b.parent.map_or(-1, |p| p as i64))?;
         string_attr(&g, "stop_reason", &b.stop_reason)?;
+        g.new_attr::<f64>()
+            .create("direction")?
+            .write_scalar(&b.direction)?;
+        g.new_attr::<f64>()
+            .create("next_step")?
+            .write_scalar(&b.next_step)?;
     }
     Ok(())
 }
@@ -206,6 +213,8 @@ pub fn read_saved(path: &Path) -> hdf5::Result<(String, SavedDiagram)> {
             tangent: rows(&g, "tangent")?,
             parent: usize::try_from(parent).ok(),
             stop_reason: read_string(&g, "stop_reason")?,
+            direction: g.attr("direction")?.read_scalar::<f64>()?,
+            next_step: g.attr("next_step")?.read_scalar::<f64>()?,
         });
     }
     let g = f.group("special_points")?;
@@ -217,27 +226,46 @@ pub fn read_saved(path: &Path) -> hdf5::Result<(String, SavedDiagram)> {
     let parameter = g.dataset("parameter")?.read_raw::<f64>()?;
     let sing = rows(&g, "singularity")?;
     let (x, t) = (rows(&g, "unknowns")?, rows(&g, "tangent")?);
-    let specials = (0..kinds.len())
-        .map(|i| SavedSpecial {
-            kind: if kinds[i].as_str() == "fold" {
-                SpecialKind::Fold
-            } else {
-                SpecialKind::BranchPoint
-            },
+    let count = kinds.len();
+    let lengths = [
+        blocks.len(),
+        branch.len(),
+        index.len(),
+        sym.len(),
+        parameter.len(),
+        sing.len(),
+        x.len(),
+        t.len(),
+    ];
+    if lengths.iter().any(|&l| l != count) || sing.iter().any(|r| r.len() != 2) {
+        return Err("the special-point datasets have different lengths".into());
+    }
+    let unknown = |what: &str, v: &str| hdf5::Error::from(format!("unknown {what} `{v}`").as_str());
+    let mut specials = Vec::with_capacity(kinds.len());
+    for i in 0..kinds.len() {
+        let kind = match kinds[i].as_str() {
+            "fold" => SpecialKind::Fold,
+            "branch_point" => SpecialKind::BranchPoint,
+            other => return Err(unknown("special point kind", other)),
+        };
+        let block = match blocks[i].as_str() {
+            "in_plane" => Block::InPlane,
+            "out_of_plane" => Block::OutOfPlane,
+            "full" => Block::Full,
+            other => return Err(unknown("block", other)),
+        };
+        specials.push(SavedSpecial {
+            kind,
             branch: branch[i] as usize,
             index: index[i] as usize,
-            block: match blocks[i].as_str() {
-                "in_plane" => Block::InPlane,
-                "out_of_plane" => Block::OutOfPlane,
-                _ => Block::Full,
-            },
+            block,
             symmetry_breaking: sym[i] == 1,
             singularity: (sing[i][0], sing[i][1]),
             parameter: parameter[i],
             unknowns: x[i].clone(),
             tangent: t[i].clone(),
-        })
-        .collect();
+        });
+    }
     Ok((
         problem,
         SavedDiagram {

@@ -9,7 +9,7 @@
 //! The file is written under a temporary name in the target directory and
 //! renamed at the end, so a failure never leaves half a file behind.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use hdf5::types::VarLenUnicode;
 
@@ -25,6 +25,9 @@ pub enum OutputError {
     /// The target exists and overwriting was not asked for.
     #[error("{0} exists; pass --force to overwrite it")]
     Exists(String),
+    /// The target cannot be replaced (not a regular file, an input).
+    #[error("{0}")]
+    Unusable(String),
     /// The HDF5 library reported an error.
     #[error("writing {path}: {message}")]
     Hdf5 { path: String, message: String },
@@ -38,6 +41,7 @@ pub enum OutputError {
 
 /// Fails early when `path` exists and `force` is false.
 pub fn check_target(path: &Path, force: bool) -> Result<(), OutputError> {
+    super::target::ensure_replaceable(path).map_err(|e| OutputError::Unusable(e.to_string()))?;
     if path.exists() && !force {
         return Err(OutputError::Exists(path.display().to_string()));
     }
@@ -94,7 +98,7 @@ pub(crate) fn write_atomically(
     write: impl FnOnce(&hdf5::File) -> hdf5::Result<()>,
 ) -> Result<(), OutputError> {
     check_target(path, force)?;
-    let tmp = temporary_path(path);
+    let tmp = super::target::temporary_path(path);
     let result = hdf5::File::create(&tmp)
         .and_then(|file| {
             write(&file)?;
@@ -108,6 +112,10 @@ pub(crate) fn write_atomically(
         let _ = std::fs::remove_file(&tmp);
         return Err(e);
     }
+    if let Err(e) = super::target::ensure_replaceable(path) {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(OutputError::Unusable(e.to_string()));
+    }
     std::fs::rename(&tmp, path).map_err(|source| {
         let _ = std::fs::remove_file(&tmp);
         OutputError::Rename {
@@ -115,14 +123,6 @@ pub(crate) fn write_atomically(
             source,
         }
     })
-}
-
-fn temporary_path(path: &Path) -> PathBuf {
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    path.with_file_name(format!(".{name}.{}.tmp", std::process::id()))
 }
 
 pub(crate) fn text(s: &str) -> hdf5::Result<VarLenUnicode> {

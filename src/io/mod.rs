@@ -10,6 +10,7 @@ mod problem;
 mod support_section;
 mod sweep_output;
 mod sweep_section;
+pub mod target;
 
 pub use arm_output::{read_search, write_arm, write_arm_study, ArmStudy, SavedSearch};
 pub use arm_section::ArmSection;

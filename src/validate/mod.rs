@@ -948,7 +948,8 @@ pub fn markdown(cases: &[Case], rows: &[Row], opts: &RunOptions) -> String {
 }
 
 /// `cosserat validate`: exit 0 when every row passes (or is informational
-/// or skipped), 1 when one fails, 2 on bad input.
+/// or skipped), 3 when one fails (a result below the asked quality), 2 on
+/// bad input, 1 when the report cannot be written.
 pub fn run_cli(args: ValidateArgs) -> ExitCode {
     let dir = args.cases.clone().unwrap_or_else(default_dir);
     let cases = match load_cases(&dir) {
@@ -981,9 +982,12 @@ pub fn run_cli(args: ValidateArgs) -> ExitCode {
         if let Some(parent) = out.parent().filter(|p| !p.as_os_str().is_empty()) {
             let _ = std::fs::create_dir_all(parent);
         }
-        if let Err(e) = std::fs::write(out, markdown(&cases, &rows, &opts)) {
-            eprintln!("error: cannot write {}: {e}", out.display());
-            return ExitCode::from(2);
+        let report = markdown(&cases, &rows, &opts);
+        if let Err(e) =
+            crate::io::target::replace_atomically(out, |tmp| std::fs::write(tmp, &report))
+        {
+            eprintln!("error: {e}");
+            return ExitCode::from(1);
         }
         println!("written   {}", out.display());
     }
@@ -992,7 +996,7 @@ pub fn run_cli(args: ValidateArgs) -> ExitCode {
         return ExitCode::from(2);
     }
     if fail > 0 {
-        ExitCode::from(1)
+        ExitCode::from(3)
     } else {
         ExitCode::SUCCESS
     }

@@ -6,4 +6,5 @@ pub mod bessel;
 pub mod columns;
 pub mod elliptic;
 pub mod fuzz;
+pub mod h5;
 pub mod references;
