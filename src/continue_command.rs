@@ -123,11 +123,13 @@ pub fn run_continue(
             output.display()
         );
     }
+    signals::set_mode(signals::Mode::NextPoint);
     let outcome = match &saved {
         Some(saved) => cosserat::continuation::resume(family, opts, saved, &mut monitor),
         None => continuation(family, opts, &mut monitor),
     };
     bar.finish_and_clear();
+    signals::set_mode(signals::Mode::Immediate);
     if let Some(e) = checkpoint_error {
         eprintln!("warning: a checkpoint was not written: {e}");
     }

@@ -20,12 +20,7 @@ use exit::{fail, BAD_INPUT, NO_RESULT, OUTPUT};
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    signals::install(match cli.command {
-        Command::Continue { .. } | Command::Optimize { .. } | Command::Sweep { .. } => {
-            signals::Mode::NextPoint
-        }
-        _ => signals::Mode::Immediate,
-    });
+    signals::install();
     match cli.command {
         Command::Solve {
             problem,

@@ -97,6 +97,18 @@ pub fn run_optimize(run: OptimizeRun) -> ExitCode {
     if was_interrupted {
         return keep_interrupted(&run, &problem.text, &opt, &progress);
     }
+    // The finished search is kept before the maps and paths that follow it
+    // (they stop at once on a signal): `--resume` starts from the optimum.
+    if let Some(out) = &run.output {
+        if let Err(e) = write_arm_study(
+            out,
+            &problem.text,
+            &interrupted_study(&opt, &progress),
+            true,
+        ) {
+            return fail(OUTPUT, e);
+        }
+    }
     report_optimum(&opt, t.elapsed().as_secs_f64());
     let straight = (*straight && scene.weight == ArmWeight::Weightless)
         .then(|| straight_optimum(arm, &opt))
@@ -139,6 +151,9 @@ fn run_search(
     progress: SearchProgress,
 ) -> (Option<ArmOptimum>, SearchProgress, bool) {
     let stop = signals::requested;
+    // Stops at the next evaluation; what follows the search (maps, R0,
+    // paths) stops at once, the search's last checkpoint kept.
+    signals::set_mode(signals::Mode::NextPoint);
     let mut last_save = Instant::now();
     let mut checkpoint = |p: &SearchProgress| {
         if last_save.elapsed() < CHECKPOINT {
@@ -149,7 +164,9 @@ fn run_search(
         }
         last_save = Instant::now();
     };
-    arm.search(scene, search, progress, &stop, &mut checkpoint)
+    let outcome = arm.search(scene, search, progress, &stop, &mut checkpoint);
+    signals::set_mode(signals::Mode::Immediate);
+    outcome
 }
 
 /// The Fig. 5 data set: the map, its 'Q', the least-Σb² design.

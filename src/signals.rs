@@ -13,6 +13,9 @@ use std::sync::Mutex;
 /// The process-wide stop flag, set by the signal handler.
 static STOP: AtomicBool = AtomicBool::new(false);
 
+/// How the handler answers: 0 at once, 1 at the next point.
+static MODE: std::sync::atomic::AtomicU8 = std::sync::atomic::AtomicU8::new(0);
+
 /// Files to remove when the process stops at once.
 static LITTER: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
@@ -25,12 +28,19 @@ pub enum Mode {
     Immediate,
 }
 
-/// Installs the handler (once, at start).
-pub fn install(mode: Mode) {
+/// Installs the handler (once, at start), stopping at once until
+/// [`set_mode`] says otherwise: while a command reads its input there is
+/// nothing to keep.
+pub fn install() {
     // If installing fails the default action stays (the process ends);
     // outputs are written atomically, so no partial file is left even then.
     let _ = ctrlc::set_handler(move || {
         let first = !STOP.swap(true, Ordering::SeqCst);
+        let mode = if MODE.load(Ordering::SeqCst) == 1 {
+            Mode::NextPoint
+        } else {
+            Mode::Immediate
+        };
         match mode {
             Mode::NextPoint if first => eprintln!(
                 "stopping at the next point (finished work is kept; send the signal again to wait no longer)"
@@ -38,10 +48,20 @@ pub fn install(mode: Mode) {
             _ => {
                 remove_litter();
                 eprintln!("interrupted");
-                std::process::exit(i32::from(crate::exit::INTERRUPTED));
+                // _exit, not exit: the main thread may be inside the HDF5
+                // library, whose exit-time clean-up must not run under it.
+                // SAFETY: _exit only ends the process; no Rust state is
+                // touched afterwards.
+                unsafe { libc::_exit(i32::from(crate::exit::INTERRUPTED)) }
             }
         }
     });
+}
+
+/// How the next signal is answered: a command that keeps finished points
+/// switches to [`Mode::NextPoint`] when its work begins.
+pub fn set_mode(mode: Mode) {
+    MODE.store(u8::from(mode == Mode::NextPoint), Ordering::SeqCst);
 }
 
 /// Whether a stop was asked for.

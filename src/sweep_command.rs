@@ -90,6 +90,9 @@ fn prepare(args: &SweepArgs) -> Result<Option<Setup>, ExitCode> {
         None => Box::new(SolveJob),
     };
     let expected = header(&problem, &sweep, shard, job.kind(), "running");
+    if args.plot.is_some() {
+        figure::chartable(&expected.kind, &expected.keys).map_err(|e| at(&e))?;
+    }
     let mut outputs: Vec<&Path> = vec![&args.output];
     outputs.extend(args.plot.as_deref());
     let claims = crate::claim_outputs(&outputs, &[&args.path], args.force || args.resume)?;
@@ -238,6 +241,7 @@ fn execute(args: &SweepArgs, setup: Setup) -> ExitCode {
     let start = Instant::now();
     let threads = setup.threads;
     let done = setup.done.clone();
+    signals::set_mode(signals::Mode::NextPoint);
     let records = match run(
         &plan,
         setup.job.as_ref(),
@@ -415,6 +419,11 @@ pub fn run_merge(inputs: &[PathBuf], output: &Path, chart: Option<&Path>, force:
     let Some(mut header) = merged else {
         return fail(BAD_INPUT, "merge: no input files");
     };
+    if chart.is_some() {
+        if let Err(e) = figure::chartable(&header.kind, &header.keys) {
+            return fail(BAD_INPUT, e);
+        }
+    }
     records.sort_by_key(|r| r.index);
     header.shard = "merged".into();
     header.members = header.points();

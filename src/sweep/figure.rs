@@ -54,20 +54,28 @@ pub fn reach_fit(header: &SweepHeader, records: &[Record], family: usize) -> Opt
     fit_power_law(&field, &field.levels(8))
 }
 
+/// Whether a sweep of this header has a chart; Err names why not (checked
+/// before any work, so that `--plot` on a sweep without one is bad input).
+pub fn chartable(kind: &str, keys: &[String]) -> Result<(), String> {
+    if kind != "arm" {
+        return Err("--plot: charts are drawn for arm sweeps (an [arm] table)".into());
+    }
+    if keys.iter().any(|k| k == ALPHA) || keys.len() == 2 {
+        Ok(())
+    } else {
+        Err(format!(
+            "--plot: charts need two axes or `{ALPHA}` among the axes, got {keys:?}"
+        ))
+    }
+}
+
 /// Draws the sweep's chart; Err names why there is none.
 pub fn draw(out: &Path, header: &SweepHeader, records: &[Record]) -> Result<(), String> {
-    if header.kind != "arm" {
-        return Err("charts are drawn for arm sweeps".into());
-    }
+    chartable(&header.kind, &header.keys)?;
     let result = if let Some(a) = header.keys.iter().position(|k| k == ALPHA) {
         envelope_chart(out, header, records, a)
-    } else if header.axes.len() == 2 {
-        map_chart(out, header, records)
     } else {
-        return Err(format!(
-            "charts need two axes or `{ALPHA}` among the axes, got {:?}",
-            header.keys
-        ));
+        map_chart(out, header, records)
     };
     result.map_err(|e| format!("{}: {e}", out.display()))
 }
