@@ -123,6 +123,30 @@ fn prepare(
     Ok((problem, claimed))
 }
 
+/// A failed solve: options the solver cannot run are bad input (2), a
+/// solver that found no equilibrium is no result (3); each with what to
+/// try next.
+fn solve_failed(e: &cosserat::bvp::SolveError) -> ExitCode {
+    use cosserat::bvp::SolveError as E;
+    let (code, hint) = match e {
+        E::Options(_) | E::Model(_) => (BAD_INPUT, "correct the problem file"),
+        E::NoConvergence { .. } | E::RampStalled { .. } => (
+            NO_RESULT,
+            "try solver.strategy = \"ramp\", --method multiple-shooting or collocation, \
+             or a guess solver.initial_curvature",
+        ),
+        E::Sampling(_) => (
+            NO_RESULT,
+            "raise solver.max_steps or loosen solver.integration_tolerance",
+        ),
+        E::Collocation { .. } => (
+            NO_RESULT,
+            "raise solver.max_intervals or loosen solver.collocation_tolerance",
+        ),
+    };
+    fail(code, format!("{e}\n  what to do: {hint}"))
+}
+
 /// Registers a claim's scratch files for removal on an immediate stop.
 pub(crate) fn hold(claim: Claim) -> Claim {
     for f in claim.scratch_files() {
@@ -168,7 +192,7 @@ fn run_stability(path: PathBuf, output: Option<PathBuf>, set: &[String], force: 
             );
             let eq = match solve(&problem.rod, &problem.model, &problem.options) {
                 Ok(eq) => eq,
-                Err(e) => return fail(NO_RESULT, e),
+                Err(e) => return solve_failed(&e),
             };
             match analyze(&problem.rod, &eq, &problem.options, opts) {
                 Ok(st) => {
@@ -241,7 +265,7 @@ fn run_solve(path: PathBuf, output: Option<PathBuf>, set: &[String], force: bool
     println!("energy    {}", problem.rod.energy.name());
     let eq = match solve(&problem.rod, &problem.model, &problem.options) {
         Ok(eq) => eq,
-        Err(e) => return fail(NO_RESULT, e),
+        Err(e) => return solve_failed(&e),
     };
     report(&eq);
     verdict(&problem, &eq);
