@@ -421,6 +421,17 @@ fn straight_optimum(arm: &ArmProblem, opt: &ArmOptimum) -> Option<cosserat::opti
         ),
         None => println!("straight  no stable level equilibrium found"),
     }
+    if let Some(s) = s
+        .as_ref()
+        .filter(|s| s.limit != cosserat::optimize::StraightLimit::StabilityLoss)
+    {
+        eprintln!(
+            "warning: R0 = {:.6} is a lower bound: the level family ended without losing \
+             stability ({})",
+            s.reach,
+            s.limit.name()
+        );
+    }
     s
 }
 

@@ -7,7 +7,9 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use cosserat::io::{read_sweep, Problem};
-use cosserat::optimize::{ArmProblem, ArmScene, SearchOptions, Verdict, REACH_TOLERANCE};
+use cosserat::optimize::{
+    ArmProblem, ArmScene, SearchOptions, StraightLimit, Verdict, REACH_TOLERANCE,
+};
 use cosserat::stability::StabilityOptions;
 
 const BIN: &str = env!("CARGO_BIN_EXE_cosserat");
@@ -461,8 +463,12 @@ fn long_computations_stop_when_asked() {
 
     let full = arm.straight().unwrap();
     assert!(!full.interrupted);
+    // The circular section's level family ends by lateral-torsional
+    // buckling (README), not where the solver gave up.
+    assert_eq!(full.limit, StraightLimit::StabilityLoss);
     let cut = arm.straight_until(&stop_after(3)).unwrap();
     assert!(cut.interrupted);
+    assert_eq!(cut.limit, StraightLimit::Interrupted);
     // A stable level equilibrium found before the stop: a lower bound.
     assert!(cut.reach <= full.reach && cut.reach > 0.0);
 

@@ -4,9 +4,11 @@
 //! `/optimum/shape_coefficients`, `/optimum/curvature_coefficients`,
 //! `/optimum/loaded_shape` (n×3), `/optimum/unloaded_shape` (n×3),
 //! `/optimum/intrinsic_curvature` (n), `/straight/reach`, `/straight/gamma_crit`,
-//! `/straight/clamp_angle`, `/straight/loaded_shape` (attribute
+//! `/straight/clamp_angle`, `/straight/loaded_shape` (attributes
 //! `stop_reason`: `interrupted` when the search for R̂0 was stopped, its
-//! reach then a lower bound); the problem text as the root attribute
+//! reach then a lower bound; `limit`: what ended the stable level family,
+//! `stability_loss` or `no_equilibrium` — a fold or a load the solver
+//! could not reach, R̂0 then a lower bound); the problem text as the root attribute
 //! `problem`, and `stop_reason` (`completed` or `interrupted`: then
 //! /optimum is the best design found so far, without a mesh check).
 //!
@@ -137,6 +139,7 @@ pub fn write_arm_study(
             scalar(&g, "clamp_angle", s.clamp_angle)?;
             points(&g, "loaded_shape", &s.loaded_shape)?;
             string_attr(&g, "stop_reason", stop_reason(s.interrupted))?;
+            string_attr(&g, "limit", s.limit.name())?;
         }
         if let Some(m) = study.map {
             let g = file.create_group("map")?;

@@ -36,6 +36,7 @@ pub use control_path::{
 pub use fig5::{ClosestStraight, ReachMap};
 pub use resolve::{MeshStudy, Resolution, Verdict, MAX_ELEMENTS, REACH_TOLERANCE};
 pub use scene::{ArmScene, ArmWeight};
+
 mod warm_start;
 
 /// The arm to design.
@@ -554,6 +555,32 @@ pub struct StraightArm {
     /// Whether `stop()` ended the search early: then this is the farthest
     /// stable level equilibrium found so far, a lower bound of R̂0.
     pub interrupted: bool,
+    /// What ended the stable level family beyond the largest load reached.
+    pub limit: StraightLimit,
+}
+
+/// What ends the stable part of the straight arm's level family.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StraightLimit {
+    /// The level equilibrium beyond it is unstable.
+    StabilityLoss,
+    /// No level equilibrium was found beyond it: a fold of the family, or
+    /// a load the solver could not reach — R̂0 is then a lower bound, and
+    /// said so (never taken silently for a stability limit).
+    NoEquilibrium,
+    /// The search was stopped before the end was found.
+    Interrupted,
+}
+
+impl StraightLimit {
+    /// `stability_loss`, `no_equilibrium` or `interrupted`.
+    pub fn name(self) -> &'static str {
+        match self {
+            StraightLimit::StabilityLoss => "stability_loss",
+            StraightLimit::NoEquilibrium => "no_equilibrium",
+            StraightLimit::Interrupted => "interrupted",
+        }
+    }
 }
 
 impl ArmProblem {
@@ -624,8 +651,14 @@ impl ArmProblem {
             // longer moves θ: near Euler's load the elevation of a column
             // is only as accurate as the BVP's residual times the growing
             // amplification 1/(1 − γ/γ_E), so 1e-12 may be out of reach.
-            if f1.abs() < 1e-12 || (t1 - t0).abs() < 1e-12 {
+            if f1.abs() < 1e-12 {
                 return Some((t1, eq));
+            }
+            if (t1 - t0).abs() < 1e-12 {
+                // A stalled secant is accepted only with the tip level to
+                // a micro-radian (the amplified residual near Euler's
+                // load); otherwise it is a failure, never a level arm.
+                return (f1.abs() < 1e-6).then_some((t1, eq));
             }
             k = Self::clamp_curvature(&eq);
             let next = t1 - f1 * (t1 - t0) / (f1 - f0);
@@ -672,8 +705,17 @@ impl ArmProblem {
         };
         let interrupted = |marched: &[(f64, Level, f64)]| {
             let best = best_of(marched)?;
-            self.straight_at(marched[best].0, &marched[best].1, true)
+            self.straight_at(
+                marched[best].0,
+                &marched[best].1,
+                StraightLimit::Interrupted,
+            )
         };
+        let reason = |found: &Option<(bool, Level, f64)>| match found {
+            Some(_) => StraightLimit::StabilityLoss,
+            None => StraightLimit::NoEquilibrium,
+        };
+        let mut limit: StraightLimit;
         let (mut lo, mut hi) = (0.25, 0.25 * 1.05);
         // A load where no level equilibrium is found counts as beyond the
         // limit, like an unstable one.
@@ -681,7 +723,9 @@ impl ArmProblem {
             if stop() {
                 return interrupted(&marched);
             }
-            let Some((true, next, r)) = level(hi, &state) else {
+            let found = level(hi, &state);
+            let Some((true, next, r)) = found else {
+                limit = reason(&found);
                 break;
             };
             marched.push((hi, next.clone(), r));
@@ -701,7 +745,7 @@ impl ArmProblem {
                     marched.push((mid, next.clone(), r));
                     (lo, state) = (mid, next);
                 }
-                _ => hi = mid,
+                found => (hi, limit) = (mid, reason(&found)),
             }
             if hi - lo < 1e-10 * hi {
                 break;
@@ -733,7 +777,7 @@ impl ArmProblem {
                 from = l;
             }
         }
-        self.straight_at(gamma, &from, false)
+        self.straight_at(gamma, &from, limit)
     }
 
     /// The level equilibrium at load γ from a neighbouring one's state
@@ -742,7 +786,7 @@ impl ArmProblem {
         &self,
         gamma: f64,
         from: &(f64, Vec<f64>),
-        interrupted: bool,
+        limit: StraightLimit,
     ) -> Option<StraightArm> {
         let (theta, eq) = self.level_clamp(gamma, from.0, Some(&from.1))?;
         let scale = gamma.sqrt();
@@ -761,7 +805,8 @@ impl ArmProblem {
                     ]
                 })
                 .collect(),
-            interrupted,
+            interrupted: limit == StraightLimit::Interrupted,
+            limit,
         })
     }
 }

@@ -358,4 +358,7 @@ fn write_straight(arm: &ArmProblem, record: &mut Record) {
         "straight/status",
         if s.is_some() { "found" } else { "not_found" },
     );
+    if let Some(s) = &s {
+        record.label("straight/limit", s.limit.name());
+    }
 }
