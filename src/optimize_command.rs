@@ -198,7 +198,7 @@ fn map_extras(
             opt.design.reach / q.optimum.design.reach
         );
     }
-    let least = arm.least_curvature(scene, &map, search.starts, search.iterations);
+    let (least, _) = arm.least_curvature(scene, &map, search.starts, search.iterations, &|| false);
     if let Some(l) = &least {
         println!(
             "least Σb² {:.3e} (the paper's R0 by Nelder–Mead from Q): R̂ = {:.6}; R*/R̂ = {:.3}",
@@ -389,6 +389,53 @@ fn report_optimum(opt: &ArmOptimum, time: f64) {
         peak / opt.scene.length(opt.design.gamma)
     );
     println!("          {} evaluations, {:.2} s", opt.evaluations, time);
+    report_mesh(opt);
+}
+
+/// The discretization error of R* (issue 14, item 11), and a warning on
+/// stderr when the search's mesh did not resolve its optimum.
+fn report_mesh(opt: &ArmOptimum) {
+    let Some(r) = &opt.resolution else {
+        return;
+    };
+    let s = &r.study;
+    let error = match (s.error(), s.order()) {
+        (Some(e), Some(p)) => format!("error {e:+.2e} (Richardson, measured order {p:.2})"),
+        _ => "error undecided (the differences do not converge geometrically)".into(),
+    };
+    println!(
+        "mesh      R* = {:.6} / {:.6} / {:.6} on {} / {} / {} elements: {error}; {}",
+        s.reach[0],
+        s.reach[1],
+        s.reach[2],
+        s.elements[0],
+        s.elements[1],
+        s.elements[2],
+        r.verdict.name()
+    );
+    if s.local_optima {
+        println!("          (on the finer meshes: the optima near the design, infeasible there)");
+    }
+    for (n, coarse, fine) in &r.rejected {
+        eprintln!(
+            "warning: R* = {coarse:.6} on {n} elements but {fine:.6} on {}: the mesh does not \
+             resolve the optimum (tolerance {:.0e}); searched again on {} elements",
+            4 * n,
+            cosserat::optimize::REACH_TOLERANCE,
+            4 * n
+        );
+    }
+    if r.verdict == cosserat::optimize::Verdict::Unresolved {
+        eprintln!(
+            "warning: R* = {:.6} on {} elements is not resolved to {:.0e} ({:.6} on {}); \
+             it carries the error above",
+            s.reach[0],
+            s.elements[0],
+            cosserat::optimize::REACH_TOLERANCE,
+            s.reach[2],
+            s.elements[2]
+        );
+    }
 }
 
 fn straight_optimum(arm: &ArmProblem, opt: &ArmOptimum) -> Option<cosserat::optimize::StraightArm> {
@@ -404,6 +451,17 @@ fn straight_optimum(arm: &ArmProblem, opt: &ArmOptimum) -> Option<cosserat::opti
             opt.design.reach / s.reach
         ),
         None => println!("straight  no stable level equilibrium found"),
+    }
+    if let Some(s) = s
+        .as_ref()
+        .filter(|s| s.limit != cosserat::optimize::StraightLimit::StabilityLoss)
+    {
+        eprintln!(
+            "warning: R0 = {:.6} is a lower bound: the level family ended without losing \
+             stability ({})",
+            s.reach,
+            s.limit.name()
+        );
     }
     s
 }

@@ -4,13 +4,32 @@
 //! `/optimum/shape_coefficients`, `/optimum/curvature_coefficients`,
 //! `/optimum/loaded_shape` (n×3), `/optimum/unloaded_shape` (n×3),
 //! `/optimum/intrinsic_curvature` (n), `/straight/reach`, `/straight/gamma_crit`,
-//! `/straight/clamp_angle`, `/straight/loaded_shape`; the problem text as the
-//! root attribute `problem`, and `stop_reason` (`completed` or
-//! `interrupted`: then /optimum is the best design found so far).
+//! `/straight/clamp_angle`, `/straight/loaded_shape` (attributes
+//! `stop_reason`: `interrupted` when the search for R̂0 was stopped, its
+//! reach then a lower bound; `limit`: what ended the stable level family,
+//! `stability_loss` or `no_equilibrium` — a fold or a load the solver
+//! could not reach, R̂0 then a lower bound); the problem text as the root attribute
+//! `problem`, and `stop_reason` (`completed` or `interrupted`: then
+//! /optimum is the best design found so far, without a mesh check).
+//!
+//! The discretization check of a reported design (in `/optimum`,
+//! `/closest_straight`, `/least_curvature`): `mesh_elements` (N, 2N, 4N,
+//! N the mesh the design was optimized on, also the attribute
+//! `elements`), `reach_meshes` (R̂ on each), `reach_fine` (R̂ on 4N),
+//! `reach_error` (Richardson's estimate of the error of `reach`, NaN when
+//! the order is undecided), `reach_order` (the measured order), the
+//! attribute `mesh_values` (`design`: the design's own reach on each
+//! mesh; `local_optima`: the design is infeasible on the finer meshes — an
+//! optimum on an actuator limit — and the values there are the optima
+//! polished from it), the attribute `mesh` (`resolved`, `refined`: searched again on a finer mesh
+//! because the search's did not resolve it, `unresolved`), and
+//! `rejected_designs` (k×3: elements, R̂ there, R̂ on 4× the elements) of
+//! the designs given up on the way.
 //!
 //! With a reach map (the Fig. 5 data set): `/map/reach` (n),
 //! `/map/load_factor` (n), `/map/shape_coefficients` (n×M),
-//! `/map/curvature_coefficients` (n×M), and the sample closest to a
+//! `/map/curvature_coefficients` (n×M), attributes `samples` (evaluated)
+//! and `stop_reason` (`interrupted`: a partial map), and the sample closest to a
 //! straight rod (the paper's 'Q') in `/closest_straight/` (`index`,
 //! `curvature_norm` = Σb², `reach`, `load_factor`, `shape_coefficients`,
 //! `curvature_coefficients`, `loaded_shape`, `unloaded_shape`); the design
@@ -25,7 +44,9 @@
 use std::path::Path;
 
 use super::hdf5_output::{array, string_attr, write_atomically, OutputError};
-use crate::optimize::{ArmOptimum, ClosestStraight, ReachMap, SearchProgress, StraightArm};
+use crate::optimize::{
+    ArmOptimum, ClosestStraight, ReachMap, Resolution, SearchProgress, StraightArm,
+};
 
 fn scalar(g: &hdf5::Group, name: &str, v: f64) -> hdf5::Result<()> {
     g.new_dataset::<f64>().create(name)?.write_scalar(&v)
@@ -47,6 +68,14 @@ fn rows(g: &hdf5::Group, name: &str, v: &[Vec<f64>]) -> hdf5::Result<()> {
 
 fn count(g: &hdf5::Location, name: &str, v: usize) -> hdf5::Result<()> {
     g.new_attr::<u64>().create(name)?.write_scalar(&(v as u64))
+}
+
+fn stop_reason(interrupted: bool) -> &'static str {
+    if interrupted {
+        "interrupted"
+    } else {
+        "completed"
+    }
 }
 
 /// Everything an optimize run keeps.
@@ -109,6 +138,8 @@ pub fn write_arm_study(
             scalar(&g, "gamma_crit", s.gamma)?;
             scalar(&g, "clamp_angle", s.clamp_angle)?;
             points(&g, "loaded_shape", &s.loaded_shape)?;
+            string_attr(&g, "stop_reason", stop_reason(s.interrupted))?;
+            string_attr(&g, "limit", s.limit.name())?;
         }
         if let Some(m) = study.map {
             let g = file.create_group("map")?;
@@ -116,6 +147,8 @@ pub fn write_arm_study(
             array(&g, "load_factor", &[m.gamma.len()], &m.gamma)?;
             rows(&g, "shape_coefficients", &m.shape_coefficients)?;
             rows(&g, "curvature_coefficients", &m.curvature_coefficients)?;
+            count(&g, "samples", m.samples)?;
+            string_attr(&g, "stop_reason", stop_reason(m.interrupted))?;
         }
         for (name, q) in [
             ("closest_straight", study.closest),
@@ -137,6 +170,9 @@ pub fn write_arm_study(
 
 fn write_design(g: &hdf5::Group, o: &ArmOptimum) -> hdf5::Result<()> {
     scalar(g, "reach", o.design.reach)?;
+    if let Some(r) = &o.resolution {
+        write_resolution(g, r)?;
+    }
     scalar(g, "load_factor", o.design.gamma)?;
     let c = &o.design.shape_coefficients;
     array(g, "shape_coefficients", &[c.len()], c)?;
@@ -146,6 +182,34 @@ fn write_design(g: &hdf5::Group, o: &ArmOptimum) -> hdf5::Result<()> {
     points(g, "unloaded_shape", &o.unloaded_shape)?;
     let k = &o.intrinsic_curvature;
     array(g, "intrinsic_curvature", &[k.len()], k)
+}
+
+/// The discretization check of a design (issue 14, item 11).
+fn write_resolution(g: &hdf5::Group, r: &Resolution) -> hdf5::Result<()> {
+    let s = &r.study;
+    let elements: Vec<f64> = s.elements.iter().map(|n| *n as f64).collect();
+    array(g, "mesh_elements", &[3], &elements)?;
+    array(g, "reach_meshes", &[3], &s.reach)?;
+    scalar(g, "reach_fine", s.reach[2])?;
+    scalar(g, "reach_error", s.error().unwrap_or(f64::NAN))?;
+    scalar(g, "reach_order", s.order().unwrap_or(f64::NAN))?;
+    count(g, "elements", s.elements[0])?;
+    string_attr(g, "mesh", r.verdict.name())?;
+    let values = if s.local_optima {
+        "local_optima"
+    } else {
+        "design"
+    };
+    string_attr(g, "mesh_values", values)?;
+    let rejected: Vec<Vec<f64>> = r
+        .rejected
+        .iter()
+        .map(|(n, coarse, fine)| vec![*n as f64, *coarse, *fine])
+        .collect();
+    if !rejected.is_empty() {
+        rows(g, "rejected_designs", &rejected)?;
+    }
+    Ok(())
 }
 
 fn write_progress(file: &hdf5::File, p: &SearchProgress) -> hdf5::Result<()> {

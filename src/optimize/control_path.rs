@@ -35,8 +35,21 @@ pub fn control_path(
     design: &ArmDesign,
     points: usize,
 ) -> Result<Diagram, ContinuationError> {
+    control_path_until(problem, scene, design, points, &|| false)
+}
+
+/// [`control_path`], stopping at the next point once `stop()` turns true:
+/// the diagram then holds the points computed, its `stop_reason`
+/// "interrupted".
+pub fn control_path_until(
+    problem: &ArmProblem,
+    scene: &ArmScene,
+    design: &ArmDesign,
+    points: usize,
+    stop: &dyn Fn() -> bool,
+) -> Result<Diagram, ContinuationError> {
     let rod = designed_rod(problem, scene, design, points);
-    continue_to_design(problem, rod, Parameter::ControlScale)
+    continue_to_design(problem, rod, Parameter::ControlScale, stop)
 }
 
 /// The loading path ([`super::loading_path`]) of a design in a scene: κ⁰
@@ -47,8 +60,20 @@ pub fn loading_path_in(
     design: &ArmDesign,
     points: usize,
 ) -> Result<Diagram, ContinuationError> {
+    loading_path_until(problem, scene, design, points, &|| false)
+}
+
+/// [`loading_path_in`], stopping at the next point once `stop()` turns
+/// true (the diagram's `stop_reason` then "interrupted").
+pub fn loading_path_until(
+    problem: &ArmProblem,
+    scene: &ArmScene,
+    design: &ArmDesign,
+    points: usize,
+    stop: &dyn Fn() -> bool,
+) -> Result<Diagram, ContinuationError> {
     let rod = designed_rod(problem, scene, design, points);
-    continue_to_design(problem, rod, Parameter::LoadScale)
+    continue_to_design(problem, rod, Parameter::LoadScale, stop)
 }
 
 /// The shape-holding control: the loads raised from 0 to the design's
@@ -64,6 +89,18 @@ pub fn shape_holding_path(
     scene: &ArmScene,
     design: &ArmDesign,
     points: usize,
+) -> Result<Diagram, ContinuationError> {
+    shape_holding_path_until(problem, scene, design, points, &|| false)
+}
+
+/// [`shape_holding_path`], stopping at the next point once `stop()` turns
+/// true (the diagram's `stop_reason` then "interrupted").
+pub fn shape_holding_path_until(
+    problem: &ArmProblem,
+    scene: &ArmScene,
+    design: &ArmDesign,
+    points: usize,
+    stop: &dyn Fn() -> bool,
 ) -> Result<Diagram, ContinuationError> {
     let target = designed_rod(problem, scene, design, points);
     let s: Vec<f64> = (0..points)
@@ -87,5 +124,5 @@ pub fn shape_holding_path(
         32,
         crate::bvp::integrator::Tolerances::default(),
     );
-    continue_family(problem, &family)
+    continue_family(problem, &family, stop)
 }

@@ -11,7 +11,7 @@
 
 use super::{ArmOptimum, ArmProblem, ArmScene};
 
-/// Designs of the box: Halton samples in the order of the global stage.
+/// Designs of the box: Sobol' samples in the order of the global stage.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct ReachMap {
     /// c1..cM of each design with a finite critical load.
@@ -22,6 +22,11 @@ pub struct ReachMap {
     pub reach: Vec<f64>,
     /// Its design load.
     pub gamma: Vec<f64>,
+    /// Samples evaluated (with or without a critical load).
+    pub samples: usize,
+    /// Whether `stop()` ended the map before all samples were evaluated:
+    /// then it holds the first `samples` only.
+    pub interrupted: bool,
 }
 
 /// The sample closest to an intrinsically straight rod (least Σ b_i²).
@@ -36,15 +41,18 @@ pub struct ClosestStraight {
 }
 
 impl ArmProblem {
-    /// R̂ and b of the first `samples` Halton points of the box (stops
-    /// early, keeping what it has, when `stop()` turns true).
+    /// R̂ and b of the first `samples` Sobol' points of the box; stops
+    /// early when `stop()` turns true (checked before every sample), the
+    /// map then holding what was computed, marked interrupted.
     pub fn reach_map(&self, scene: &ArmScene, samples: usize, stop: &dyn Fn() -> bool) -> ReachMap {
         let mut map = ReachMap::default();
         for i in 1..=samples {
             if stop() {
+                map.interrupted = true;
                 break;
             }
-            let p = self.halton_point(i);
+            map.samples = i;
+            let p = self.sample_point(i);
             let Some(d) = self.design_in(scene, &p) else {
                 continue;
             };
@@ -75,7 +83,7 @@ impl ReachMap {
         Some(ClosestStraight {
             index,
             curvature_norm: norm(&self.curvature_coefficients[index]),
-            optimum: problem.finish(scene, design, 1)?,
+            optimum: problem.checked(scene, problem.finish(scene, design, 1)?),
         })
     }
 }
@@ -86,6 +94,7 @@ impl ReachMap {
 struct CurvatureCost<'a> {
     problem: &'a ArmProblem,
     scene: &'a ArmScene,
+    stop: &'a dyn Fn() -> bool,
 }
 
 impl CurvatureCost<'_> {
@@ -100,6 +109,9 @@ impl argmin::core::CostFunction for &CurvatureCost<'_> {
     type Output = f64;
 
     fn cost(&self, p: &Vec<f64>) -> Result<f64, argmin::core::Error> {
+        if (self.stop)() {
+            return Err(argmin::core::Error::msg("interrupted"));
+        }
         let q = self.problem.project(p);
         let outside: f64 = p.iter().zip(&q).map(|(a, b)| (a - b).powi(2)).sum();
         let norm = self.fit(&q).map_or(1e6, |o| {
@@ -113,13 +125,17 @@ impl ArmProblem {
     /// The paper's R0 (Sec. 3.2): the design that minimizes Σ b_i², by
     /// Nelder–Mead from each of the `starts` map samples with the least
     /// Σ b_i²; the best result.
+    ///
+    /// `stop()` (checked at every evaluation) ends it early: the result is
+    /// then the best of the polishes finished, and the flag is true.
     pub fn least_curvature(
         &self,
         scene: &ArmScene,
         map: &ReachMap,
         starts: usize,
         iterations: u64,
-    ) -> Option<ClosestStraight> {
+        stop: &dyn Fn() -> bool,
+    ) -> (Option<ClosestStraight>, bool) {
         use argmin::core::{Executor, State};
         let norm = |b: &Vec<f64>| b.iter().map(|v| v * v).sum::<f64>();
         let mut order: Vec<usize> = (0..map.reach.len()).collect();
@@ -129,9 +145,13 @@ impl ArmProblem {
         let cost = CurvatureCost {
             problem: self,
             scene,
+            stop,
         };
         let mut best: Option<ClosestStraight> = None;
         for &index in order.iter().take(starts) {
+            if stop() {
+                return (best, true);
+            }
             let start = map.shape_coefficients[index][1..].to_vec();
             let simplex = self.simplex(&start);
             let Ok(solver) =
@@ -139,10 +159,14 @@ impl ArmProblem {
             else {
                 continue;
             };
-            let Ok(result) = Executor::new(&cost, solver)
+            let result = Executor::new(&cost, solver)
                 .configure(|s| s.max_iters(iterations))
-                .run()
-            else {
+                .run();
+            if stop() {
+                return (best, true);
+            }
+            // The cost never fails but on an interrupt, handled above.
+            let Ok(result) = result else {
                 continue;
             };
             let Some(p) = result.state().get_best_param() else {
@@ -160,6 +184,11 @@ impl ArmProblem {
                 });
             }
         }
-        best
+        // Its reach is reported: with its discretization error.
+        let best = best.map(|b| ClosestStraight {
+            optimum: self.checked(scene, b.optimum),
+            ..b
+        });
+        (best, false)
     }
 }

@@ -11,8 +11,9 @@
 //! The intrinsic curvature follows from (43): κ̄⁰2 = φ' − γ m̄2, with m̄2 the
 //! moment of the unit tip load on the shape.
 //!
-//! The search is deterministic: a Halton set over the box of c2..cM (the
-//! global stage), then Nelder–Mead (argmin) from the best few (the polish).
+//! The search is deterministic: an Owen-scrambled Sobol' set over the box
+//! of c2..cM (the global stage, [`sampling`]), then Nelder–Mead (argmin)
+//! from the best few (the polish).
 
 use std::sync::Arc;
 
@@ -24,11 +25,18 @@ use crate::stability::{critical_load, FixedShape, StabilityOptions};
 
 pub mod control_path;
 pub mod fig5;
+mod resolve;
+mod sampling;
 pub mod scene;
 
-pub use control_path::{control_path, loading_path_in, shape_holding_path};
+pub use control_path::{
+    control_path, control_path_until, loading_path_in, loading_path_until, shape_holding_path,
+    shape_holding_path_until,
+};
 pub use fig5::{ClosestStraight, ReachMap};
+pub use resolve::{MeshStudy, Resolution, Verdict, MAX_ELEMENTS, REACH_TOLERANCE};
 pub use scene::{ArmScene, ArmWeight};
+
 mod warm_start;
 
 /// The arm to design.
@@ -49,7 +57,7 @@ pub struct ArmProblem {
 /// How hard to search.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct SearchOptions {
-    /// Halton samples of the global stage.
+    /// Samples (scrambled Sobol' points) of the global stage.
     pub samples: usize,
     /// Nelder–Mead polishes from the best samples.
     pub starts: usize,
@@ -100,13 +108,19 @@ pub struct ArmOptimum {
     pub critical_load: f64,
     /// The loads and limits the design was made for.
     pub scene: ArmScene,
+    /// Its discretization check ([`ArmProblem::resolve`]): R̂ on finer
+    /// meshes, the error estimate, and whether it was searched for again on
+    /// a finer mesh. None
+    /// where no check was made (a sample, the best so far of an
+    /// interrupted search).
+    pub resolution: Option<Resolution>,
 }
 
 /// How far a search has come: what `cosserat optimize --resume` keeps of an
 /// interrupted run to go on where it stopped (issue 9).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct SearchProgress {
-    /// Halton samples evaluated: the global stage goes on from the next one.
+    /// Samples evaluated: the global stage goes on from the next one.
     pub samples_done: usize,
     /// The best samples so far as (R̂, c2..cM), best first, at most
     /// `starts` of them: the starting points of the polishes.
@@ -228,8 +242,8 @@ impl ArmProblem {
             .collect()
     }
 
-    /// The best design: Halton samples of the box, then Nelder–Mead from
-    /// the best few.
+    /// The best design: scrambled Sobol' samples of the box, then
+    /// Nelder–Mead from the best few.
     pub fn optimize(&self, opts: &SearchOptions) -> Option<ArmOptimum> {
         self.optimize_until(opts, &|| false).map(|(o, _)| o)
     }
@@ -252,14 +266,37 @@ impl ArmProblem {
     }
 
     /// The search in a scene, going on from `progress` (a fresh one, or
-    /// what an interrupted run kept): Halton samples of the box, then
+    /// what an interrupted run kept): Sobol' samples of the box, then
     /// Nelder–Mead from the best `starts`. Returns the optimum (the best
     /// so far when interrupted), the progress to resume from, and whether
     /// `stop()` interrupted it. Resuming gives the same optimum as an
     /// uninterrupted run: the samples are a fixed sequence and a polish
     /// cut short is redone from its start. `checkpoint` sees the progress
     /// after every sample and every polish (to save it against a kill).
+    ///
+    /// The optimum is then checked on finer meshes ([`Self::resolve`]):
+    /// where the search's mesh does not resolve it, the search is redone on
+    /// a finer one, and the optimum reported is that search's, with its
+    /// discretization error.
     pub fn search(
+        &self,
+        scene: &ArmScene,
+        opts: &SearchOptions,
+        progress: SearchProgress,
+        stop: &dyn Fn() -> bool,
+        checkpoint: &mut dyn FnMut(&SearchProgress),
+    ) -> (Option<ArmOptimum>, SearchProgress, bool) {
+        let (optimum, progress, interrupted) =
+            self.search_on_mesh(scene, opts, progress, stop, checkpoint);
+        if interrupted {
+            return (optimum, progress, true);
+        }
+        let optimum = optimum.map(|o| self.resolve(scene, o, opts, REACH_TOLERANCE, stop));
+        (optimum, progress, stop())
+    }
+
+    /// The search on this problem's mesh alone, without the mesh check.
+    fn search_on_mesh(
         &self,
         scene: &ArmScene,
         opts: &SearchOptions,
@@ -270,7 +307,7 @@ impl ArmProblem {
         let keep = opts.starts.max(1);
         while progress.samples_done < opts.samples && !stop() {
             let i = progress.samples_done + 1;
-            let p = self.halton_point(i);
+            let p = self.sample_point(i);
             progress.evaluations += 1;
             if let Some(d) = self.design_in(scene, &p) {
                 let at = progress.leaders.partition_point(|(r, _)| *r >= d.reach);
@@ -284,7 +321,7 @@ impl ArmProblem {
             let optimum = self
                 .design_in(scene, &[])
                 .and_then(|d| self.finish(scene, d, progress.evaluations));
-            return (optimum, progress, false);
+            return (optimum, progress, stop());
         }
         if progress.polishes_done == 0 {
             progress.best = progress
@@ -433,6 +470,7 @@ impl ArmProblem {
             evaluations,
             critical_load: critical,
             scene: *scene,
+            resolution: None,
         })
     }
 }
@@ -470,19 +508,6 @@ fn least_squares_polynomial(s: &[f64], y: &[f64], m: usize) -> Vec<f64> {
         .solve(&b, 1e-14)
         .map(|v| v.as_slice().to_vec())
         .unwrap_or_else(|_| vec![f64::NAN; m])
-}
-
-const PRIMES: [usize; 12] = [2, 3, 5, 7, 11, 13, 17, 19, 23, 29, 31, 37];
-
-/// The i-th element of the van der Corput sequence in base b.
-fn halton(mut i: usize, b: usize) -> f64 {
-    let (mut f, mut r) = (1.0, 0.0);
-    while i > 0 {
-        f /= b as f64;
-        r += f * (i % b) as f64;
-        i /= b;
-    }
-    r
 }
 
 /// −R̂ for Nelder–Mead; points outside the box are projected into it and
@@ -527,6 +552,35 @@ pub struct StraightArm {
     pub clamp_angle: f64,
     /// The loaded shape, scaled by √γ.
     pub loaded_shape: Vec<[f64; 3]>,
+    /// Whether `stop()` ended the search early: then this is the farthest
+    /// stable level equilibrium found so far, a lower bound of R̂0.
+    pub interrupted: bool,
+    /// What ended the stable level family beyond the largest load reached.
+    pub limit: StraightLimit,
+}
+
+/// What ends the stable part of the straight arm's level family.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StraightLimit {
+    /// The level equilibrium beyond it is unstable.
+    StabilityLoss,
+    /// No level equilibrium was found beyond it: a fold of the family, or
+    /// a load the solver could not reach — R̂0 is then a lower bound, and
+    /// said so (never taken silently for a stability limit).
+    NoEquilibrium,
+    /// The search was stopped before the end was found.
+    Interrupted,
+}
+
+impl StraightLimit {
+    /// `stability_loss`, `no_equilibrium` or `interrupted`.
+    pub fn name(self) -> &'static str {
+        match self {
+            StraightLimit::StabilityLoss => "stability_loss",
+            StraightLimit::NoEquilibrium => "no_equilibrium",
+            StraightLimit::Interrupted => "interrupted",
+        }
+    }
 }
 
 impl ArmProblem {
@@ -597,8 +651,14 @@ impl ArmProblem {
             // longer moves θ: near Euler's load the elevation of a column
             // is only as accurate as the BVP's residual times the growing
             // amplification 1/(1 − γ/γ_E), so 1e-12 may be out of reach.
-            if f1.abs() < 1e-12 || (t1 - t0).abs() < 1e-12 {
+            if f1.abs() < 1e-12 {
                 return Some((t1, eq));
+            }
+            if (t1 - t0).abs() < 1e-12 {
+                // A stalled secant is accepted only with the tip level to
+                // a micro-radian (the amplified residual near Euler's
+                // load); otherwise it is a failure, never a level arm.
+                return (f1.abs() < 1e-6).then_some((t1, eq));
             }
             k = Self::clamp_curvature(&eq);
             let next = t1 - f1 * (t1 - t0) / (f1 - f0);
@@ -614,6 +674,13 @@ impl ArmProblem {
     /// so its largest value on the stable part is refined by golden-section
     /// search around the best step.
     pub fn straight(&self) -> Option<StraightArm> {
+        self.straight_until(&|| false)
+    }
+
+    /// As [`Self::straight`], stopping early when `stop()` turns true
+    /// (checked before every load step): the result is then the farthest
+    /// stable level equilibrium found so far, marked interrupted.
+    pub fn straight_until(&self, stop: &dyn Fn() -> bool) -> Option<StraightArm> {
         let opts = crate::bvp::SolverOptions::default();
         type Level = (f64, Vec<f64>);
         let reach =
@@ -633,10 +700,34 @@ impl ArmProblem {
         // (γ, state, R̂) of every stable step.
         let mut marched: Vec<(f64, Level, f64)> =
             vec![(0.25, state.clone(), reach(0.25, &first.1))];
+        let best_of = |marched: &[(f64, Level, f64)]| {
+            (0..marched.len()).max_by(|&a, &b| marched[a].2.total_cmp(&marched[b].2))
+        };
+        let interrupted = |marched: &[(f64, Level, f64)]| {
+            let best = best_of(marched)?;
+            self.straight_at(
+                marched[best].0,
+                &marched[best].1,
+                StraightLimit::Interrupted,
+            )
+        };
+        let reason = |found: &Option<(bool, Level, f64)>| match found {
+            Some(_) => StraightLimit::StabilityLoss,
+            None => StraightLimit::NoEquilibrium,
+        };
+        let mut limit: StraightLimit;
         let (mut lo, mut hi) = (0.25, 0.25 * 1.05);
         // A load where no level equilibrium is found counts as beyond the
         // limit, like an unstable one.
-        while let Some((true, next, r)) = level(hi, &state) {
+        loop {
+            if stop() {
+                return interrupted(&marched);
+            }
+            let found = level(hi, &state);
+            let Some((true, next, r)) = found else {
+                limit = reason(&found);
+                break;
+            };
             marched.push((hi, next.clone(), r));
             (lo, state) = (hi, next);
             hi *= 1.05;
@@ -645,19 +736,22 @@ impl ArmProblem {
             }
         }
         for _ in 0..40 {
+            if stop() {
+                return interrupted(&marched);
+            }
             let mid = 0.5 * (lo + hi);
             match level(mid, &state) {
                 Some((true, next, r)) => {
                     marched.push((mid, next.clone(), r));
                     (lo, state) = (mid, next);
                 }
-                _ => hi = mid,
+                found => (hi, limit) = (mid, reason(&found)),
             }
             if hi - lo < 1e-10 * hi {
                 break;
             }
         }
-        let best = (0..marched.len()).max_by(|&a, &b| marched[a].2.total_cmp(&marched[b].2))?;
+        let best = best_of(&marched)?;
         let (mut gamma, mut from) = (marched[best].0, marched[best].1.clone());
         if best > 0 && best + 1 < marched.len() {
             // Golden-section search for the largest R̂ between the neighbours.
@@ -665,6 +759,9 @@ impl ArmProblem {
             let g = 0.5 * (5f64.sqrt() - 1.0);
             let f = |x: f64, from: &Level| level(x, from).map_or(f64::NEG_INFINITY, |l| l.2);
             for _ in 0..60 {
+                if stop() {
+                    return interrupted(&marched);
+                }
                 let (c, d) = (b - g * (b - a), a + g * (b - a));
                 if f(c, &from) > f(d, &from) {
                     b = d;
@@ -680,12 +777,22 @@ impl ArmProblem {
                 from = l;
             }
         }
-        let lo = gamma;
-        let (theta, eq) = self.level_clamp(lo, from.0, Some(&from.1))?;
-        let scale = lo.sqrt();
+        self.straight_at(gamma, &from, limit)
+    }
+
+    /// The level equilibrium at load γ from a neighbouring one's state
+    /// (θ, κ(0)), as a [`StraightArm`].
+    fn straight_at(
+        &self,
+        gamma: f64,
+        from: &(f64, Vec<f64>),
+        limit: StraightLimit,
+    ) -> Option<StraightArm> {
+        let (theta, eq) = self.level_clamp(gamma, from.0, Some(&from.1))?;
+        let scale = gamma.sqrt();
         Some(StraightArm {
             reach: scale * eq.tip().position.norm(),
-            gamma: lo,
+            gamma,
             clamp_angle: theta,
             loaded_shape: eq
                 .samples
@@ -698,6 +805,8 @@ impl ArmProblem {
                     ]
                 })
                 .collect(),
+            interrupted: limit == StraightLimit::Interrupted,
+            limit,
         })
     }
 }
@@ -749,6 +858,7 @@ pub(crate) fn continue_to_design(
     problem: &ArmProblem,
     rod: Rod,
     parameter: crate::continuation::Parameter,
+    stop: &dyn Fn() -> bool,
 ) -> Result<crate::continuation::Diagram, crate::continuation::ContinuationError> {
     let family = crate::continuation::Family::new(
         rod,
@@ -757,13 +867,16 @@ pub(crate) fn continue_to_design(
         32,
         crate::bvp::integrator::Tolerances::default(),
     );
-    continue_family(problem, &family)
+    continue_family(problem, &family, stop)
 }
 
-/// Continues `family` from p = 10⁻³ to 1 with the design's own mesh.
+/// Continues `family` from p = 10⁻³ to 1 with the design's own mesh,
+/// stopping at the next point once `stop()` turns true (the diagram's
+/// `stop_reason` is then "interrupted").
 pub(crate) fn continue_family(
     problem: &ArmProblem,
     family: &crate::continuation::Family,
+    stop: &dyn Fn() -> bool,
 ) -> Result<crate::continuation::Diagram, crate::continuation::ContinuationError> {
     use crate::continuation::{continuation, ContinuationOptions};
     let opts = ContinuationOptions {
@@ -779,7 +892,7 @@ pub(crate) fn continue_family(
         },
         ..Default::default()
     };
-    continuation(family, &opts, &mut |_, _| true)
+    continuation(family, &opts, &mut |_, _| !stop())
 }
 
 /// The loading path of a designed arm (paper Sec. 5 warns that loading need
@@ -792,6 +905,5 @@ pub fn loading_path(
     design: &ArmDesign,
     points: usize,
 ) -> Result<crate::continuation::Diagram, crate::continuation::ContinuationError> {
-    let rod = designed_rod(problem, &ArmScene::default(), design, points);
-    continue_to_design(problem, rod, crate::continuation::Parameter::LoadScale)
+    loading_path_until(problem, &ArmScene::default(), design, points, &|| false)
 }

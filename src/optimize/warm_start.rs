@@ -1,4 +1,4 @@
-//! Pieces of the arm search that a sweep reuses point by point: Halton
+//! Pieces of the arm search that a sweep reuses point by point: the
 //! samples of the box, a Nelder–Mead polish from a given start with a
 //! chosen simplex size (a warm start from a neighbouring grid point's
 //! optimum needs a small simplex, a cold start the search's 5 %), and the
@@ -7,16 +7,18 @@
 //! A child module of `optimize`, so that it uses the search's private
 //! pieces instead of copying them.
 
-use super::{halton, ArmDesign, ArmOptimum, ArmProblem, ArmScene, PRIMES};
+use super::{sampling, ArmDesign, ArmOptimum, ArmProblem, ArmScene};
 
 impl ArmProblem {
-    /// The i-th Halton point (i ≥ 1) of the box of c2..cM — the samples of
-    /// the global stage of [`ArmProblem::optimize`].
-    pub fn halton_point(&self, i: usize) -> Vec<f64> {
-        self.bounds
+    /// The i-th sample (i ≥ 1) of the box of c2..cM — the samples of the
+    /// global stage of [`ArmProblem::optimize`]: point i − 1 of the
+    /// scrambled Sobol' sequence ([`sampling`]) mapped onto the bounds.
+    pub fn sample_point(&self, i: usize) -> Vec<f64> {
+        assert!(i >= 1, "samples are numbered from 1");
+        sampling::unit_point(i - 1, self.bounds.len())
             .iter()
-            .enumerate()
-            .map(|(d, (lo, hi))| lo + (hi - lo) * halton(i, PRIMES[d % PRIMES.len()]))
+            .zip(&self.bounds)
+            .map(|(u, (lo, hi))| lo + (hi - lo) * u)
             .collect()
     }
 

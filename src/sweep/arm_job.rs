@@ -2,7 +2,7 @@
 //! two families of local optima across the grid.
 //!
 //! Cold (the first point of a line): the global stage of
-//! [`ArmProblem::optimize`] — Halton samples of the box, Nelder–Mead from
+//! [`ArmProblem::optimize`] — Sobol' samples of the box, Nelder–Mead from
 //! the best `starts` samples — plus, with two families, `starts` more
 //! polishes from samples spread evenly over the ranking, so that a basin
 //! other than the best one is entered. Family 0 is the best polished
@@ -13,13 +13,15 @@
 //!
 //! Warm (the next points of the line): each family is polished from its
 //! predecessor's optimum with a small simplex (1 % of the bounds), and
-//! family 0 also from `warm_samples` Halton samples; family 1 is marked
+//! family 0 also from `warm_samples` Sobol' samples; family 1 is marked
 //! `merged` when its polish lands on family 0's shape. Family 0 is the
 //! better of the two at each point (they swap labels where they cross).
 
 use super::{Job, Record};
 use crate::io::Problem;
-use crate::optimize::{ArmDesign, ArmProblem, ArmScene, SearchOptions};
+use crate::optimize::{
+    ArmDesign, ArmOptimum, ArmProblem, ArmScene, SearchOptions, Verdict, REACH_TOLERANCE,
+};
 
 /// Loaded shapes closer than this (root-mean-square difference of the
 /// turning angle φ(s̄) over [0, 1], rad) are one local optimum: the reach
@@ -37,7 +39,7 @@ const COLD_STEP: f64 = 0.05;
 pub struct ArmJob {
     /// Families followed (1 or 2).
     pub families: usize,
-    /// Halton samples added to a warm polish of family 0.
+    /// Sobol' samples added to a warm polish of family 0.
     pub warm_samples: usize,
     /// Nelder–Mead iterations of a warm polish.
     pub warm_iterations: u64,
@@ -79,6 +81,8 @@ pub fn distinct_optima(arm: &ArmProblem, scene: &ArmScene, a: &ArmDesign, b: &Ar
 struct Found {
     design: Option<ArmDesign>,
     status: &'static str,
+    /// `cold`, `warm` or `cold_after_failure`.
+    start: &'static str,
     evaluations: usize,
 }
 
@@ -87,7 +91,7 @@ impl ArmJob {
     fn cold(&self, arm: &ArmProblem, scene: &ArmScene, search: &SearchOptions) -> Vec<Found> {
         let mut sampled: Vec<(f64, Vec<f64>)> = (1..=search.samples)
             .filter_map(|i| {
-                let p = arm.halton_point(i);
+                let p = arm.sample_point(i);
                 arm.design_in(scene, &p).map(|d| (d.reach, p))
             })
             .collect();
@@ -114,6 +118,7 @@ impl ArmJob {
         });
         let found = |design: Option<ArmDesign>, missing: &'static str| Found {
             status: if design.is_some() { "optimum" } else { missing },
+            start: "cold",
             design,
             evaluations,
         };
@@ -136,6 +141,7 @@ impl ArmJob {
             return Found {
                 design: None,
                 status: "not_found",
+                start: "warm",
                 evaluations: 0,
             };
         };
@@ -144,7 +150,7 @@ impl ArmJob {
         if f == 0 && self.warm_samples > 0 {
             let best_sample = (1..=self.warm_samples)
                 .filter_map(|i| {
-                    let p = arm.halton_point(i);
+                    let p = arm.sample_point(i);
                     arm.design_in(scene, &p).map(|d| (d.reach, p))
                 })
                 .max_by(|a, b| a.0.total_cmp(&b.0));
@@ -163,42 +169,60 @@ impl ArmJob {
             } else {
                 "no_critical_load"
             },
+            start: "warm",
             design,
             evaluations,
         }
     }
 
-    /// Records family `f`'s outcome.
-    fn write(
-        &self,
-        arm: &ArmProblem,
-        scene: &ArmScene,
-        record: &mut Record,
-        f: usize,
-        found: Found,
-    ) {
-        let m = arm.coefficients();
+    /// Records family `f`'s outcome: the optimum as reported (checked on
+    /// finer meshes, searched again on a finer mesh where the search's does not resolve
+    /// it: [`ArmProblem::resolve`]) with its discretization error.
+    fn write(record: &mut Record, m: usize, f: usize, outcome: &Outcome) {
         let key = |name: &str| format!("family_{f}/{name}");
         let nan = vec![f64::NAN; m];
-        let optimum = found
-            .design
-            .and_then(|d| arm.complete(scene, d, found.evaluations));
-        let (reach, gamma, c, b) = match &optimum {
-            Some(o) => (
-                o.design.reach,
-                o.design.gamma,
-                o.design.shape_coefficients.clone(),
-                o.curvature_coefficients.clone(),
-            ),
-            None => (f64::NAN, f64::NAN, nan.clone(), nan),
-        };
-        record.set(&key("reach"), vec![reach]);
-        record.set(&key("gamma_crit"), vec![gamma]);
-        record.set(&key("shape_coefficients"), c);
-        record.set(&key("curvature_coefficients"), b);
-        record.set(&key("evaluations"), vec![found.evaluations as f64]);
-        record.label(&key("status"), found.status);
+        let optimum = outcome.optimum.as_ref();
+        let value = |g: fn(&ArmOptimum) -> f64| optimum.map_or(f64::NAN, g);
+        let check = optimum.and_then(|o| o.resolution.as_ref());
+        let study = |g: fn(&crate::optimize::Resolution) -> f64| check.map_or(f64::NAN, g);
+        record.set(&key("reach"), vec![value(|o| o.design.reach)]);
+        record.set(&key("gamma_crit"), vec![value(|o| o.design.gamma)]);
+        record.set(
+            &key("shape_coefficients"),
+            optimum.map_or(nan.clone(), |o| o.design.shape_coefficients.clone()),
+        );
+        record.set(
+            &key("curvature_coefficients"),
+            optimum.map_or(nan, |o| o.curvature_coefficients.clone()),
+        );
+        record.set(&key("reach_fine"), vec![study(|r| r.study.reach[2])]);
+        record.set(
+            &key("reach_error"),
+            vec![study(|r| r.study.error().unwrap_or(f64::NAN))],
+        );
+        record.set(
+            &key("reach_order"),
+            vec![study(|r| r.study.order().unwrap_or(f64::NAN))],
+        );
+        record.set(
+            &key("elements"),
+            vec![study(|r| r.study.elements[0] as f64)],
+        );
+        record.set(&key("evaluations"), vec![outcome.evaluations as f64]);
+        record.label(&key("status"), outcome.status);
+        record.label(&key("start"), outcome.start);
+        if let Some(r) = check {
+            record.label(&key("mesh"), r.verdict.name());
+        }
     }
+}
+
+/// A family's reported outcome at a point.
+struct Outcome {
+    optimum: Option<ArmOptimum>,
+    status: &'static str,
+    start: &'static str,
+    evaluations: usize,
 }
 
 impl Job for ArmJob {
@@ -208,24 +232,71 @@ impl Job for ArmJob {
 
     fn run(&self, index: usize, problem: &Problem, previous: Option<&Record>) -> Record {
         let mut record = Record::new(index);
-        let Some((arm, search, straight)) = &problem.arm else {
+        let (Some((arm, search, straight)), Some((scene, _))) = (&problem.arm, &problem.arm_scene)
+        else {
             record.label("error", "the problem has no [arm] table");
             return record;
         };
-        // The arm's loads and actuator limit (the paper's tip load unless
-        // the file says otherwise).
-        let scene = problem.arm_scene.map(|(s, _)| s).unwrap_or_default();
         let mut found = match previous {
-            None => self.cold(arm, &scene, search),
-            Some(p) => (0..self.families)
-                .map(|f| self.warm(arm, &scene, p, f))
-                .collect(),
+            None => self.cold(arm, scene, search),
+            Some(p) => {
+                let warm: Vec<Found> = (0..self.families)
+                    .map(|f| self.warm(arm, scene, p, f))
+                    .collect();
+                if warm.iter().all(|w| w.design.is_some()) {
+                    warm
+                } else {
+                    // A family without a predecessor to start from (it
+                    // failed there) or whose warm polish failed is searched
+                    // cold: one failure must not end the family for the
+                    // rest of the line (issue 14, item 6).
+                    let cold = self.cold(arm, scene, search);
+                    warm.into_iter()
+                        .zip(cold)
+                        .map(|(w, c)| match w.design {
+                            Some(_) => w,
+                            None => Found {
+                                evaluations: w.evaluations + c.evaluations,
+                                start: "cold_after_failure",
+                                ..c
+                            },
+                        })
+                        .collect()
+                }
+            }
         };
         if let [first, second] = &mut found[..] {
             if let (Some(a), Some(b)) = (&first.design, &second.design) {
-                if !distinct_optima(arm, &scene, a, b) {
+                if !distinct_optima(arm, scene, a, b) {
                     second.status = "merged";
-                } else if b.reach > a.reach {
+                }
+            }
+        }
+        let mut outcomes: Vec<Outcome> = found
+            .into_iter()
+            .map(|f| {
+                let had_design = f.design.is_some();
+                let optimum = f
+                    .design
+                    .and_then(|d| arm.complete(scene, d, 0))
+                    .map(|o| arm.resolve(scene, o, search, REACH_TOLERANCE, &|| false));
+                let evaluations = f.evaluations + optimum.as_ref().map_or(0, |o| o.evaluations);
+                Outcome {
+                    status: if optimum.is_some() || !had_design {
+                        f.status
+                    } else {
+                        "evaluation_failed"
+                    },
+                    optimum,
+                    start: f.start,
+                    evaluations,
+                }
+            })
+            .collect();
+        if let [first, second] = &mut outcomes[..] {
+            if let (Some(a), Some(b), "optimum") = (&first.optimum, &second.optimum, second.status)
+            {
+                if b.design.reach > a.design.reach {
                     // Family 0 is the better optimum at every point (the
                     // paper's panel a, "the global optimum"); the two
                     // continued optima swap labels where they cross.
@@ -233,14 +304,45 @@ impl Job for ArmJob {
                 }
             }
         }
-        for (f, outcome) in found.into_iter().enumerate() {
-            self.write(arm, &scene, &mut record, f, outcome);
+        let m = arm.coefficients();
+        for (f, outcome) in outcomes.iter().enumerate() {
+            Self::write(&mut record, m, f, outcome);
+            if let Some(r) = outcome.optimum.as_ref().and_then(|o| o.resolution.as_ref()) {
+                warn_mesh(index, f, r);
+            }
         }
         if *straight {
             write_straight(arm, &mut record);
         }
         record
     }
+}
+
+/// Says on stderr when a family's optimum was not resolved by the search's
+/// mesh (the reported one is then the finer mesh's, or carries its error).
+fn warn_mesh(index: usize, f: usize, r: &crate::optimize::Resolution) {
+    let Some(&(n, coarse, fine)) = r.rejected.first() else {
+        if r.verdict == Verdict::Unresolved {
+            eprintln!(
+                "warning: point {index}, family {f}: R* = {:.6} on {} elements is not resolved \
+                 ({:.6} on {}); reported with its error",
+                r.study.reach[0], r.study.elements[0], r.study.reach[2], r.study.elements[2]
+            );
+        }
+        return;
+    };
+    eprintln!(
+        "warning: point {index}, family {f}: R* = {coarse:.6} on {n} elements but {fine:.6} \
+         on {}: {} on {} elements, R* = {:.6}",
+        4 * n,
+        if r.verdict == Verdict::Refined {
+            "searched again"
+        } else {
+            "still unresolved"
+        },
+        r.study.elements[0],
+        r.study.reach[0]
+    );
 }
 
 /// R0 of the intrinsically straight arm at the point's direction α
@@ -256,4 +358,7 @@ fn write_straight(arm: &ArmProblem, record: &mut Record) {
         "straight/status",
         if s.is_some() { "found" } else { "not_found" },
     );
+    if let Some(s) = &s {
+        record.label("straight/limit", s.limit.name());
+    }
 }
