@@ -110,19 +110,16 @@ pub fn run_optimize(run: OptimizeRun) -> ExitCode {
         }
     }
     report_optimum(&opt, t.elapsed().as_secs_f64());
+    // What follows the search stops at its next point on a signal; the
+    // study then stays marked interrupted (its search complete), so that
+    // `--resume` computes the rest.
+    signals::set_mode(signals::Mode::NextPoint);
     let straight = (*straight && scene.weight == ArmWeight::Weightless)
         .then(|| straight_optimum(arm, &opt))
         .flatten();
     let extras = map_extras(arm, search, scene, *map_samples, &opt);
-    if let Err(code) = write_study(
-        &run,
-        &problem.text,
-        &opt,
-        straight.as_ref(),
-        &extras,
-        &progress,
-    ) {
-        return code;
+    if signals::requested() {
+        return keep_interrupted(&run, &problem.text, &opt, &progress);
     }
     let paths = [
         (&run.loading_path, Route::LOADING),
@@ -136,6 +133,20 @@ pub fn run_optimize(run: OptimizeRun) -> ExitCode {
                 return code;
             }
         }
+    }
+    if signals::requested() {
+        return keep_interrupted(&run, &problem.text, &opt, &progress);
+    }
+    signals::set_mode(signals::Mode::Immediate);
+    if let Err(code) = write_study(
+        &run,
+        &problem.text,
+        &opt,
+        straight.as_ref(),
+        &extras,
+        &progress,
+    ) {
+        return code;
     }
     ExitCode::SUCCESS
 }
@@ -187,7 +198,7 @@ fn map_extras(
     if samples == 0 {
         return MapExtras::default();
     }
-    let map = arm.reach_map(scene, samples, &|| false);
+    let map = arm.reach_map(scene, samples, &signals::requested);
     let closest = map.closest_straight(arm, scene);
     if let Some(q) = &closest {
         println!(
@@ -198,7 +209,13 @@ fn map_extras(
             opt.design.reach / q.optimum.design.reach
         );
     }
-    let (least, _) = arm.least_curvature(scene, &map, search.starts, search.iterations, &|| false);
+    let (least, _) = arm.least_curvature(
+        scene,
+        &map,
+        search.starts,
+        search.iterations,
+        &signals::requested,
+    );
     if let Some(l) = &least {
         println!(
             "least Σb² {:.3e} (the paper's R0 by Nelder–Mead from Q): R̂ = {:.6}; R*/R̂ = {:.3}",
@@ -440,7 +457,7 @@ fn report_mesh(opt: &ArmOptimum) {
 
 fn straight_optimum(arm: &ArmProblem, opt: &ArmOptimum) -> Option<cosserat::optimize::StraightArm> {
     let t = Instant::now();
-    let s = arm.straight();
+    let s = arm.straight_until(&signals::requested);
     match &s {
         Some(s) => println!(
             "straight  R0 = {:.6}, γ_crit = {:.6}, clamp angle {:.3}° ({:.2} s); R*/R0 = {:.3}",
@@ -499,10 +516,11 @@ fn write_path(
     kind: Route,
 ) -> ExitCode {
     let t = Instant::now();
+    let stop = &signals::requested;
     let diagram = match kind.name {
-        "loading" => cosserat::optimize::loading_path_in(arm, scene, &opt.design, 2001),
-        "control" => cosserat::optimize::control_path(arm, scene, &opt.design, 2001),
-        _ => cosserat::optimize::shape_holding_path(arm, scene, &opt.design, 2001),
+        "loading" => cosserat::optimize::loading_path_until(arm, scene, &opt.design, 2001, stop),
+        "control" => cosserat::optimize::control_path_until(arm, scene, &opt.design, 2001, stop),
+        _ => cosserat::optimize::shape_holding_path_until(arm, scene, &opt.design, 2001, stop),
     };
     let diagram = match diagram {
         Ok(d) => d,
