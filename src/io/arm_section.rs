@@ -19,6 +19,7 @@ pub struct ArmSection {
     /// M, the number of Taylor coefficients of φ(s̄).
     pub coefficients: usize,
     /// Bounds of c2..cM, M − 1 pairs.
+    #[serde(deserialize_with = "super::strict::vec")]
     pub bounds: Vec<[f64; 2]>,
     /// Halton samples of the global stage.
     #[serde(default = "default_samples")]

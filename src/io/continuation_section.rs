@@ -18,6 +18,7 @@ pub struct ContinuationSection {
     /// The value to start from.
     pub start: f64,
     /// [min, max]: a branch stops when the parameter leaves it.
+    #[serde(deserialize_with = "super::strict::array")]
     pub bounds: [f64; 2],
     /// Initial arclength step.
     #[serde(default = "default_step")]

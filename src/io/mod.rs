@@ -7,6 +7,7 @@ mod continuation_section;
 mod diagram;
 mod hdf5_output;
 mod problem;
+mod strict;
 mod support_section;
 mod sweep_output;
 mod sweep_section;

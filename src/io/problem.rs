@@ -16,6 +16,7 @@ use serde::{Deserialize, Deserializer, Serialize};
 
 use super::arm_section::ArmSection;
 use super::continuation_section::ContinuationSection;
+use super::strict;
 use super::sweep_section::{Sweep, SweepSection};
 use super::SupportSection;
 use crate::bvp::integrator::Tolerances;
@@ -150,9 +151,10 @@ pub struct EnergySection {
     #[serde(default = "default_energy_kind")]
     pub kind: String,
     /// B1, B2, B3 (N·m²), each a profile.
+    #[serde(deserialize_with = "strict::array")]
     pub stiffness: [ProfileSpec; 3],
     /// κ⁰ body components (1/m), each a profile.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "strict::array")]
     pub intrinsic_curvature: [ProfileSpec; 3],
     /// C (N·m⁴) of the quartic energy (shorthand for
     /// `parameters.quartic`).
@@ -164,7 +166,11 @@ pub struct EnergySection {
     /// Shear and extension stiffnesses (k G A, k G A, E A) in N: a
     /// shearable, extensible Cosserat rod. Absent: unshearable and
     /// inextensible (Kirchhoff).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "strict::option"
+    )]
     pub shear: Option<[f64; 3]>,
 }
 
@@ -237,13 +243,13 @@ impl<'de> Deserialize<'de> for ProfileSpec {
 #[serde(deny_unknown_fields)]
 pub struct ClampSection {
     /// r(0) (m).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "strict::array")]
     pub position: [f64; 3],
     /// d1(0), a unit vector.
-    #[serde(default = "unit_x")]
+    #[serde(default = "unit_x", deserialize_with = "strict::array")]
     pub d1: [f64; 3],
     /// d3(0), the tangent, a unit vector orthogonal to d1.
-    #[serde(default = "unit_z")]
+    #[serde(default = "unit_z", deserialize_with = "strict::array")]
     pub d3: [f64; 3],
     /// The frame (d1, d3) turned about d2 by this angle (rad), d3 towards
     /// d1: the clamp angle of the paper's Fig. 2.
@@ -279,13 +285,13 @@ impl Default for ClampSection {
 #[serde(deny_unknown_fields)]
 pub struct LoadSection {
     /// Tip force (N).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "strict::array")]
     pub tip_force: [f64; 3],
     /// Tip couple (N·m).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "strict::array")]
     pub tip_couple: [f64; 3],
     /// Uniform force per unit length (N/m), e.g. self-weight ρAg.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "strict::array")]
     pub distributed_force: [f64; 3],
 }
 
@@ -331,7 +337,11 @@ pub struct SolverSection {
     #[serde(default = "default_output_points")]
     pub output_points: usize,
     /// Guess of κ(0), body components (1/m).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "strict::option"
+    )]
     pub initial_curvature: Option<[f64; 3]>,
 }
 
@@ -433,8 +443,7 @@ impl Problem {
         catalog: &EnergyCatalog,
     ) -> Result<Problem, ProblemError> {
         let text = apply_overrides(text, overrides)?;
-        let file: ProblemFile =
-            toml::from_str(&text).map_err(|e| ProblemError::Parse(e.to_string()))?;
+        let file: ProblemFile = strict::parse(&text)?;
         let rod = build_rod(&file, catalog)?;
         let model = choose_model(&rod, &file.solver.model, file.energy.shear.is_some())?;
         if rod.clamp.hinge && model.level != ModelLevel::Planar {

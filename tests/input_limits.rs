@@ -1,0 +1,159 @@
+//! Issue 14, the input side: every number of a problem file has a
+//! meaningful range and every array its length; what falls outside is
+//! refused before any work, with the key's name, the allowed range and
+//! what to do. Where a bad count could reach a computation, the
+//! computation returns an error instead of panicking.
+
+use cosserat::io::Problem;
+
+/// A planar cantilever under a tip load: the smallest valid problem.
+const CANTILEVER: &str = "
+[rod]
+length = 1.0
+[energy]
+stiffness = [1.0, 1.0, 1.0]
+[loads]
+tip_force = [1.0, 0.0, 0.0]
+";
+
+/// The error text of `text` with `overrides`; panics when accepted.
+fn refusal(text: &str, overrides: &[&str]) -> String {
+    let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    match Problem::from_str_with(text, &overrides) {
+        Ok(_) => panic!("accepted: {overrides:?}"),
+        Err(e) => e.to_string(),
+    }
+}
+
+fn accepted(text: &str, overrides: &[&str]) -> Problem {
+    let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    Problem::from_str_with(text, &overrides).unwrap_or_else(|e| panic!("{overrides:?}: {e}"))
+}
+
+/// A problem with every optional table present, so that every
+/// fixed-length key can be overridden.
+const EVERY_TABLE: &str = "
+[rod]
+length = 1.0
+[energy]
+stiffness = [1.0, 1.0, 1.0]
+intrinsic_curvature = [0.0, 0.0, 0.0]
+shear = [100.0, 100.0, 100.0]
+[clamp]
+position = [0.0, 0.0, 0.0]
+d1 = [1.0, 0.0, 0.0]
+d3 = [0.0, 0.0, 1.0]
+[loads]
+tip_force = [1.0, 0.0, 0.0]
+tip_couple = [0.0, 0.0, 0.0]
+distributed_force = [0.0, 0.0, 0.0]
+[solver]
+initial_curvature = [0.0, 0.0, 0.0]
+[continuation]
+parameter = \"load_scale\"
+start = 0.1
+bounds = [0.0, 1.0]
+";
+
+/// Item 8: every fixed-length array of every table refuses a longer or a
+/// shorter array, naming the key and the expected length.
+#[test]
+fn every_fixed_length_key_takes_exactly_its_length() {
+    let three = [
+        "energy.stiffness",
+        "energy.intrinsic_curvature",
+        "energy.shear",
+        "clamp.position",
+        "clamp.d1",
+        "clamp.d3",
+        "loads.tip_force",
+        "loads.tip_couple",
+        "loads.distributed_force",
+        "solver.initial_curvature",
+    ];
+    // The base is accepted as written.
+    accepted(EVERY_TABLE, &[]);
+    for key in three {
+        for (value, got) in [("[1, 0, 0, 5]", 4), ("[1, 0]", 2), ("[]", 0)] {
+            let e = refusal(EVERY_TABLE, &[&format!("{key}={value}")]);
+            assert!(
+                e.contains(key) && e.contains("expected exactly 3") && e.contains(&got.to_string()),
+                "{key}={value}: {e}"
+            );
+        }
+    }
+    for (value, got) in [("[0, 1, 2]", 3), ("[0]", 1)] {
+        let e = refusal(EVERY_TABLE, &[&format!("continuation.bounds={value}")]);
+        assert!(
+            e.contains("continuation.bounds") && e.contains("expected exactly 2"),
+            "{got}: {e}"
+        );
+    }
+    // Support vectors (optional keys of an optional table).
+    for key in [
+        "support.axis",
+        "support.position",
+        "support.d1",
+        "support.d3",
+    ] {
+        let e = refusal(
+            CANTILEVER,
+            &[
+                "support.translation=\"axial\"",
+                "support.axis=[0, 0, 1]",
+                &format!("{key}=[0, 0, 1, 0]"),
+            ],
+        );
+        assert!(
+            e.contains(key) && e.contains("expected exactly 3"),
+            "{key}: {e}"
+        );
+    }
+}
+
+/// The issue's example in a file (not through `--set`): the message names
+/// the key, the lengths and the line of the file.
+#[test]
+fn a_four_entry_tip_force_in_a_file_is_refused_with_its_line() {
+    let text = CANTILEVER.replace(
+        "tip_force = [1.0, 0.0, 0.0]",
+        "tip_force = [1.0, 0.0, 0.0, 4.0]",
+    );
+    let e = refusal(&text, &[]);
+    assert!(
+        e.contains("loads.tip_force")
+            && e.contains("has 4 entries, expected exactly 3")
+            && e.contains("line 7"),
+        "{e}"
+    );
+}
+
+/// Arrays of pairs and the sweep's `[start, stop, count]`.
+#[test]
+fn arm_bounds_and_sweep_spacings_take_exactly_their_length() {
+    let arm = format!(
+        "{CANTILEVER}
+[arm]
+coefficients = 3
+bounds = [[-4.0, 4.0], [-2.0, 2.0, 7.0]]
+"
+    );
+    let e = refusal(&arm, &[]);
+    assert!(
+        e.contains("arm.bounds[1]") && e.contains("expected exactly 2"),
+        "{e}"
+    );
+    for kind in ["linspace", "logspace"] {
+        let sweep = format!(
+            "{CANTILEVER}
+[sweep]
+axes = [{{ key = \"loads.tip_force[0]\", {kind} = [1.0, 2.0, 3, 4] }}]
+"
+        );
+        let e = refusal(&sweep, &[]);
+        assert!(
+            e.contains(&format!("sweep.axes[0].{kind}")) && e.contains("expected exactly 3"),
+            "{e}"
+        );
+    }
+}
