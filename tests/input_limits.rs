@@ -5,6 +5,8 @@
 //! computation returns an error instead of panicking.
 
 use cosserat::io::Problem;
+mod support;
+use support::references::cantilever_tip;
 
 /// A planar cantilever under a tip load: the smallest valid problem.
 const CANTILEVER: &str = "
@@ -156,4 +158,74 @@ axes = [{{ key = \"loads.tip_force[0]\", {kind} = [1.0, 2.0, 3, 4] }}]
             "{e}"
         );
     }
+}
+
+/// Item 7: `solver.tolerance = 1` "converged" to a wrong shape. Every
+/// tolerance-like key is refused outside its documented range, with the
+/// key, the range and a value to choose; both ends are accepted.
+#[test]
+fn every_tolerance_has_a_meaningful_range() {
+    let e = refusal(CANTILEVER, &["solver.tolerance=1"]);
+    assert!(
+        e.contains("solver.tolerance") && e.contains("outside [1e-15, 1e-6]") && e.contains("e.g."),
+        "{e}"
+    );
+    let continued = format!(
+        "{CANTILEVER}
+[continuation]
+parameter = \"load_scale\"
+start = 0.1
+bounds = [0.0, 1.0]
+"
+    );
+    for (key, lo, hi) in [
+        ("solver.tolerance", "1e-15", "1e-6"),
+        ("solver.integration_tolerance", "1e-14", "1e-6"),
+        ("solver.collocation_tolerance", "1e-14", "1e-6"),
+        ("continuation.tolerance", "1e-15", "1e-6"),
+    ] {
+        for v in [lo, hi] {
+            accepted(&continued, &[&format!("{key}={v}")]);
+        }
+        for v in ["2e-6", "1", "1e300", "1e-16", "0", "-1e-10", "nan", "inf"] {
+            let e = refusal(&continued, &[&format!("{key}={v}")]);
+            assert!(
+                e.contains(key) && e.contains(&format!("[{lo}, {hi}]")),
+                "{key}={v}: {e}"
+            );
+        }
+    }
+    // The tip angle is at most 180°: a larger limit would never act.
+    for v in ["181", "0", "-5", "inf"] {
+        let e = refusal(&continued, &[&format!("continuation.tip_angle_limit={v}")]);
+        assert!(
+            e.contains("continuation.tip_angle_limit") && e.contains("(0, 180]"),
+            "{e}"
+        );
+    }
+    accepted(&continued, &["continuation.tip_angle_limit=180"]);
+    // A zero step budget was silently raised to 1.
+    let e = refusal(CANTILEVER, &["solver.max_steps=0"]);
+    assert!(e.contains("solver.max_steps"), "{e}");
+}
+
+/// At the loosest tolerances accepted (Newton 1e-6, integration 1e-6) the
+/// answer is still right to the digits the range promises: the planar
+/// cantilever's tip against Bisshopp & Drucker's elliptic integrals.
+#[test]
+fn the_loosest_tolerances_accepted_still_give_the_elastica() {
+    let p = accepted(
+        CANTILEVER,
+        &[
+            "loads.tip_force=[3, 0, 0]",
+            "solver.tolerance=1e-6",
+            "solver.integration_tolerance=1e-6",
+        ],
+    );
+    let eq = cosserat::bvp::solve(&p.rod, &p.model, &p.options).unwrap();
+    let tip = eq.samples.last().unwrap().position;
+    let exact = cantilever_tip(3.0);
+    let err = (tip[0] - exact.x).abs().max((tip[2] - exact.z).abs());
+    eprintln!("tip error at the loosest tolerances: {err:.2e}");
+    assert!(err < 1e-5, "{err:e}");
 }

@@ -897,13 +897,58 @@ fn build_stability(s: &StabilitySection) -> Result<StabilityOptions, ProblemErro
     })
 }
 
-fn positive(field: &str, v: f64) -> Result<f64, ProblemError> {
-    if v.is_finite() && v > 0.0 {
+/// The meaningful range of a tolerance-like key and why (docs/problem-files.md
+/// lists each).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Range {
+    /// Smallest value accepted.
+    pub lo: f64,
+    /// Largest value accepted.
+    pub hi: f64,
+    /// Why the range ends there and what to choose instead.
+    pub why: &'static str,
+}
+
+/// Newton's tolerance on the scaled residual (`solver.tolerance`,
+/// `continuation.tolerance`): the correction must then be below √τ, so
+/// above 1e-6 a "converged" shape may be wrong in its third digit (at τ = 1
+/// any iterate passes); below 1e-15 (≈ 5 ε) round-off alone keeps the
+/// scaled residual above it.
+pub(crate) const NEWTON_TOLERANCE: Range = Range {
+    lo: 1e-15,
+    hi: 1e-6,
+    why: "the scaled residual Newton must reach; above 1e-6 a converged shape may be \
+          wrong in its third digit, below 1e-15 round-off cannot reach it; e.g. 1e-10",
+};
+
+/// The integrator's relative and absolute tolerance: the shooting
+/// residual, and so the shape, is only as accurate as the integration.
+pub(crate) const INTEGRATION_TOLERANCE: Range = Range {
+    lo: 1e-14,
+    hi: 1e-6,
+    why: "the shape is only as accurate as the integration; above 1e-6 fewer than six \
+          digits are right, below 1e-14 DOP853's steps underflow in round-off; e.g. 1e-12",
+};
+
+/// Collocation's target for its accumulated local error estimate.
+pub(crate) const COLLOCATION_TOLERANCE: Range = Range {
+    lo: 1e-14,
+    hi: 1e-6,
+    why: "the mesh is refined until the error estimate is below it; above 1e-6 fewer than \
+          six digits are right, below 1e-14 round-off in the estimate dominates; e.g. 1e-10",
+};
+
+/// A tolerance-like number within its range.
+pub(crate) fn within(field: &str, v: f64, range: Range) -> Result<f64, ProblemError> {
+    if v.is_finite() && (range.lo..=range.hi).contains(&v) {
         Ok(v)
     } else {
         Err(invalid(
             field,
-            format!("must be a positive finite number, got {v}"),
+            format!(
+                "{v} is outside [{:e}, {:e}] ({})",
+                range.lo, range.hi, range.why
+            ),
         ))
     }
 }
@@ -944,7 +989,11 @@ fn build_options(s: &SolverSection) -> Result<SolverOptions, ProblemError> {
     }
     let collocation = crate::bvp::CollocationOptions {
         stages: s.stages,
-        tolerance: positive("solver.collocation_tolerance", s.collocation_tolerance)?,
+        tolerance: within(
+            "solver.collocation_tolerance",
+            s.collocation_tolerance,
+            COLLOCATION_TOLERANCE,
+        )?,
         max_intervals: s.max_intervals,
         ..defaults
     };
@@ -959,7 +1008,17 @@ fn build_options(s: &SolverSection) -> Result<SolverOptions, ProblemError> {
             ))
         }
     };
-    let tol = positive("solver.integration_tolerance", s.integration_tolerance)?;
+    let tol = within(
+        "solver.integration_tolerance",
+        s.integration_tolerance,
+        INTEGRATION_TOLERANCE,
+    )?;
+    if s.max_steps < 1 {
+        return Err(invalid(
+            "solver.max_steps",
+            "must be at least 1 (the step budget of one integration; e.g. 100000)",
+        ));
+    }
     if s.output_points < 2 {
         return Err(invalid("solver.output_points", "must be at least 2"));
     }
@@ -973,14 +1032,14 @@ fn build_options(s: &SolverSection) -> Result<SolverOptions, ProblemError> {
     Ok(SolverOptions {
         method,
         newton: NewtonOptions {
-            tolerance: positive("solver.tolerance", s.tolerance)?,
+            tolerance: within("solver.tolerance", s.tolerance, NEWTON_TOLERANCE)?,
             max_iterations: s.max_iterations,
             ..Default::default()
         },
         integration: Tolerances {
             rtol: tol,
             atol: tol,
-            max_steps: s.max_steps.max(1),
+            max_steps: s.max_steps,
         },
         collocation,
         output_points: s.output_points,
