@@ -229,3 +229,75 @@ fn the_loosest_tolerances_accepted_still_give_the_elastica() {
     eprintln!("tip error at the loosest tolerances: {err:.2e}");
     assert!(err < 1e-5, "{err:e}");
 }
+
+/// Item 9: an arm hanging straight down is in tension, stable under any
+/// load: its fixed shape has no critical load (the search had reported a
+/// γ_crit of 3e20, a number of round-off).
+#[test]
+fn a_hanging_arm_has_no_critical_load() {
+    use cosserat::model::{Clamp, DeadLoads, LinearElastic, Profile, Rod};
+    use cosserat::stability::{critical_load, FixedShape, StabilityOptions};
+    use nalgebra::Vector3;
+    for (b1, b3) in [(4.0, 1.27), (1.0, 1.0), (0.25, 4.0)] {
+        let rod = Rod {
+            length: 1.0,
+            energy: std::sync::Arc::new(LinearElastic::uniform([b1, 1.0, b3], [0.0; 3])),
+            clamp: Clamp::paper(),
+            loads: DeadLoads {
+                tip_force: Vector3::new(1.0, 0.0, 0.0),
+                tip_couple: Vector3::zeros(),
+                distributed_force: Vector3::zeros(),
+            },
+            support: None,
+        };
+        // φ = π/2 from the horizontal d3 towards d1 (down): hanging.
+        let shape = FixedShape {
+            turning_angle: Profile::Constant(std::f64::consts::FRAC_PI_2),
+        };
+        let opts = StabilityOptions {
+            elements: 100,
+            order: 1,
+            eigenvalues: 1,
+        };
+        let crit = critical_load(&rod, &shape, &opts).unwrap();
+        assert_eq!(
+            crit.load_factor, None,
+            "B̄ = ({b1}, {b3}): {:?}",
+            crit.load_factor
+        );
+    }
+}
+
+/// Item 9: every reach direction has a meaning or is refused. Straight
+/// down (−90°) is unbounded; near it the reach grows like 4/|cos α|,
+/// resolved by a mesh of N elements only while |cos α| ≥ 8/N; beyond ±90°
+/// the arm reaches to the other side.
+#[test]
+fn arm_reach_directions_are_defined_or_refused() {
+    let arm = format!(
+        "{CANTILEVER}
+[arm]
+coefficients = 3
+bounds = [[-4.0, 4.0], [-2.0, 2.0]]
+"
+    );
+    for alpha in ["-90", "-89.9", "-86", "-94", "-181", "200", "nan"] {
+        let e = refusal(&arm, &[&format!("arm.alpha={alpha}")]);
+        assert!(e.contains("arm.alpha"), "{alpha}: {e}");
+        if alpha == "-90" {
+            assert!(
+                e.contains("unbounded") && e.contains("−85.4") && e.contains("arm.elements"),
+                "{e}"
+            );
+        }
+    }
+    // |cos α| ≥ 8/N: −85.4° at N = 100 (cos 85.4° = 0.0802), −88.85° at 400.
+    for alpha in ["-85", "-95", "0", "90", "120", "180", "-180", "-60"] {
+        accepted(&arm, &[&format!("arm.alpha={alpha}")]);
+    }
+    let e = refusal(&arm, &["arm.alpha=-88"]);
+    assert!(e.contains("arm.alpha"), "{e}");
+    accepted(&arm, &["arm.alpha=-88", "arm.elements=400"]);
+    let e = refusal(&arm, &["arm.alpha=-88.9", "arm.elements=400"]);
+    assert!(e.contains("arm.alpha"), "{e}");
+}
