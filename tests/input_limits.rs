@@ -301,3 +301,193 @@ bounds = [[-4.0, 4.0], [-2.0, 2.0]]
     let e = refusal(&arm, &["arm.alpha=-88.9", "arm.elements=400"]);
     assert!(e.contains("arm.alpha"), "{e}");
 }
+
+/// Item 12: continuation in a stiffness of a shearable (Cosserat) column
+/// keeps its shear and extension part. A clamped–free column under a dead
+/// compressive load P with shear stiffness S1 and extensional stiffness
+/// S3: linearized about the straight state, N1 = P θ, ν1 = Pθ/S1,
+/// ν3 = 1 − P/S3, and the moment balance B2 θ'' + P (ν1 + ν3 θ) = 0 gives
+/// B2 θ'' + P (1 + P/S1 − P/S3) θ = 0 with θ(0) = 0, θ'(L) = 0: the
+/// branch point is at B2 = 4 L² P (1 + P/S1 − P/S3)/π² (Haringx's
+/// P (1 + P/S1) = π² B/(4L²) when S3 → ∞).
+#[test]
+fn stiffness_continuation_of_a_shearable_column_reaches_haringx() {
+    use cosserat::continuation::{continuation, SpecialKind};
+    use cosserat::model::ModelLevel;
+    use std::f64::consts::PI;
+    let (p, s1, s3, l) = (1.0, 2.0, 10.0, 1.0);
+    let exact = 4.0 * l * l * p * (1.0 + p / s1 - p / s3) / (PI * PI);
+    let text = "[rod]\nlength = 1.0\n[energy]\nstiffness = [3.0, 0.35, 1.0]\n\
+                shear = [2.0, 1e3, 10.0]\n[loads]\ntip_force = [0.0, 0.0, -1.0]\n\
+                [continuation]\nparameter = \"energy.stiffness[1]\"\nstart = 0.35\n\
+                bounds = [0.3, 3.0]\nstep = 0.1\nmax_step = 0.2\nelements = 40\norder = 3\n\
+                eigenvalues = 2\nswitch_depth = 0\nmax_points = 40\n";
+    let problem = accepted(text, &[]);
+    assert_eq!(problem.model.level, ModelLevel::Cosserat);
+    let (family, opts) = problem.continuation.clone().unwrap();
+    let d = continuation(&family, &opts, &mut |_, _| true).unwrap();
+    let bp = d
+        .special_points
+        .iter()
+        .find(|s| s.kind == SpecialKind::BranchPoint)
+        .expect("a branch point");
+    let found = bp.point.parameter;
+    eprintln!("branch point B2 = {found:.12}, closed form {exact:.12}");
+    assert!((found - exact).abs() < 1e-8 * exact, "{found} vs {exact}");
+    // The curvature parameter on the same shearable scene is accepted too
+    // (it failed with "needs energy.shear").
+    accepted(
+        text,
+        &[
+            "continuation.parameter=\"energy.intrinsic_curvature[1]\"",
+            "continuation.start=0.0",
+            "continuation.bounds=[-1.0, 1.0]",
+        ],
+    );
+    // A varying profile is not silently replaced by its value at s = 0.
+    let e = refusal(text, &["energy.stiffness[1]={polynomial = [0.35, 0.1]}"]);
+    assert!(e.contains("continuation.parameter"), "{e}");
+}
+
+fn euler_column() -> String {
+    std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/problems/euler_column.toml"
+    ))
+    .unwrap()
+}
+
+/// Crashes: `continuation.eigenvalues = 100` on 16 elements of order 2
+/// indexed past the tracker's columns. Refused at input with the block's
+/// size; and the tracker itself returns an error where a count beyond the
+/// mesh reaches it (a library caller), instead of panicking.
+#[test]
+fn eigenvalue_counts_beyond_the_mesh_are_refused_not_a_panic() {
+    use cosserat::continuation::continuation;
+    let text = euler_column();
+    let e = refusal(&text, &["continuation.eigenvalues=100"]);
+    assert!(
+        e.contains("continuation.eigenvalues") && e.contains("32 unknowns"),
+        "{e}"
+    );
+    accepted(&text, &["continuation.eigenvalues=32"]);
+    let e = refusal(&text, &["stability.eigenvalues=401"]);
+    assert!(
+        e.contains("stability.eigenvalues") && e.contains("400 unknowns"),
+        "{e}"
+    );
+    // A support removes up to six unknowns.
+    let e = refusal(
+        CANTILEVER,
+        &[
+            "support.rotation=\"fixed\"",
+            "support.translation=\"free\"",
+            "stability.elements=2",
+            "stability.order=1",
+            "stability.eigenvalues=1",
+        ],
+    );
+    assert!(e.contains("stability.eigenvalues"), "{e}");
+    // Past the reader: the computation says why.
+    let p = accepted(&text, &[]);
+    let (family, mut opts) = p.continuation.clone().unwrap();
+    opts.stability.eigenvalues = 100;
+    opts.max_points = 3;
+    let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        continuation(&family, &opts, &mut |_, _| true)
+    }));
+    let e = match outcome.expect("no panic") {
+        Ok(_) => panic!("100 eigenvalues on 32 unknowns were accepted"),
+        Err(e) => e.to_string(),
+    };
+    assert!(e.contains("continuation.eigenvalues"), "{e}");
+}
+
+/// Crashes: `rod.length = 1e-320` reached the finite elements (h = 1e-322,
+/// B/h = inf). Lengths are refused outside [1e-6, 1e6] with the advice to
+/// change the length unit.
+#[test]
+fn lengths_far_from_one_are_refused_with_the_unit_advice() {
+    for l in ["0", "-1"] {
+        let e = refusal(CANTILEVER, &[&format!("rod.length={l}")]);
+        assert!(e.contains("rod.length") && e.contains("positive"), "{l}: {e}");
+    }
+    for l in ["1e-320", "1e-7", "2e6", "1e300"] {
+        let e = refusal(CANTILEVER, &[&format!("rod.length={l}")]);
+        assert!(
+            e.contains("rod.length") && e.contains("[1e-6, 1e6]") && e.contains("unit"),
+            "{l}: {e}"
+        );
+    }
+    for l in ["1e-6", "1e6", "30"] {
+        accepted(CANTILEVER, &[&format!("rod.length={l}")]);
+    }
+}
+
+/// Stiffness ratios beyond 1/(4ε) ≈ 1.1e15 lose the softer stiffness in
+/// round-off; the issue's range B1, B3 ∈ [1e-3, 1e12] (B2 = 1) is kept.
+#[test]
+fn stiffness_ratios_beyond_round_off_are_refused() {
+    accepted(CANTILEVER, &["energy.stiffness=[1e-3, 1, 1e12]"]);
+    accepted(CANTILEVER, &["energy.stiffness=[1e12, 1, 1e-3]"]);
+    let e = refusal(CANTILEVER, &["energy.stiffness=[1e-4, 1, 1e12]"]);
+    assert!(
+        e.contains("energy.stiffness[0]")
+            && e.contains("energy.stiffness[2]")
+            && e.contains("ratio"),
+        "{e}"
+    );
+    // Along s too: a table from 1 to 1e16.
+    let e = refusal(
+        CANTILEVER,
+        &["energy.stiffness=[1, {s = [0, 1], values = [1, 1e16]}, 1]"],
+    );
+    assert!(e.contains("ratio"), "{e}");
+}
+
+/// Item 6: positive-definiteness is checked exactly where the profile
+/// allows. B2(s) = (s − 0.43215)² − 1e-9 is positive at every one of
+/// 1001 equally spaced samples of [0, 1] (the nearest, 0.432, gives
+/// 2.3e-8 − 1e-9) but negative at s = 0.43215: refused, with its minimum
+/// and where. A table is checked at its knots, exactly.
+#[test]
+fn stiffness_dipping_between_samples_is_refused() {
+    let (s0, delta): (f64, f64) = (0.43215, 1e-9);
+    let sampled = (0..=1000)
+        .map(|i| {
+            let s = i as f64 / 1000.0;
+            (s - s0).powi(2) - delta
+        })
+        .fold(f64::INFINITY, f64::min);
+    assert!(sampled > 0.0);
+    let poly = format!(
+        "energy.stiffness=[1, {{polynomial = [{:e}, {:e}, 1.0]}}, 1]",
+        s0 * s0 - delta,
+        -2.0 * s0
+    );
+    let e = refusal(CANTILEVER, &[&poly]);
+    assert!(
+        e.contains("energy.stiffness[1]") && e.contains("-1.000000e-9") && e.contains("0.4321"),
+        "{e}"
+    );
+    // Touching zero exactly (a double root) cannot be certified positive.
+    let e = refusal(
+        CANTILEVER,
+        &["energy.stiffness=[1, {polynomial = [0.25, -1.0, 1.0]}, 1]"],
+    );
+    assert!(e.contains("energy.stiffness[1]"), "{e}");
+    // Clearly positive: accepted.
+    accepted(
+        CANTILEVER,
+        &["energy.stiffness=[1, {polynomial = [0.26, -1.0, 1.0]}, 1]"],
+    );
+    // A table whose one knot inside [0, L] is negative.
+    let e = refusal(
+        CANTILEVER,
+        &["energy.stiffness=[1, {s = [0, 0.5003, 1], values = [1, -1e-9, 1]}, 1]"],
+    );
+    assert!(
+        e.contains("energy.stiffness[1]") && e.contains("0.5003"),
+        "{e}"
+    );
+}

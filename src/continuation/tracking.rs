@@ -144,14 +144,34 @@ impl Tracker {
         let mut block_morse = vec![];
         for (bi, (k, g, constraints)) in mats.iter().enumerate() {
             // The previous point's lowest two eigenvalues place the shift.
-            let near = self.previous_values.as_ref().map(|v| {
-                let mut b: Vec<f64> = v[bi].clone();
-                b.sort_by(|x, y| x.total_cmp(y));
-                (b[0], *b.get(1).unwrap_or(&b[0]))
-            });
+            let near = self
+                .previous_values
+                .as_ref()
+                .and_then(|v| v.get(bi))
+                .filter(|b| !b.is_empty())
+                .map(|b| {
+                    let mut b: Vec<f64> = b.clone();
+                    b.sort_by(|x, y| x.total_cmp(y));
+                    // One tracked eigenvalue: it is both of the lowest two.
+                    (b[0], *b.get(1).unwrap_or(&b[0]))
+                });
             let pairs =
                 lowest_eigenpairs_constrained(k, g, constraints, self.opts.eigenvalues, near)
                     .map_err(|e| PointError::Eigen(e.to_string()))?;
+            // Every block fills its `eigenvalues` columns of the diagram; a
+            // mesh with fewer unknowns than that cannot (the eigensolver
+            // returns at most the block's dimension).
+            if pairs.values.len() != self.opts.eigenvalues {
+                return Err(PointError::Eigen(format!(
+                    "the {} block has only {} eigenvalues on {} elements of order {}, \
+                     {} are tracked: lower continuation.eigenvalues or raise continuation.elements",
+                    self.blocks[bi].name(),
+                    pairs.values.len(),
+                    self.opts.elements,
+                    self.opts.order,
+                    self.opts.eigenvalues
+                )));
+            }
             let order = match &self.previous {
                 Some(prev) => match_modes(&prev[bi], &pairs.vectors, g),
                 None => (0..pairs.values.len()).collect(),

@@ -180,8 +180,9 @@ impl ContinuationSection {
             return Err(invalid(
                 "continuation.measure",
                 format!(
-                    "unknown measure `{}`; expected one of {MEASURES:?}",
-                    self.measure
+                    "unknown measure `{}`; expected one of {}",
+                    self.measure,
+                    MEASURES.join(", ")
                 ),
             ));
         }

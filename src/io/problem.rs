@@ -458,6 +458,7 @@ impl Problem {
         let options = build_options(&file.solver)?;
         let shape = build_shape(&file)?;
         let stability = build_stability(&file.stability)?;
+        eigenvalue_count("stability", &stability, &rod)?;
         let continuation = build_continuation(&file, &rod, &model, &options, shape.as_ref())?;
         let arm = file.arm.as_ref().map(|a| a.build(&rod)).transpose()?;
         let arm_scene = file
@@ -609,7 +610,23 @@ fn build_rod(file: &ProblemFile, catalog: &EnergyCatalog) -> Result<Rod, Problem
     if length <= 0.0 {
         return Err(invalid(
             "rod.length",
-            format!("must be positive, got {length}"),
+            format!(
+                "must be positive, got {length} (accepted: [{:e}, {:e}] in the file's length \
+                 unit)",
+                LENGTH_RANGE.0, LENGTH_RANGE.1
+            ),
+        ));
+    }
+    if !(LENGTH_RANGE.0..=LENGTH_RANGE.1).contains(&length) {
+        return Err(invalid(
+            "rod.length",
+            format!(
+                "{length} is outside [{:e}, {:e}]: positions (of order L) and curvatures (of \
+                 order 1/L) are integrated with one absolute tolerance, so a length far from 1 \
+                 loses digits (at 1e-320 the finite elements divide by zero); choose the length \
+                 unit so that L is near 1 (any consistent units work)",
+                LENGTH_RANGE.0, LENGTH_RANGE.1
+            ),
         ));
     }
     let mut energy = build_energy(&file.energy, length, catalog)?;
@@ -669,20 +686,62 @@ fn build_energy(
         intrinsic_curvature: Default::default(),
         parameters: Default::default(),
     };
+    let mut softest: Option<(f64, String)> = None;
+    let mut stiffest: Option<(f64, String)> = None;
     for i in 0..3 {
         let field = format!("energy.stiffness[{i}]");
         spec.stiffness[i] = profile(&field, &e.stiffness[i])?;
-        let min = spec.stiffness[i].minimum_on(length);
-        if min.is_nan() || min <= 0.0 {
+        // Exact where the profile allows (Profile::extremes_on): a table at
+        // its knots, a polynomial at the roots of its derivative, with a
+        // certified lower bound.
+        let x = spec.stiffness[i].extremes_on(length);
+        if x.min.is_nan() || x.min <= 0.0 {
             return Err(invalid(
                 field,
-                format!("must be positive on [0, L], minimum {min}"),
+                format!(
+                    "must be positive on [0, L], but its minimum is {:.6e} at s = {}; make the \
+                     profile positive on the whole rod",
+                    x.min, x.argmin
+                ),
             ));
+        }
+        if x.min_lower <= 0.0 {
+            return Err(invalid(
+                field,
+                format!(
+                    "its minimum {:.6e} at s = {} is within rounding ({:.1e}) of zero, so it cannot be \
+                     certified positive; make the profile clearly positive",
+                    x.min,
+                    x.argmin,
+                    x.min - x.min_lower
+                ),
+            ));
+        }
+        if softest.as_ref().is_none_or(|(v, _)| x.min < *v) {
+            softest = Some((x.min, field.clone()));
+        }
+        if stiffest.as_ref().is_none_or(|(v, _)| x.max > *v) {
+            stiffest = Some((x.max, field.clone()));
         }
         spec.intrinsic_curvature[i] = profile(
             &format!("energy.intrinsic_curvature[{i}]"),
             &e.intrinsic_curvature[i],
         )?;
+    }
+    if let (Some((lo, soft)), Some((hi, stiff))) = (softest, stiffest) {
+        if hi / lo > MAX_STIFFNESS_RATIO {
+            return Err(invalid(
+                soft,
+                format!(
+                    "the stiffness ratio {:.3e} ({stiff} up to {hi:e}, this down to {lo:e}) \
+                     exceeds {MAX_STIFFNESS_RATIO:.3e} = 1/(4ε): the softer stiffness is then \
+                     below four rounding units of the stiffer one in the sums of the equations \
+                     and the second variation, and is lost; a stiffness that large is the \
+                     constraint limit — keep the ratio below it",
+                    hi / lo
+                ),
+            ));
+        }
     }
     for (name, value) in &e.parameters {
         let v = finite(&format!("energy.parameters.{name}"), *value)?;
@@ -718,6 +777,13 @@ fn build_energy(
         )),
     }
 }
+
+/// The accepted rod lengths (in the file's length unit).
+pub const LENGTH_RANGE: (f64, f64) = (1e-6, 1e6);
+
+/// The largest ratio of the stiffest to the softest bending or torsional
+/// stiffness anywhere on the rod: 1/(4ε) ≈ 1.1e15.
+pub const MAX_STIFFNESS_RATIO: f64 = 0.25 / f64::EPSILON;
 
 /// Orthonormality tolerance of the clamp frame.
 const FRAME_TOLERANCE: f64 = 1e-9;
@@ -794,6 +860,7 @@ fn build_continuation(
         return Ok(None);
     };
     let (parameter, opts) = section.build()?;
+    eigenvalue_count("continuation", &opts.stability, rod)?;
     let (segments, stages) = match options.method {
         Method::Shooting => (1, None),
         Method::MultipleShooting { segments } => (segments, None),
@@ -843,6 +910,11 @@ fn build_continuation(
             options.integration,
         ),
     };
+    // A parameter the energy cannot vary (a varying profile, an energy
+    // without that profile) is refused here, not at the first point.
+    family
+        .rod_at(opts.start)
+        .map_err(|e| invalid("continuation.parameter", e.to_string()))?;
     Ok(Some((family, opts)))
 }
 
@@ -875,6 +947,44 @@ fn build_shape(file: &ProblemFile) -> Result<Option<FixedShape>, ProblemError> {
         ));
     }
     Ok(Some(FixedShape { turning_angle }))
+}
+
+/// The fewest unknowns a block of the second variation can have: the
+/// in-plane block has one rotation per node but the clamped one
+/// (elements × order), and a tip support removes up to six more
+/// (three held translations, three held rotations).
+pub(crate) fn fewest_block_unknowns(opts: &StabilityOptions, rod: &Rod) -> usize {
+    let nodes = opts.elements.saturating_mul(opts.order);
+    if rod.support.is_some() {
+        nodes.saturating_sub(6)
+    } else {
+        nodes
+    }
+}
+
+/// The eigenvalues asked per block exist on the mesh (a count beyond the
+/// block's unknowns made the continuation tracker index past its columns).
+fn eigenvalue_count(table: &str, opts: &StabilityOptions, rod: &Rod) -> Result<(), ProblemError> {
+    let most = fewest_block_unknowns(opts, rod);
+    if opts.eigenvalues > most {
+        return Err(invalid(
+            format!("{table}.eigenvalues"),
+            format!(
+                "{} eigenvalues per block, but the smallest block of {} elements of order {} \
+                 has {most} unknowns{}: lower {table}.eigenvalues to at most {most} or raise \
+                 {table}.elements",
+                opts.eigenvalues,
+                opts.elements,
+                opts.order,
+                if rod.support.is_some() {
+                    " (elements × order, less six held by the support)"
+                } else {
+                    " (elements × order)"
+                },
+            ),
+        ));
+    }
+    Ok(())
 }
 
 fn build_stability(s: &StabilitySection) -> Result<StabilityOptions, ProblemError> {

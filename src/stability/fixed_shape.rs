@@ -74,7 +74,7 @@ impl FixedShape {
                 |_| {},
             )
             .map_err(|e| {
-                StabilityError::FixedShape(format!("the shape's quadrature failed: {e:?}"))
+                StabilityError::FixedShape(format!("the shape's quadrature failed: {e}"))
             })?;
         let (_, tip) = *states.last().expect("the tip is a stop");
         // In-plane vectors to global: (a, b) ↦ a ex + b ez.
