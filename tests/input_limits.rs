@@ -410,7 +410,10 @@ fn eigenvalue_counts_beyond_the_mesh_are_refused_not_a_panic() {
 fn lengths_far_from_one_are_refused_with_the_unit_advice() {
     for l in ["0", "-1"] {
         let e = refusal(CANTILEVER, &[&format!("rod.length={l}")]);
-        assert!(e.contains("rod.length") && e.contains("positive"), "{l}: {e}");
+        assert!(
+            e.contains("rod.length") && e.contains("positive"),
+            "{l}: {e}"
+        );
     }
     for l in ["1e-320", "1e-7", "2e6", "1e300"] {
         let e = refusal(CANTILEVER, &[&format!("rod.length={l}")]);
@@ -490,4 +493,142 @@ fn stiffness_dipping_between_samples_is_refused() {
         e.contains("energy.stiffness[1]") && e.contains("0.5003"),
         "{e}"
     );
+}
+
+/// Memory: sizes that exhausted the machine are refused by the reader,
+/// before anything is allocated, naming the key and the estimate.
+#[test]
+fn sizes_beyond_the_memory_budget_are_refused_with_the_estimate() {
+    let column = euler_column();
+    let arm = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/problems/longest_arm_fig6.toml"
+    ))
+    .unwrap();
+    let cases: [(&str, &[&str], &str); 8] = [
+        (CANTILEVER, &["solver.output_points=1000000000000"], "solver.output_points"),
+        (
+            CANTILEVER,
+            &["solver.method=\"multiple-shooting\"", "solver.segments=1000000"],
+            "solver.segments",
+        ),
+        (
+            CANTILEVER,
+            &["solver.method=\"collocation\"", "solver.max_intervals=100000000"],
+            "solver.max_intervals",
+        ),
+        (CANTILEVER, &["stability.elements=100000000"], "stability.elements"),
+        (
+            &column,
+            &["solver.method=\"collocation\"", "continuation.intervals=10000"],
+            "continuation.intervals",
+        ),
+        (&column, &["continuation.max_points=1000000000"], "continuation.max_points"),
+        (&arm, &["arm.map_samples=100000000000"], "arm.map_samples"),
+        (
+            &arm,
+            &["sweep.axes=[{key=\"energy.stiffness[0]\",linspace=[0.25,7,1000]},{key=\"energy.stiffness[2]\",linspace=[0.2,4,1000]}]", "sweep.families=2"],
+            "sweep.axes",
+        ),
+    ];
+    for (text, sets, field) in cases {
+        let e = refusal(text, sets);
+        assert!(
+            e.starts_with(field) && e.contains("would allocate about") && e.contains("budget"),
+            "{sets:?}: {e}"
+        );
+    }
+    // The shipped problems fit with room to spare.
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/problems");
+    for entry in std::fs::read_dir(dir).unwrap() {
+        let path = entry.unwrap().path();
+        let p = Problem::from_path(&path, &[]).unwrap();
+        let total = cosserat::io::memory::estimate(&p).total();
+        assert!(total < 1e9, "{}: {total:e}", path.display());
+    }
+}
+
+/// The budget is COSSERAT_MEMORY_BUDGET (bytes, with a suffix) — run in
+/// the binary so that the variable does not leak into parallel tests.
+#[test]
+fn the_memory_budget_comes_from_the_environment() {
+    let dir = std::env::temp_dir().join(format!("cosserat-limits-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("p.toml");
+    std::fs::write(&file, CANTILEVER).unwrap();
+    let run = |budget: &str| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_cosserat"))
+            .args(["solve", file.to_str().unwrap()])
+            .args([
+                "--set",
+                "solver.output_points=100000",
+                "--set",
+                "stability.elements=10",
+            ])
+            .arg("-o")
+            .arg(dir.join(format!("out-{}.h5", budget.replace(' ', ""))))
+            .env("COSSERAT_MEMORY_BUDGET", budget)
+            .output()
+            .unwrap()
+    };
+    // 100000 points × 528 bytes = 50 MiB.
+    let small = run("20M");
+    let err = String::from_utf8_lossy(&small.stderr);
+    assert!(
+        !small.status.success() && err.contains("solver.output_points") && err.contains("20.0 MiB"),
+        "{err}"
+    );
+    let large = run("1 GiB");
+    assert!(
+        large.status.success(),
+        "{}",
+        String::from_utf8_lossy(&large.stderr)
+    );
+    let bad = run("lots");
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(
+        !bad.status.success() && err.contains("COSSERAT_MEMORY_BUDGET"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// A problem file over 1 MiB is refused before it is read, and a
+/// directory, a device or a FIFO is refused by its type (reading /dev/zero
+/// never ended; opening a FIFO blocks) — each quickly, naming the path.
+#[test]
+fn problem_files_are_bounded_regular_files() {
+    use std::path::Path;
+    use std::time::Instant;
+    let dir = std::env::temp_dir().join(format!("cosserat-files-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let big = dir.join("big.toml");
+    let mut text = CANTILEVER.to_string();
+    text.push_str(&format!("# {}\n", "x".repeat(1 << 20)));
+    std::fs::write(&big, text).unwrap();
+    let fifo = dir.join("fifo.toml");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    let mut paths: Vec<(&Path, &str)> = vec![
+        (&big, "1 MiB"),
+        (Path::new("/dev/zero"), "not a regular file"),
+        (&dir, "directory"),
+    ];
+    if made.is_ok_and(|s| s.success()) {
+        paths.push((&fifo, "not a regular file"));
+    }
+    for (path, expect) in paths {
+        let t = Instant::now();
+        let e = Problem::from_path(path, &[])
+            .expect_err("refused")
+            .to_string();
+        assert!(t.elapsed().as_secs_f64() < 1.0);
+        assert!(
+            e.contains(&path.display().to_string()) && e.contains(expect),
+            "{e}"
+        );
+    }
+    // The text itself (a library caller) is bounded too.
+    let e = refusal(&format!("{CANTILEVER}#{}\n", "y".repeat(1 << 20)), &[]);
+    assert!(e.contains("1048576"), "{e}");
+    std::fs::remove_dir_all(dir).unwrap();
 }

@@ -6,6 +6,7 @@ mod arm_section;
 mod continuation_section;
 mod diagram;
 mod hdf5_output;
+pub mod memory;
 mod problem;
 mod strict;
 mod support_section;

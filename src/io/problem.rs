@@ -424,10 +424,7 @@ impl Problem {
         overrides: &[String],
         catalog: &EnergyCatalog,
     ) -> Result<Problem, ProblemError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ProblemError::Read {
-            path: path.display().to_string(),
-            source,
-        })?;
+        let text = read_problem_file(path)?;
         Problem::from_str_in(&text, overrides, catalog)
     }
 
@@ -442,6 +439,13 @@ impl Problem {
         overrides: &[String],
         catalog: &EnergyCatalog,
     ) -> Result<Problem, ProblemError> {
+        if text.len() > MAX_PROBLEM_BYTES as usize {
+            return Err(ProblemError::Parse(format!(
+                "the problem text is {} bytes, more than the {MAX_PROBLEM_BYTES} a problem file \
+                 may have; a problem file describes a rod, not data",
+                text.len()
+            )));
+        }
         let text = apply_overrides(text, overrides)?;
         let file: ProblemFile = strict::parse(&text)?;
         let rod = build_rod(&file, catalog)?;
@@ -467,7 +471,7 @@ impl Problem {
             .map(|a| a.scene(&rod).map(|s| (s, a.map_samples)))
             .transpose()?;
         let sweep = file.sweep.as_ref().map(SweepSection::build).transpose()?;
-        Ok(Problem {
+        let problem = Problem {
             rod,
             model,
             options,
@@ -478,8 +482,68 @@ impl Problem {
             arm,
             arm_scene,
             sweep,
-        })
+        };
+        // Before any command allocates: what the sizes ask for must fit.
+        super::memory::check(&problem)?;
+        Ok(problem)
     }
+}
+
+/// The largest problem file read: 1 MiB (the shipped ones are under 3 KiB).
+pub const MAX_PROBLEM_BYTES: u64 = 1 << 20;
+
+/// The text of a problem file, refusing before reading anything what is not
+/// a regular file (a directory; a device such as /dev/zero or a FIFO would
+/// be read without end, or block) or is larger than [`MAX_PROBLEM_BYTES`];
+/// at most that many bytes are read even if the file grows meanwhile.
+fn read_problem_file(path: &Path) -> Result<String, ProblemError> {
+    use std::io::Read;
+    let fail = |message: String| ProblemError::Read {
+        path: path.display().to_string(),
+        source: std::io::Error::new(std::io::ErrorKind::InvalidInput, message),
+    };
+    let io = |source: std::io::Error| ProblemError::Read {
+        path: path.display().to_string(),
+        source,
+    };
+    let meta = std::fs::metadata(path).map_err(io)?;
+    if meta.is_dir() {
+        return Err(fail(
+            "is a directory; give a problem file (TOML), e.g. problems/cantilever_tip_load.toml"
+                .into(),
+        ));
+    }
+    if !meta.is_file() {
+        return Err(fail(
+            "is not a regular file (a device, FIFO or socket would be read without end); give a \
+             problem file (TOML)"
+                .into(),
+        ));
+    }
+    if meta.len() > MAX_PROBLEM_BYTES {
+        return Err(fail(format!(
+            "is {} bytes, more than the {MAX_PROBLEM_BYTES} (1 MiB) a problem file may have; is \
+             it the right file?",
+            meta.len()
+        )));
+    }
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)
+        .map_err(io)?
+        .take(MAX_PROBLEM_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    if bytes.len() as u64 > MAX_PROBLEM_BYTES {
+        return Err(fail(format!(
+            "grew beyond {MAX_PROBLEM_BYTES} bytes (1 MiB) while being read"
+        )));
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        fail(format!(
+            "is not UTF-8 text (byte {}); a problem file is TOML text",
+            e.utf8_error().valid_up_to()
+        ))
+    })
 }
 
 /// The text with every `a.b.c=value` applied; the value is read as a TOML
