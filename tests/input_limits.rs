@@ -295,6 +295,10 @@ bounds = [[-4.0, 4.0], [-2.0, 2.0]]
     for alpha in ["-85", "-95", "0", "90", "120", "180", "-180", "-60"] {
         accepted(&arm, &[&format!("arm.alpha={alpha}")]);
     }
+    for key in ["arm.starts", "arm.iterations", "arm.samples"] {
+        let e = refusal(&arm, &[&format!("{key}=0")]);
+        assert!(e.contains(key), "{e}");
+    }
     let e = refusal(&arm, &["arm.alpha=-88"]);
     assert!(e.contains("arm.alpha"), "{e}");
     accepted(&arm, &["arm.alpha=-88", "arm.elements=400"]);
@@ -631,4 +635,36 @@ fn problem_files_are_bounded_regular_files() {
     let e = refusal(&format!("{CANTILEVER}#{}\n", "y".repeat(1 << 20)), &[]);
     assert!(e.contains("1048576"), "{e}");
     std::fs::remove_dir_all(dir).unwrap();
+}
+
+/// Item 8 (a failure becoming a value): options no mesh can honour were
+/// clamped silently (order 5 ran at order 3); the analyses now say so.
+#[test]
+fn stability_options_out_of_range_are_errors_not_clamps() {
+    use cosserat::model::{Clamp, DeadLoads, LinearElastic, Profile, Rod};
+    use cosserat::stability::{critical_load, FixedShape, StabilityOptions};
+    let rod = Rod {
+        length: 1.0,
+        energy: std::sync::Arc::new(LinearElastic::uniform([1.0, 1.0, 1.0], [0.0; 3])),
+        clamp: Clamp::paper(),
+        loads: DeadLoads {
+            tip_force: nalgebra::Vector3::new(1.0, 0.0, 0.0),
+            ..Default::default()
+        },
+        support: None,
+    };
+    let shape = FixedShape {
+        turning_angle: Profile::Constant(0.0),
+    };
+    for (elements, order) in [(10, 5), (0, 2), (10, 0)] {
+        let opts = StabilityOptions {
+            elements,
+            order,
+            eigenvalues: 1,
+        };
+        let e = critical_load(&rod, &shape, &opts)
+            .expect_err("refused")
+            .to_string();
+        assert!(e.contains("order 1, 2 or 3"), "{e}");
+    }
 }

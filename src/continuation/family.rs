@@ -167,8 +167,14 @@ impl Family {
         stages: usize,
         tolerances: Tolerances,
     ) -> Self {
+        // The problem reader checks solver.stages; another value is a
+        // caller's error (it was clamped silently, running another order).
+        assert!(
+            (1..=3).contains(&stages),
+            "collocation with {stages} Gauss points; 1 to 3 are implemented"
+        );
         Family {
-            stages: Some(stages.clamp(1, 3)),
+            stages: Some(stages),
             ..Family::new(base, parameter, level, intervals, tolerances)
         }
     }
@@ -177,7 +183,7 @@ impl Family {
     fn system<'e>(&self, eq: &'e dyn crate::equations::RodEquations) -> ShootingSystem<'e> {
         match self.stages {
             Some(m) => ShootingSystem::collocation(eq, self.segments, m, self.tolerances)
-                .expect("stages clamped to a tableau"),
+                .expect("stages checked in Family::collocation"),
             None => ShootingSystem::new(eq, self.segments, self.tolerances),
         }
     }

@@ -80,6 +80,10 @@ impl Tracker {
 
     /// Finite-element nodes of the modes (at the base length).
     pub fn nodes(&self) -> Vec<f64> {
+        if self.opts.check().is_err() {
+            // Options no mesh can honour: measure() reports why.
+            return vec![];
+        }
         FiniteElements::new(self.base_length, self.opts.elements, self.opts.order).nodes()
     }
 
@@ -97,6 +101,9 @@ impl Tracker {
         p: f64,
     ) -> Result<(FiniteElements, Vec<BlockMatrices>, f64, Vec<RodSample>), PointError> {
         let rod = family.rod_at(p)?;
+        self.opts
+            .check()
+            .map_err(|e| PointError::Eigen(e.to_string()))?;
         let fe = FiniteElements::new(rod.length, self.opts.elements, self.opts.order)
             .with_hinged_base(rod.clamp.hinge);
         // One integration for the quadrature points and the 21 shape points

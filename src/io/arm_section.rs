@@ -216,6 +216,18 @@ impl ArmSection {
                 "must be at least 1 (the Halton samples of the global stage; e.g. 400)",
             ));
         }
+        if self.starts < 1 || self.iterations < 1 {
+            // starts = 0 skipped every polish and reported the best raw
+            // sample as the optimum.
+            return Err(invalid(
+                if self.starts < 1 {
+                    "arm.starts"
+                } else {
+                    "arm.iterations"
+                },
+                "must be at least 1 (Nelder–Mead polishes and their iterations; e.g. 4 and 400)",
+            ));
+        }
         reach_direction(self.alpha, self.elements)?;
         let b2 = h[(1, 1)];
         Ok((
