@@ -668,3 +668,31 @@ fn stability_options_out_of_range_are_errors_not_clamps() {
         assert!(e.contains("order 1, 2 or 3"), "{e}");
     }
 }
+
+/// Numbers at the ends of the floating-point range: stiffnesses of 1e±300
+/// gave a critical load of NaN, or "stable under any load", with exit
+/// code 0. Material and load numbers are refused outside [1e-100, 1e100];
+/// inside, Euler's column still buckles at γ = π²/4 (Euler 1744) at both
+/// ends of the range.
+#[test]
+fn numbers_near_the_floating_point_limits_are_refused_or_right() {
+    use cosserat::stability::critical_load;
+    let column = euler_column();
+    for set in [
+        "energy.stiffness=[1e-300, 1e-300, 1e-300]",
+        "energy.stiffness=[1e300, 1e300, 1e300]",
+        "loads.tip_force=[0, 0, -1e300]",
+        "energy.shear=[1e-320, 1, 1]",
+        "energy.intrinsic_curvature=[0, 1e200, 0]",
+    ] {
+        let e = refusal(&column, &[set]);
+        assert!(e.contains("[1e-100, 1e100]"), "{set}: {e}");
+    }
+    for b in ["1e-90", "1e90"] {
+        let p = accepted(&column, &[&format!("energy.stiffness=[{b}, {b}, {b}]")]);
+        let crit = critical_load(&p.rod, p.shape.as_ref().unwrap(), &p.stability).unwrap();
+        let gamma = crit.gamma.expect("a critical load");
+        let euler = std::f64::consts::PI.powi(2) / 4.0;
+        assert!((gamma - euler).abs() < 1e-8 * euler, "B = {b}: γ = {gamma}");
+    }
+}

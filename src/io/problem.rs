@@ -631,6 +631,39 @@ fn vector(field: &str, v: [f64; 3]) -> Result<Vector3<f64>, ProblemError> {
     Ok(Vector3::from(v))
 }
 
+/// The magnitudes a material or load number may have: 0, or 1e-100 to
+/// 1e100. Products of three such numbers (a load times a length squared
+/// over a stiffness, B/h · κ²) stay inside the floating-point range
+/// (1e±308); beyond it a critical load came out NaN or "none" with exit
+/// code 0.
+pub const MAGNITUDE_RANGE: (f64, f64) = (1e-100, 1e100);
+
+fn magnitude(field: &str, v: f64) -> Result<f64, ProblemError> {
+    let v = finite(field, v)?;
+    let a = v.abs();
+    if a == 0.0 || (MAGNITUDE_RANGE.0..=MAGNITUDE_RANGE.1).contains(&a) {
+        Ok(v)
+    } else {
+        Err(invalid(
+            field,
+            format!(
+                "{v:e} is outside the magnitudes [{:e}, {:e}] (or 0) that keep products of the \
+                 problem's numbers inside the floating-point range; change the units",
+                MAGNITUDE_RANGE.0, MAGNITUDE_RANGE.1
+            ),
+        ))
+    }
+}
+
+/// A vector of loads or curvatures: finite, each component within
+/// [`MAGNITUDE_RANGE`] or zero.
+fn load_vector(field: &str, v: [f64; 3]) -> Result<Vector3<f64>, ProblemError> {
+    for (i, x) in v.iter().enumerate() {
+        magnitude(&format!("{field}[{i}]"), *x)?;
+    }
+    Ok(Vector3::from(v))
+}
+
 fn profile(field: &str, spec: &ProfileSpec) -> Result<Profile, ProblemError> {
     let p = match spec {
         ProfileSpec::Constant(c) => Profile::Constant(*c),
@@ -665,6 +698,14 @@ fn profile(field: &str, spec: &ProfileSpec) -> Result<Profile, ProblemError> {
     };
     if !p.is_finite() {
         return Err(invalid(field, "must contain finite numbers only"));
+    }
+    let numbers: Vec<f64> = match spec {
+        ProfileSpec::Constant(c) => vec![*c],
+        ProfileSpec::Polynomial { polynomial } => polynomial.clone(),
+        ProfileSpec::Table { s, values } => s.iter().chain(values).copied().collect(),
+    };
+    for v in numbers {
+        magnitude(field, v)?;
     }
     Ok(p)
 }
@@ -717,9 +758,12 @@ fn build_rod(file: &ProblemFile, catalog: &EnergyCatalog) -> Result<Rod, Problem
         energy,
         clamp,
         loads: DeadLoads {
-            tip_force: vector("loads.tip_force", file.loads.tip_force)?,
-            tip_couple: vector("loads.tip_couple", file.loads.tip_couple)?,
-            distributed_force: vector("loads.distributed_force", file.loads.distributed_force)?,
+            tip_force: load_vector("loads.tip_force", file.loads.tip_force)?,
+            tip_couple: load_vector("loads.tip_couple", file.loads.tip_couple)?,
+            distributed_force: load_vector(
+                "loads.distributed_force",
+                file.loads.distributed_force,
+            )?,
         },
         support,
     })
@@ -729,7 +773,7 @@ fn build_rod(file: &ProblemFile, catalog: &EnergyCatalog) -> Result<Rod, Problem
 fn shear_stiffness(shear: [f64; 3]) -> Result<nalgebra::Vector3<f64>, ProblemError> {
     for (i, v) in shear.iter().enumerate() {
         let field = format!("energy.shear[{i}]");
-        let v = finite(&field, *v)?;
+        let v = magnitude(&field, *v)?;
         if v <= 0.0 {
             return Err(invalid(field, format!("must be positive, got {v}")));
         }
@@ -808,11 +852,11 @@ fn build_energy(
         }
     }
     for (name, value) in &e.parameters {
-        let v = finite(&format!("energy.parameters.{name}"), *value)?;
+        let v = magnitude(&format!("energy.parameters.{name}"), *value)?;
         spec.parameters.insert(name.clone(), v);
     }
     if let Some(c) = e.quartic {
-        let c = finite("energy.quartic", c)?;
+        let c = magnitude("energy.quartic", c)?;
         if spec.parameters.insert("quartic".into(), c).is_some() {
             return Err(invalid(
                 "energy.quartic",

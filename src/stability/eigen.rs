@@ -30,6 +30,9 @@ pub enum EigenError {
     /// The metric (mass matrix or K0) is not positive definite.
     #[error("the reference matrix is not positive definite: {0}")]
     NotDefinite(String),
+    /// The matrices or their eigenvalues are not finite numbers.
+    #[error("not finite: {0}")]
+    NotFinite(String),
     /// Lanczos did not converge.
     #[error("Lanczos did not converge: residual {residual:.2e} after {steps} steps")]
     NoConvergence { residual: f64, steps: usize },
@@ -442,6 +445,13 @@ pub fn smallest_positive_load_factor(
         lanczos(k0.size(), 1, 60, apply, k0, |mu| mu, |a, b| a.total_cmp(&b))?
     };
     let mu = pairs.values[0];
+    if !mu.is_finite() || pairs.vectors[0].iter().any(|v| !v.is_finite()) {
+        // Overflow or underflow in K0 or K1 (stiffnesses or loads near the
+        // ends of the floating-point range): no number to report.
+        return Err(EigenError::NotFinite(format!(
+            "the pencil's lowest eigenvalue is {mu}: K0 or K1 left the floating-point range"
+        )));
+    }
     if mu >= 0.0 || !destabilizing(k1, &pairs.vectors[0]) {
         return Ok(None);
     }
