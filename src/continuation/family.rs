@@ -219,6 +219,11 @@ impl Family {
         }
     }
 
+    /// The length of the base rod (the problem's `rod.length`).
+    pub fn base_length(&self) -> f64 {
+        self.base.length
+    }
+
     /// The model level.
     pub fn level(&self) -> ModelLevel {
         self.level

@@ -52,10 +52,9 @@ pub struct Tracker {
 impl Tracker {
     /// A tracker of `blocks` with the discretization in `opts`.
     pub fn new(family: &Family, blocks: Vec<Block>, opts: StabilityOptions) -> Self {
-        let base_length = family
-            .rod_at(0.0)
-            .or_else(|_| family.rod_at(1.0))
-            .map_or(1.0, |r| r.length);
+        // The base rod's own length (a failed rod_at(0) used to fall back to
+        // a length of 1 for the nodes of the written modes).
+        let base_length = family.base_length();
         Tracker {
             blocks,
             opts,
