@@ -255,6 +255,9 @@ fn solution_file_follows_the_contract() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
+/// A tolerance round-off cannot reach is refused at input with its range;
+/// one within the range that the iteration budget cannot reach is an
+/// error, not a result.
 #[test]
 fn impossible_tolerance_is_an_error_not_a_result() {
     ends_with(
@@ -262,6 +265,19 @@ fn impossible_tolerance_is_an_error_not_a_result() {
         "impossible-tolerance",
         CANTILEVER,
         &["--set", "solver.tolerance=1e-30"],
+        &["solver.tolerance", "outside [1e-15, 1e-6]"],
+    );
+    rejects(
+        "unreached-tolerance",
+        CANTILEVER,
+        &[
+            "--set",
+            "solver.tolerance=1e-15",
+            "--set",
+            "solver.max_iterations=1",
+            "--set",
+            "solver.strategy=\"direct\"",
+        ],
         &["did not converge"],
     );
 }

@@ -396,9 +396,11 @@ fn check_energy(rod: &Rod) -> Result<(), SolveError> {
         if !finite || h.cholesky().is_none() {
             return Err(SolveError::Model(format!(
                 "the Hessian of the {} energy is not positive definite at s = {s} \
-                 (stiffness {:?})",
+                 (diagonal {:e}, {:e}, {:e}); check energy.stiffness and the energy's parameters",
                 rod.energy.name(),
-                h.diagonal().as_slice()
+                h[(0, 0)],
+                h[(1, 1)],
+                h[(2, 2)]
             )));
         }
     }

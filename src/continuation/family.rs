@@ -7,13 +7,13 @@
 //! slows the corrector at worst — the points themselves satisfy F = 0 to
 //! the Newton tolerance.
 
-use nalgebra::{DMatrix, DVector, Matrix3, Vector3};
+use nalgebra::{DMatrix, DVector, Matrix3};
 
 use crate::bvp::integrator::{IntegrationError, Tolerances};
 use crate::bvp::newton::NonlinearSystem;
 use crate::bvp::{equations, ShootingSystem};
 use crate::equations::RodSample;
-use crate::model::{ModelLevel, Profile, Rod};
+use crate::model::{ModelLevel, ProfileKind, Rod};
 
 /// Which number of the rod the parameter sets.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -45,6 +45,23 @@ pub enum Parameter {
     IntrinsicCurvature(usize),
     /// The clamp turned by p (rad) about d2(0), d3 towards d1.
     ClampAngle,
+}
+
+impl std::fmt::Display for Parameter {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Parameter::LoadScale => f.write_str("load_scale"),
+            Parameter::ControlScale => f.write_str("control_scale"),
+            Parameter::CurvatureTowards => f.write_str("the shape-holding control"),
+            Parameter::TipForce(i) => write!(f, "loads.tip_force[{i}]"),
+            Parameter::TipCouple(i) => write!(f, "loads.tip_couple[{i}]"),
+            Parameter::DistributedForce(i) => write!(f, "loads.distributed_force[{i}]"),
+            Parameter::Length => f.write_str("rod.length"),
+            Parameter::Stiffness(i) => write!(f, "energy.stiffness[{i}]"),
+            Parameter::IntrinsicCurvature(i) => write!(f, "energy.intrinsic_curvature[{i}]"),
+            Parameter::ClampAngle => f.write_str("clamp.angle"),
+        }
+    }
 }
 
 impl Parameter {
@@ -104,12 +121,16 @@ pub struct Family {
 pub enum FamilyError {
     /// The parameter needs a linear energy with constant profiles.
     #[error(
-        "parameter {0:?} needs the linear energy (with constant stiffness and intrinsic curvature \
-         for a stiffness or curvature parameter)"
+        "continuation.parameter = {0} needs an energy with that profile as a constant (the \
+         linear energy, possibly with energy.shear; a stiffness or curvature parameter replaces \
+         a constant, never a varying profile)"
     )]
     NotConstant(Parameter),
     /// A value outside the physical range.
-    #[error("parameter {parameter:?} = {value} is not physical")]
+    #[error(
+        "continuation.parameter = {parameter} is not physical at {value} (a length or stiffness \
+         must be positive): narrow continuation.bounds"
+    )]
     NotPhysical { parameter: Parameter, value: f64 },
 }
 
@@ -146,8 +167,14 @@ impl Family {
         stages: usize,
         tolerances: Tolerances,
     ) -> Self {
+        // The problem reader checks solver.stages; another value is a
+        // caller's error (it was clamped silently, running another order).
+        assert!(
+            (1..=3).contains(&stages),
+            "collocation with {stages} Gauss points; 1 to 3 are implemented"
+        );
         Family {
-            stages: Some(stages.clamp(1, 3)),
+            stages: Some(stages),
             ..Family::new(base, parameter, level, intervals, tolerances)
         }
     }
@@ -156,7 +183,7 @@ impl Family {
     fn system<'e>(&self, eq: &'e dyn crate::equations::RodEquations) -> ShootingSystem<'e> {
         match self.stages {
             Some(m) => ShootingSystem::collocation(eq, self.segments, m, self.tolerances)
-                .expect("stages clamped to a tableau"),
+                .expect("stages checked in Family::collocation"),
             None => ShootingSystem::new(eq, self.segments, self.tolerances),
         }
     }
@@ -190,6 +217,11 @@ impl Family {
             1 => crate::bvp::Method::Shooting,
             segments => crate::bvp::Method::MultipleShooting { segments },
         }
+    }
+
+    /// The length of the base rod (the problem's `rod.length`).
+    pub fn base_length(&self) -> f64 {
+        self.base.length
     }
 
     /// The model level.
@@ -253,22 +285,14 @@ impl Family {
         Ok(rod)
     }
 
-    /// The linear energy with constant profiles, one of them set to p.
+    /// The base energy with one constant profile set to p, everything else
+    /// (the other profiles, the shear and extension part of a Cosserat rod)
+    /// kept ([`crate::model::StoredEnergy::with_constant`]).
     fn linear_with(
         &self,
         p: f64,
     ) -> Result<std::sync::Arc<dyn crate::model::StoredEnergy>, FamilyError> {
-        let e = &self.base.energy;
-        if !e.is_quadratic() {
-            return Err(FamilyError::NotConstant(self.parameter));
-        }
-        let zero = Vector3::zeros();
-        let h = e.stiffness(0.0, &zero);
-        // For the linear energy M(0) = −B κ⁰ at κ = 0.
-        let m = e.moment(0.0, &zero);
-        let mut b = [h[(0, 0)], h[(1, 1)], h[(2, 2)]];
-        let mut k0 = [-m[0] / b[0], -m[1] / b[1], -m[2] / b[2]];
-        match self.parameter {
+        let (kind, i) = match self.parameter {
             Parameter::Stiffness(i) => {
                 if p <= 0.0 {
                     return Err(FamilyError::NotPhysical {
@@ -276,16 +300,15 @@ impl Family {
                         value: p,
                     });
                 }
-                b[i] = p
+                (ProfileKind::Stiffness, i)
             }
-            Parameter::IntrinsicCurvature(i) => k0[i] = p,
+            Parameter::IntrinsicCurvature(i) => (ProfileKind::IntrinsicCurvature, i),
             _ => unreachable!("only profile parameters"),
-        }
-        let linear = crate::model::LinearElastic {
-            stiffness: b.map(Profile::Constant),
-            intrinsic_curvature: k0.map(Profile::Constant),
         };
-        Ok(std::sync::Arc::new(linear))
+        self.base
+            .energy
+            .with_constant(kind, i, p)
+            .ok_or(FamilyError::NotConstant(self.parameter))
     }
 
     /// The typical magnitudes of the shooting unknowns: 1 for the free

@@ -52,10 +52,9 @@ pub struct Tracker {
 impl Tracker {
     /// A tracker of `blocks` with the discretization in `opts`.
     pub fn new(family: &Family, blocks: Vec<Block>, opts: StabilityOptions) -> Self {
-        let base_length = family
-            .rod_at(0.0)
-            .or_else(|_| family.rod_at(1.0))
-            .map_or(1.0, |r| r.length);
+        // The base rod's own length (a failed rod_at(0) used to fall back to
+        // a length of 1 for the nodes of the written modes).
+        let base_length = family.base_length();
         Tracker {
             blocks,
             opts,
@@ -80,6 +79,10 @@ impl Tracker {
 
     /// Finite-element nodes of the modes (at the base length).
     pub fn nodes(&self) -> Vec<f64> {
+        if self.opts.check().is_err() {
+            // Options no mesh can honour: measure() reports why.
+            return vec![];
+        }
         FiniteElements::new(self.base_length, self.opts.elements, self.opts.order).nodes()
     }
 
@@ -97,6 +100,9 @@ impl Tracker {
         p: f64,
     ) -> Result<(FiniteElements, Vec<BlockMatrices>, f64, Vec<RodSample>), PointError> {
         let rod = family.rod_at(p)?;
+        self.opts
+            .check()
+            .map_err(|e| PointError::Eigen(e.to_string()))?;
         let fe = FiniteElements::new(rod.length, self.opts.elements, self.opts.order)
             .with_hinged_base(rod.clamp.hinge);
         // One integration for the quadrature points and the 21 shape points
@@ -144,14 +150,34 @@ impl Tracker {
         let mut block_morse = vec![];
         for (bi, (k, g, constraints)) in mats.iter().enumerate() {
             // The previous point's lowest two eigenvalues place the shift.
-            let near = self.previous_values.as_ref().map(|v| {
-                let mut b: Vec<f64> = v[bi].clone();
-                b.sort_by(|x, y| x.total_cmp(y));
-                (b[0], *b.get(1).unwrap_or(&b[0]))
-            });
+            let near = self
+                .previous_values
+                .as_ref()
+                .and_then(|v| v.get(bi))
+                .filter(|b| !b.is_empty())
+                .map(|b| {
+                    let mut b: Vec<f64> = b.clone();
+                    b.sort_by(|x, y| x.total_cmp(y));
+                    // One tracked eigenvalue: it is both of the lowest two.
+                    (b[0], *b.get(1).unwrap_or(&b[0]))
+                });
             let pairs =
                 lowest_eigenpairs_constrained(k, g, constraints, self.opts.eigenvalues, near)
                     .map_err(|e| PointError::Eigen(e.to_string()))?;
+            // Every block fills its `eigenvalues` columns of the diagram; a
+            // mesh with fewer unknowns than that cannot (the eigensolver
+            // returns at most the block's dimension).
+            if pairs.values.len() != self.opts.eigenvalues {
+                return Err(PointError::Eigen(format!(
+                    "the {} block has only {} eigenvalues on {} elements of order {}, \
+                     {} are tracked: lower continuation.eigenvalues or raise continuation.elements",
+                    self.blocks[bi].name(),
+                    pairs.values.len(),
+                    self.opts.elements,
+                    self.opts.order,
+                    self.opts.eigenvalues
+                )));
+            }
             let order = match &self.previous {
                 Some(prev) => match_modes(&prev[bi], &pairs.vectors, g),
                 None => (0..pairs.values.len()).collect(),

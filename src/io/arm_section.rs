@@ -19,6 +19,7 @@ pub struct ArmSection {
     /// M, the number of Taylor coefficients of φ(s̄).
     pub coefficients: usize,
     /// Bounds of c2..cM, M − 1 pairs.
+    #[serde(deserialize_with = "super::strict::vec")]
     pub bounds: Vec<[f64; 2]>,
     /// Halton samples of the global stage.
     #[serde(default = "default_samples")]
@@ -78,6 +79,59 @@ fn downward(rod: &Rod) -> Result<(f64, f64), ProblemError> {
         ));
     }
     Ok((l.tip_force[0], l.distributed_force[0]))
+}
+
+/// The smallest |cos α| of a downward reach direction (sin α < 0) that a
+/// mesh of `elements` resolves: [`reach_direction`].
+pub fn min_downward_cosine(elements: usize) -> f64 {
+    8.0 / elements as f64
+}
+
+/// Checks the reach direction α (degrees above the horizontal, the tip's
+/// elevation seen from the clamp).
+///
+/// Every α in [−180°, 180°] names a direction: α in [−90°, 90°] reaches
+/// to the side the clamp's tangent points to, α beyond ±90° to the other
+/// side (the mirror image of 180° − α, resp. −180° − α, with the clamp
+/// angle free). The reach is finite everywhere but straight down: at
+/// α = −90° the arm hangs, in tension, stable under any load, so its
+/// reach is unbounded (the search reported R* ≈ 1e10, a number of the
+/// mesh). Near it the reach is finite but grows like 1/|cos α|: measured
+/// R* |cos α| = 3.97, 3.42, 2.48, 1.51 at α = −60°, −80°, −88°, −89.9°
+/// (B̄1 = 4, B̄3 = 1.27, M = 3), so R* ≤ 4/|cos α| in units of √(B2/F).
+/// The critical load γ ≥ R*² of such an arm bends it in a boundary layer
+/// of length 1/√γ (in units of L), which the mesh resolves only when it
+/// spans two elements: 4/|cos α| ≤ elements/2, i.e.
+/// |cos α| ≥ 8/elements. Downward directions closer to vertical are
+/// refused: α ≥ −85.4° (and ≤ −94.6°) for 100 elements.
+pub fn reach_direction(alpha: f64, elements: usize) -> Result<f64, ProblemError> {
+    if !alpha.is_finite() || alpha.abs() > 180.0 {
+        return Err(invalid(
+            "arm.alpha",
+            format!(
+                "{alpha} is outside [−180, 180] degrees (the tip's elevation above the \
+                 horizontal; beyond ±90° the arm reaches to the other side)"
+            ),
+        ));
+    }
+    let (sin, cos) = alpha.to_radians().sin_cos();
+    let min = min_downward_cosine(elements);
+    if sin < 0.0 && cos.abs() < min {
+        let limit = 90.0 - min.asin().to_degrees();
+        return Err(invalid(
+            "arm.alpha",
+            format!(
+                "{alpha}° is within {:.1}° of straight down: an arm hanging straight down is \
+                 stable under any load, so its reach is unbounded, and near it the reach grows \
+                 like 4/|cos α| (in units of √(B2/F)), beyond what arm.elements = {elements} \
+                 resolves (|cos α| ≥ 8/elements). Use α ≥ −{limit:.1}° (or ≤ −{:.1}°), or \
+                 raise arm.elements",
+                90.0 - limit,
+                180.0 - limit,
+            ),
+        ));
+    }
+    Ok(alpha)
 }
 
 impl ArmSection {
@@ -144,18 +198,37 @@ impl ArmSection {
                 ));
             }
         }
-        if !self.alpha.is_finite() || self.alpha.abs() > 180.0 {
+        if !(1..=3).contains(&self.order) {
             return Err(invalid(
-                "arm.alpha",
-                format!("must be in [−180, 180] degrees, got {}", self.alpha),
+                "arm.order",
+                format!("must be 1, 2 or 3, got {}", self.order),
             ));
         }
-        if !(1..=3).contains(&self.order) || self.elements < 2 || self.samples < 1 {
+        if self.elements < 2 {
             return Err(invalid(
-                "arm",
-                "order 1–3, elements ≥ 2 and samples ≥ 1 are needed",
+                "arm.elements",
+                format!("must be at least 2, got {}", self.elements),
             ));
         }
+        if self.samples < 1 {
+            return Err(invalid(
+                "arm.samples",
+                "must be at least 1 (the Halton samples of the global stage; e.g. 400)",
+            ));
+        }
+        if self.starts < 1 || self.iterations < 1 {
+            // starts = 0 skipped every polish and reported the best raw
+            // sample as the optimum.
+            return Err(invalid(
+                if self.starts < 1 {
+                    "arm.starts"
+                } else {
+                    "arm.iterations"
+                },
+                "must be at least 1 (Nelder–Mead polishes and their iterations; e.g. 4 and 400)",
+            ));
+        }
+        reach_direction(self.alpha, self.elements)?;
         let b2 = h[(1, 1)];
         Ok((
             ArmProblem {

@@ -3,7 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::problem::{invalid, ProblemError};
+use super::problem::{invalid, within, ProblemError, NEWTON_TOLERANCE};
 use crate::continuation::{ContinuationOptions, Parameter};
 use crate::stability::StabilityOptions;
 
@@ -18,6 +18,7 @@ pub struct ContinuationSection {
     /// The value to start from.
     pub start: f64,
     /// [min, max]: a branch stops when the parameter leaves it.
+    #[serde(deserialize_with = "super::strict::array")]
     pub bounds: [f64; 2],
     /// Initial arclength step.
     #[serde(default = "default_step")]
@@ -160,11 +161,17 @@ impl ContinuationSection {
             ));
         }
         let tip_angle_limit = match self.tip_angle_limit {
-            Some(a) if a.is_finite() && a > 0.0 => Some(a.to_radians()),
+            // The tip angle is measured in [0°, 180°] (the angle between
+            // two unit vectors): a limit above 180° would never stop a branch.
+            Some(a) if a.is_finite() && a > 0.0 && a <= 180.0 => Some(a.to_radians()),
             Some(a) => {
                 return Err(invalid(
                     "continuation.tip_angle_limit",
-                    format!("must be positive, got {a}"),
+                    format!(
+                        "{a} is outside (0, 180] degrees: the angle between the tip and clamp \
+                         tangents is at most 180°, so a larger limit never stops a branch; \
+                         remove the key for no limit"
+                    ),
                 ))
             }
             None => None,
@@ -173,8 +180,9 @@ impl ContinuationSection {
             return Err(invalid(
                 "continuation.measure",
                 format!(
-                    "unknown measure `{}`; expected one of {MEASURES:?}",
-                    self.measure
+                    "unknown measure `{}`; expected one of {}",
+                    self.measure,
+                    MEASURES.join(", ")
                 ),
             ));
         }
@@ -195,7 +203,7 @@ impl ContinuationSection {
                     order: self.order,
                     eigenvalues: self.eigenvalues,
                 },
-                tolerance: positive("continuation.tolerance", self.tolerance)?,
+                tolerance: within("continuation.tolerance", self.tolerance, NEWTON_TOLERANCE)?,
                 event_tolerance: 1e-11,
             },
         ))

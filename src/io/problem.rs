@@ -16,6 +16,7 @@ use serde::{Deserialize, Deserializer, Serialize};
 
 use super::arm_section::ArmSection;
 use super::continuation_section::ContinuationSection;
+use super::strict;
 use super::sweep_section::{Sweep, SweepSection};
 use super::SupportSection;
 use crate::bvp::integrator::Tolerances;
@@ -150,9 +151,10 @@ pub struct EnergySection {
     #[serde(default = "default_energy_kind")]
     pub kind: String,
     /// B1, B2, B3 (N·m²), each a profile.
+    #[serde(deserialize_with = "strict::array")]
     pub stiffness: [ProfileSpec; 3],
     /// κ⁰ body components (1/m), each a profile.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "strict::array")]
     pub intrinsic_curvature: [ProfileSpec; 3],
     /// C (N·m⁴) of the quartic energy (shorthand for
     /// `parameters.quartic`).
@@ -164,7 +166,11 @@ pub struct EnergySection {
     /// Shear and extension stiffnesses (k G A, k G A, E A) in N: a
     /// shearable, extensible Cosserat rod. Absent: unshearable and
     /// inextensible (Kirchhoff).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "strict::option"
+    )]
     pub shear: Option<[f64; 3]>,
 }
 
@@ -237,13 +243,13 @@ impl<'de> Deserialize<'de> for ProfileSpec {
 #[serde(deny_unknown_fields)]
 pub struct ClampSection {
     /// r(0) (m).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "strict::array")]
     pub position: [f64; 3],
     /// d1(0), a unit vector.
-    #[serde(default = "unit_x")]
+    #[serde(default = "unit_x", deserialize_with = "strict::array")]
     pub d1: [f64; 3],
     /// d3(0), the tangent, a unit vector orthogonal to d1.
-    #[serde(default = "unit_z")]
+    #[serde(default = "unit_z", deserialize_with = "strict::array")]
     pub d3: [f64; 3],
     /// The frame (d1, d3) turned about d2 by this angle (rad), d3 towards
     /// d1: the clamp angle of the paper's Fig. 2.
@@ -279,13 +285,13 @@ impl Default for ClampSection {
 #[serde(deny_unknown_fields)]
 pub struct LoadSection {
     /// Tip force (N).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "strict::array")]
     pub tip_force: [f64; 3],
     /// Tip couple (N·m).
-    #[serde(default)]
+    #[serde(default, deserialize_with = "strict::array")]
     pub tip_couple: [f64; 3],
     /// Uniform force per unit length (N/m), e.g. self-weight ρAg.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "strict::array")]
     pub distributed_force: [f64; 3],
 }
 
@@ -331,7 +337,11 @@ pub struct SolverSection {
     #[serde(default = "default_output_points")]
     pub output_points: usize,
     /// Guess of κ(0), body components (1/m).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "strict::option"
+    )]
     pub initial_curvature: Option<[f64; 3]>,
 }
 
@@ -414,10 +424,7 @@ impl Problem {
         overrides: &[String],
         catalog: &EnergyCatalog,
     ) -> Result<Problem, ProblemError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ProblemError::Read {
-            path: path.display().to_string(),
-            source,
-        })?;
+        let text = read_problem_file(path)?;
         Problem::from_str_in(&text, overrides, catalog)
     }
 
@@ -432,9 +439,15 @@ impl Problem {
         overrides: &[String],
         catalog: &EnergyCatalog,
     ) -> Result<Problem, ProblemError> {
+        if text.len() > MAX_PROBLEM_BYTES as usize {
+            return Err(ProblemError::Parse(format!(
+                "the problem text is {} bytes, more than the {MAX_PROBLEM_BYTES} a problem file \
+                 may have; a problem file describes a rod, not data",
+                text.len()
+            )));
+        }
         let text = apply_overrides(text, overrides)?;
-        let file: ProblemFile =
-            toml::from_str(&text).map_err(|e| ProblemError::Parse(e.to_string()))?;
+        let file: ProblemFile = strict::parse(&text)?;
         let rod = build_rod(&file, catalog)?;
         let model = choose_model(&rod, &file.solver.model, file.energy.shear.is_some())?;
         if rod.clamp.hinge && model.level != ModelLevel::Planar {
@@ -449,6 +462,7 @@ impl Problem {
         let options = build_options(&file.solver)?;
         let shape = build_shape(&file)?;
         let stability = build_stability(&file.stability)?;
+        eigenvalue_count("stability", &stability, &rod)?;
         let continuation = build_continuation(&file, &rod, &model, &options, shape.as_ref())?;
         let arm = file.arm.as_ref().map(|a| a.build(&rod)).transpose()?;
         let arm_scene = file
@@ -457,7 +471,7 @@ impl Problem {
             .map(|a| a.scene(&rod).map(|s| (s, a.map_samples)))
             .transpose()?;
         let sweep = file.sweep.as_ref().map(SweepSection::build).transpose()?;
-        Ok(Problem {
+        let problem = Problem {
             rod,
             model,
             options,
@@ -468,8 +482,68 @@ impl Problem {
             arm,
             arm_scene,
             sweep,
-        })
+        };
+        // Before any command allocates: what the sizes ask for must fit.
+        super::memory::check(&problem)?;
+        Ok(problem)
     }
+}
+
+/// The largest problem file read: 1 MiB (the shipped ones are under 3 KiB).
+pub const MAX_PROBLEM_BYTES: u64 = 1 << 20;
+
+/// The text of a problem file, refusing before reading anything what is not
+/// a regular file (a directory; a device such as /dev/zero or a FIFO would
+/// be read without end, or block) or is larger than [`MAX_PROBLEM_BYTES`];
+/// at most that many bytes are read even if the file grows meanwhile.
+fn read_problem_file(path: &Path) -> Result<String, ProblemError> {
+    use std::io::Read;
+    let fail = |message: String| ProblemError::Read {
+        path: path.display().to_string(),
+        source: std::io::Error::new(std::io::ErrorKind::InvalidInput, message),
+    };
+    let io = |source: std::io::Error| ProblemError::Read {
+        path: path.display().to_string(),
+        source,
+    };
+    let meta = std::fs::metadata(path).map_err(io)?;
+    if meta.is_dir() {
+        return Err(fail(
+            "is a directory; give a problem file (TOML), e.g. problems/cantilever_tip_load.toml"
+                .into(),
+        ));
+    }
+    if !meta.is_file() {
+        return Err(fail(
+            "is not a regular file (a device, FIFO or socket would be read without end); give a \
+             problem file (TOML)"
+                .into(),
+        ));
+    }
+    if meta.len() > MAX_PROBLEM_BYTES {
+        return Err(fail(format!(
+            "is {} bytes, more than the {MAX_PROBLEM_BYTES} (1 MiB) a problem file may have; is \
+             it the right file?",
+            meta.len()
+        )));
+    }
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)
+        .map_err(io)?
+        .take(MAX_PROBLEM_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    if bytes.len() as u64 > MAX_PROBLEM_BYTES {
+        return Err(fail(format!(
+            "grew beyond {MAX_PROBLEM_BYTES} bytes (1 MiB) while being read"
+        )));
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        fail(format!(
+            "is not UTF-8 text (byte {}); a problem file is TOML text",
+            e.utf8_error().valid_up_to()
+        ))
+    })
 }
 
 /// The text with every `a.b.c=value` applied; the value is read as a TOML
@@ -557,6 +631,39 @@ fn vector(field: &str, v: [f64; 3]) -> Result<Vector3<f64>, ProblemError> {
     Ok(Vector3::from(v))
 }
 
+/// The magnitudes a material or load number may have: 0, or 1e-100 to
+/// 1e100. Products of three such numbers (a load times a length squared
+/// over a stiffness, B/h · κ²) stay inside the floating-point range
+/// (1e±308); beyond it a critical load came out NaN or "none" with exit
+/// code 0.
+pub const MAGNITUDE_RANGE: (f64, f64) = (1e-100, 1e100);
+
+fn magnitude(field: &str, v: f64) -> Result<f64, ProblemError> {
+    let v = finite(field, v)?;
+    let a = v.abs();
+    if a == 0.0 || (MAGNITUDE_RANGE.0..=MAGNITUDE_RANGE.1).contains(&a) {
+        Ok(v)
+    } else {
+        Err(invalid(
+            field,
+            format!(
+                "{v:e} is outside the magnitudes [{:e}, {:e}] (or 0) that keep products of the \
+                 problem's numbers inside the floating-point range; change the units",
+                MAGNITUDE_RANGE.0, MAGNITUDE_RANGE.1
+            ),
+        ))
+    }
+}
+
+/// A vector of loads or curvatures: finite, each component within
+/// [`MAGNITUDE_RANGE`] or zero.
+fn load_vector(field: &str, v: [f64; 3]) -> Result<Vector3<f64>, ProblemError> {
+    for (i, x) in v.iter().enumerate() {
+        magnitude(&format!("{field}[{i}]"), *x)?;
+    }
+    Ok(Vector3::from(v))
+}
+
 fn profile(field: &str, spec: &ProfileSpec) -> Result<Profile, ProblemError> {
     let p = match spec {
         ProfileSpec::Constant(c) => Profile::Constant(*c),
@@ -592,6 +699,14 @@ fn profile(field: &str, spec: &ProfileSpec) -> Result<Profile, ProblemError> {
     if !p.is_finite() {
         return Err(invalid(field, "must contain finite numbers only"));
     }
+    let numbers: Vec<f64> = match spec {
+        ProfileSpec::Constant(c) => vec![*c],
+        ProfileSpec::Polynomial { polynomial } => polynomial.clone(),
+        ProfileSpec::Table { s, values } => s.iter().chain(values).copied().collect(),
+    };
+    for v in numbers {
+        magnitude(field, v)?;
+    }
     Ok(p)
 }
 
@@ -600,7 +715,23 @@ fn build_rod(file: &ProblemFile, catalog: &EnergyCatalog) -> Result<Rod, Problem
     if length <= 0.0 {
         return Err(invalid(
             "rod.length",
-            format!("must be positive, got {length}"),
+            format!(
+                "must be positive, got {length} (accepted: [{:e}, {:e}] in the file's length \
+                 unit)",
+                LENGTH_RANGE.0, LENGTH_RANGE.1
+            ),
+        ));
+    }
+    if !(LENGTH_RANGE.0..=LENGTH_RANGE.1).contains(&length) {
+        return Err(invalid(
+            "rod.length",
+            format!(
+                "{length} is outside [{:e}, {:e}]: positions (of order L) and curvatures (of \
+                 order 1/L) are integrated with one absolute tolerance, so a length far from 1 \
+                 loses digits (at 1e-320 the finite elements divide by zero); choose the length \
+                 unit so that L is near 1 (any consistent units work)",
+                LENGTH_RANGE.0, LENGTH_RANGE.1
+            ),
         ));
     }
     let mut energy = build_energy(&file.energy, length, catalog)?;
@@ -627,9 +758,12 @@ fn build_rod(file: &ProblemFile, catalog: &EnergyCatalog) -> Result<Rod, Problem
         energy,
         clamp,
         loads: DeadLoads {
-            tip_force: vector("loads.tip_force", file.loads.tip_force)?,
-            tip_couple: vector("loads.tip_couple", file.loads.tip_couple)?,
-            distributed_force: vector("loads.distributed_force", file.loads.distributed_force)?,
+            tip_force: load_vector("loads.tip_force", file.loads.tip_force)?,
+            tip_couple: load_vector("loads.tip_couple", file.loads.tip_couple)?,
+            distributed_force: load_vector(
+                "loads.distributed_force",
+                file.loads.distributed_force,
+            )?,
         },
         support,
     })
@@ -639,7 +773,7 @@ fn build_rod(file: &ProblemFile, catalog: &EnergyCatalog) -> Result<Rod, Problem
 fn shear_stiffness(shear: [f64; 3]) -> Result<nalgebra::Vector3<f64>, ProblemError> {
     for (i, v) in shear.iter().enumerate() {
         let field = format!("energy.shear[{i}]");
-        let v = finite(&field, *v)?;
+        let v = magnitude(&field, *v)?;
         if v <= 0.0 {
             return Err(invalid(field, format!("must be positive, got {v}")));
         }
@@ -660,27 +794,69 @@ fn build_energy(
         intrinsic_curvature: Default::default(),
         parameters: Default::default(),
     };
+    let mut softest: Option<(f64, String)> = None;
+    let mut stiffest: Option<(f64, String)> = None;
     for i in 0..3 {
         let field = format!("energy.stiffness[{i}]");
         spec.stiffness[i] = profile(&field, &e.stiffness[i])?;
-        let min = spec.stiffness[i].minimum_on(length);
-        if min.is_nan() || min <= 0.0 {
+        // Exact where the profile allows (Profile::extremes_on): a table at
+        // its knots, a polynomial at the roots of its derivative, with a
+        // certified lower bound.
+        let x = spec.stiffness[i].extremes_on(length);
+        if x.min.is_nan() || x.min <= 0.0 {
             return Err(invalid(
                 field,
-                format!("must be positive on [0, L], minimum {min}"),
+                format!(
+                    "must be positive on [0, L], but its minimum is {:.6e} at s = {}; make the \
+                     profile positive on the whole rod",
+                    x.min, x.argmin
+                ),
             ));
+        }
+        if x.min_lower <= 0.0 {
+            return Err(invalid(
+                field,
+                format!(
+                    "its minimum {:.6e} at s = {} is within rounding ({:.1e}) of zero, so it cannot be \
+                     certified positive; make the profile clearly positive",
+                    x.min,
+                    x.argmin,
+                    x.min - x.min_lower
+                ),
+            ));
+        }
+        if softest.as_ref().is_none_or(|(v, _)| x.min < *v) {
+            softest = Some((x.min, field.clone()));
+        }
+        if stiffest.as_ref().is_none_or(|(v, _)| x.max > *v) {
+            stiffest = Some((x.max, field.clone()));
         }
         spec.intrinsic_curvature[i] = profile(
             &format!("energy.intrinsic_curvature[{i}]"),
             &e.intrinsic_curvature[i],
         )?;
     }
+    if let (Some((lo, soft)), Some((hi, stiff))) = (softest, stiffest) {
+        if hi / lo > MAX_STIFFNESS_RATIO {
+            return Err(invalid(
+                soft,
+                format!(
+                    "the stiffness ratio {:.3e} ({stiff} up to {hi:e}, this down to {lo:e}) \
+                     exceeds {MAX_STIFFNESS_RATIO:.3e} = 1/(4ε): the softer stiffness is then \
+                     below four rounding units of the stiffer one in the sums of the equations \
+                     and the second variation, and is lost; a stiffness that large is the \
+                     constraint limit — keep the ratio below it",
+                    hi / lo
+                ),
+            ));
+        }
+    }
     for (name, value) in &e.parameters {
-        let v = finite(&format!("energy.parameters.{name}"), *value)?;
+        let v = magnitude(&format!("energy.parameters.{name}"), *value)?;
         spec.parameters.insert(name.clone(), v);
     }
     if let Some(c) = e.quartic {
-        let c = finite("energy.quartic", c)?;
+        let c = magnitude("energy.quartic", c)?;
         if spec.parameters.insert("quartic".into(), c).is_some() {
             return Err(invalid(
                 "energy.quartic",
@@ -709,6 +885,13 @@ fn build_energy(
         )),
     }
 }
+
+/// The accepted rod lengths (in the file's length unit).
+pub const LENGTH_RANGE: (f64, f64) = (1e-6, 1e6);
+
+/// The largest ratio of the stiffest to the softest bending or torsional
+/// stiffness anywhere on the rod: 1/(4ε) ≈ 1.1e15.
+pub const MAX_STIFFNESS_RATIO: f64 = 0.25 / f64::EPSILON;
 
 /// Orthonormality tolerance of the clamp frame.
 const FRAME_TOLERANCE: f64 = 1e-9;
@@ -785,6 +968,7 @@ fn build_continuation(
         return Ok(None);
     };
     let (parameter, opts) = section.build()?;
+    eigenvalue_count("continuation", &opts.stability, rod)?;
     let (segments, stages) = match options.method {
         Method::Shooting => (1, None),
         Method::MultipleShooting { segments } => (segments, None),
@@ -834,6 +1018,11 @@ fn build_continuation(
             options.integration,
         ),
     };
+    // A parameter the energy cannot vary (a varying profile, an energy
+    // without that profile) is refused here, not at the first point.
+    family
+        .rod_at(opts.start)
+        .map_err(|e| invalid("continuation.parameter", e.to_string()))?;
     Ok(Some((family, opts)))
 }
 
@@ -868,6 +1057,44 @@ fn build_shape(file: &ProblemFile) -> Result<Option<FixedShape>, ProblemError> {
     Ok(Some(FixedShape { turning_angle }))
 }
 
+/// The fewest unknowns a block of the second variation can have: the
+/// in-plane block has one rotation per node but the clamped one
+/// (elements × order), and a tip support removes up to six more
+/// (three held translations, three held rotations).
+pub(crate) fn fewest_block_unknowns(opts: &StabilityOptions, rod: &Rod) -> usize {
+    let nodes = opts.elements.saturating_mul(opts.order);
+    if rod.support.is_some() {
+        nodes.saturating_sub(6)
+    } else {
+        nodes
+    }
+}
+
+/// The eigenvalues asked per block exist on the mesh (a count beyond the
+/// block's unknowns made the continuation tracker index past its columns).
+fn eigenvalue_count(table: &str, opts: &StabilityOptions, rod: &Rod) -> Result<(), ProblemError> {
+    let most = fewest_block_unknowns(opts, rod);
+    if opts.eigenvalues > most {
+        return Err(invalid(
+            format!("{table}.eigenvalues"),
+            format!(
+                "{} eigenvalues per block, but the smallest block of {} elements of order {} \
+                 has {most} unknowns{}: lower {table}.eigenvalues to at most {most} or raise \
+                 {table}.elements",
+                opts.eigenvalues,
+                opts.elements,
+                opts.order,
+                if rod.support.is_some() {
+                    " (elements × order, less six held by the support)"
+                } else {
+                    " (elements × order)"
+                },
+            ),
+        ));
+    }
+    Ok(())
+}
+
 fn build_stability(s: &StabilitySection) -> Result<StabilityOptions, ProblemError> {
     if s.elements < 1 {
         return Err(invalid("stability.elements", "must be at least 1"));
@@ -888,13 +1115,58 @@ fn build_stability(s: &StabilitySection) -> Result<StabilityOptions, ProblemErro
     })
 }
 
-fn positive(field: &str, v: f64) -> Result<f64, ProblemError> {
-    if v.is_finite() && v > 0.0 {
+/// The meaningful range of a tolerance-like key and why (docs/problem-files.md
+/// lists each).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Range {
+    /// Smallest value accepted.
+    pub lo: f64,
+    /// Largest value accepted.
+    pub hi: f64,
+    /// Why the range ends there and what to choose instead.
+    pub why: &'static str,
+}
+
+/// Newton's tolerance on the scaled residual (`solver.tolerance`,
+/// `continuation.tolerance`): the correction must then be below √τ, so
+/// above 1e-6 a "converged" shape may be wrong in its third digit (at τ = 1
+/// any iterate passes); below 1e-15 (≈ 5 ε) round-off alone keeps the
+/// scaled residual above it.
+pub(crate) const NEWTON_TOLERANCE: Range = Range {
+    lo: 1e-15,
+    hi: 1e-6,
+    why: "the scaled residual Newton must reach; above 1e-6 a converged shape may be \
+          wrong in its third digit, below 1e-15 round-off cannot reach it; e.g. 1e-10",
+};
+
+/// The integrator's relative and absolute tolerance: the shooting
+/// residual, and so the shape, is only as accurate as the integration.
+pub(crate) const INTEGRATION_TOLERANCE: Range = Range {
+    lo: 1e-14,
+    hi: 1e-6,
+    why: "the shape is only as accurate as the integration; above 1e-6 fewer than six \
+          digits are right, below 1e-14 DOP853's steps underflow in round-off; e.g. 1e-12",
+};
+
+/// Collocation's target for its accumulated local error estimate.
+pub(crate) const COLLOCATION_TOLERANCE: Range = Range {
+    lo: 1e-14,
+    hi: 1e-6,
+    why: "the mesh is refined until the error estimate is below it; above 1e-6 fewer than \
+          six digits are right, below 1e-14 round-off in the estimate dominates; e.g. 1e-10",
+};
+
+/// A tolerance-like number within its range.
+pub(crate) fn within(field: &str, v: f64, range: Range) -> Result<f64, ProblemError> {
+    if v.is_finite() && (range.lo..=range.hi).contains(&v) {
         Ok(v)
     } else {
         Err(invalid(
             field,
-            format!("must be a positive finite number, got {v}"),
+            format!(
+                "{v} is outside [{:e}, {:e}] ({})",
+                range.lo, range.hi, range.why
+            ),
         ))
     }
 }
@@ -935,7 +1207,11 @@ fn build_options(s: &SolverSection) -> Result<SolverOptions, ProblemError> {
     }
     let collocation = crate::bvp::CollocationOptions {
         stages: s.stages,
-        tolerance: positive("solver.collocation_tolerance", s.collocation_tolerance)?,
+        tolerance: within(
+            "solver.collocation_tolerance",
+            s.collocation_tolerance,
+            COLLOCATION_TOLERANCE,
+        )?,
         max_intervals: s.max_intervals,
         ..defaults
     };
@@ -950,7 +1226,17 @@ fn build_options(s: &SolverSection) -> Result<SolverOptions, ProblemError> {
             ))
         }
     };
-    let tol = positive("solver.integration_tolerance", s.integration_tolerance)?;
+    let tol = within(
+        "solver.integration_tolerance",
+        s.integration_tolerance,
+        INTEGRATION_TOLERANCE,
+    )?;
+    if s.max_steps < 1 {
+        return Err(invalid(
+            "solver.max_steps",
+            "must be at least 1 (the step budget of one integration; e.g. 100000)",
+        ));
+    }
     if s.output_points < 2 {
         return Err(invalid("solver.output_points", "must be at least 2"));
     }
@@ -964,14 +1250,14 @@ fn build_options(s: &SolverSection) -> Result<SolverOptions, ProblemError> {
     Ok(SolverOptions {
         method,
         newton: NewtonOptions {
-            tolerance: positive("solver.tolerance", s.tolerance)?,
+            tolerance: within("solver.tolerance", s.tolerance, NEWTON_TOLERANCE)?,
             max_iterations: s.max_iterations,
             ..Default::default()
         },
         integration: Tolerances {
             rtol: tol,
             atol: tol,
-            max_steps: s.max_steps.max(1),
+            max_steps: s.max_steps,
         },
         collocation,
         output_points: s.output_points,

@@ -27,17 +27,33 @@ pub struct SupportSection {
     #[serde(default = "free")]
     pub rotation: String,
     /// The sliding / spin axis (unit vector), required for "axial".
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "super::strict::option"
+    )]
     pub axis: Option<[f64; 3]>,
     /// The held tip position; default the unloaded straight rod's tip
     /// r(0) + L d3(0).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "super::strict::option"
+    )]
     pub position: Option<[f64; 3]>,
     /// The held tip frame's d1; default the clamp's.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "super::strict::option"
+    )]
     pub d1: Option<[f64; 3]>,
     /// The held tip frame's d3; default the clamp's.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "super::strict::option"
+    )]
     pub d3: Option<[f64; 3]>,
 }
 

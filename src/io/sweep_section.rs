@@ -67,10 +67,18 @@ pub struct AxisSpec {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub values: Option<Vec<f64>>,
     /// `[start, stop, count]`, equally spaced.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "super::strict::spacing"
+    )]
     pub linspace: Option<(f64, f64, usize)>,
     /// `[start, stop, count]`, geometrically spaced (start, stop > 0).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "super::strict::spacing"
+    )]
     pub logspace: Option<(f64, f64, usize)>,
 }
 

@@ -56,6 +56,21 @@ pub trait StoredEnergy: std::fmt::Debug + Send + Sync {
     fn intrinsic_profiles(&self) -> Option<&[Profile; 3]> {
         None
     }
+    /// The same material with one constant profile set to `value`: the
+    /// stiffness B_i or the intrinsic curvature κ⁰_i, for energies that
+    /// have it as a separate profile and where that profile is a constant
+    /// (None otherwise: replacing a varying profile by a number would
+    /// change the rod silently). Every other part of the material (the
+    /// other profiles, a shear and extension part) is kept. Continuation
+    /// in `energy.stiffness[i]` or `energy.intrinsic_curvature[i]`.
+    fn with_constant(
+        &self,
+        _profile: ProfileKind,
+        _i: usize,
+        _value: f64,
+    ) -> Option<std::sync::Arc<dyn StoredEnergy>> {
+        None
+    }
     /// The same material with κ⁰ = (1 − p) κ⁰_self + p κ⁰_target (None
     /// when either has no κ⁰ profiles or they do not blend): a control
     /// moving κ⁰ from one profile to another while the load is applied.
@@ -66,6 +81,15 @@ pub trait StoredEnergy: std::fmt::Debug + Send + Sync {
     ) -> Option<std::sync::Arc<dyn StoredEnergy>> {
         None
     }
+}
+
+/// Which profile of an energy [`StoredEnergy::with_constant`] sets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ProfileKind {
+    /// The stiffness B_i.
+    Stiffness,
+    /// The intrinsic curvature κ⁰_i.
+    IntrinsicCurvature,
 }
 
 /// The linear-elastic energy with intrinsic curvature,
@@ -186,6 +210,24 @@ impl StoredEnergy for LinearElastic {
             stiffness: self.stiffness.clone(),
             intrinsic_curvature: self.intrinsic_curvature.clone().map(|p| p.scaled(factor)),
         }))
+    }
+
+    fn with_constant(
+        &self,
+        profile: ProfileKind,
+        i: usize,
+        value: f64,
+    ) -> Option<std::sync::Arc<dyn StoredEnergy>> {
+        let mut e = self.clone();
+        let slot = match profile {
+            ProfileKind::Stiffness => e.stiffness.get_mut(i)?,
+            ProfileKind::IntrinsicCurvature => e.intrinsic_curvature.get_mut(i)?,
+        };
+        if !matches!(slot, Profile::Constant(_)) {
+            return None;
+        }
+        *slot = Profile::Constant(value);
+        Some(std::sync::Arc::new(e))
     }
 }
 

@@ -13,10 +13,10 @@ mod shear;
 mod support;
 
 pub use catalog::{EnergyBuilder, EnergyCatalog, EnergySpec, EnergySpecError};
-pub use energy::{LinearElastic, QuarticStiffening, StoredEnergy};
+pub use energy::{LinearElastic, ProfileKind, QuarticStiffening, StoredEnergy};
 pub use level::{ModelChoice, ModelLevel};
 pub use loads::DeadLoads;
-pub use profile::Profile;
+pub use profile::{Extremes, Profile};
 pub use rod::{Clamp, ResidualScales, Rod};
 pub use shear::Shearable;
 pub use support::{across, Freedom, TipSupport};

@@ -213,27 +213,71 @@ impl Profile {
         }
     }
 
-    /// The smallest value on [0, length]: exact for constants and tables
-    /// (extremes sit at knots), sampled densely plus the end points for
-    /// polynomials. Used to reject non-positive stiffness.
+    /// The smallest value on [0, length] ([`Profile::extremes_on`]).
     pub fn minimum_on(&self, length: f64) -> f64 {
-        match self {
-            Profile::Constant(c) => *c,
-            Profile::Table { s, values } => {
-                let mut m = self.value(0.0).min(self.value(length));
-                for (sk, vk) in s.iter().zip(values) {
-                    if (0.0..=length).contains(sk) {
-                        m = m.min(*vk);
-                    }
-                }
-                m
-            }
-            Profile::Polynomial(_) | Profile::Spline { .. } => (0..=1000)
-                .map(|i| self.value(length * i as f64 / 1000.0))
-                .fold(f64::INFINITY, f64::min),
-        }
+        self.extremes_on(length).min
     }
 
+    /// The extremes on [0, length], exactly where the profile allows:
+    ///
+    /// - a constant: itself;
+    /// - a table (piecewise linear, constant outside): the values at the
+    ///   knots inside [0, length] and at both ends, exact;
+    /// - a polynomial: the values at the ends and at the real roots of the
+    ///   derivative in (0, length), found by the derivative cascade (the
+    ///   roots of p^(k+1) split [0, L] into intervals where p^(k) is
+    ///   monotone, so each holds at most one root, bracketed by a sign
+    ///   change and bisected to adjacent floating-point numbers);
+    /// - a natural spline: the same on each cubic piece.
+    ///
+    /// `min_lower` and `max_upper` bound the true extremes: a root's
+    /// bracket [a, b] contributes p(a), p(b) widened by (b − a) max |p'|
+    /// there, and every value by Horner's rounding bound
+    /// γ_2n Σ |c_k| |s|^k (Higham, *Accuracy and Stability*, eq. (5.3)).
+    pub fn extremes_on(&self, length: f64) -> Extremes {
+        match self {
+            Profile::Constant(c) => Extremes::at(*c, 0.0, 0.0),
+            Profile::Table { s, values } => {
+                let mut e = Extremes::at(self.value(0.0), 0.0, 0.0);
+                e.include(self.value(length), length, 0.0);
+                for (sk, vk) in s.iter().zip(values) {
+                    if (0.0..=length).contains(sk) {
+                        e.include(*vk, *sk, 0.0);
+                    }
+                }
+                // Linear between knots: the extremes are knot values, exact.
+                e
+            }
+            Profile::Polynomial(c) => polynomial_extremes(c, 0.0, length),
+            Profile::Spline {
+                s: knots,
+                values,
+                curvature,
+            } => {
+                let n = knots.len();
+                let mut e = Extremes::at(self.value(0.0), 0.0, 0.0);
+                e.include(self.value(length), length, 0.0);
+                for k in 0..n - 1 {
+                    let (a, b) = (knots[k].max(0.0), knots[k + 1].min(length));
+                    if a > b {
+                        continue;
+                    }
+                    // The piece as a cubic in t = (s − s_k)/h.
+                    let h = knots[k + 1] - knots[k];
+                    let w = h * h / 6.0;
+                    let cubic = [
+                        values[k],
+                        values[k + 1] - values[k] - w * (2.0 * curvature[k] + curvature[k + 1]),
+                        3.0 * w * curvature[k],
+                        w * (curvature[k + 1] - curvature[k]),
+                    ];
+                    let piece = polynomial_extremes(&cubic, (a - knots[k]) / h, (b - knots[k]) / h);
+                    e.merge(&piece, |t| knots[k] + t * h);
+                }
+                e
+            }
+        }
+    }
     /// Every number in the profile is finite.
     pub fn is_finite(&self) -> bool {
         match self {
@@ -251,6 +295,146 @@ impl Profile {
                 .all(|x| x.is_finite()),
         }
     }
+}
+
+/// The extremes of a profile on an interval, with certified bounds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Extremes {
+    /// The smallest value found.
+    pub min: f64,
+    /// Where.
+    pub argmin: f64,
+    /// The largest value found.
+    pub max: f64,
+    /// Where.
+    pub argmax: f64,
+    /// A lower bound of the true minimum.
+    pub min_lower: f64,
+    /// An upper bound of the true maximum.
+    pub max_upper: f64,
+}
+
+impl Extremes {
+    fn at(v: f64, s: f64, slack: f64) -> Self {
+        Extremes {
+            min: v,
+            argmin: s,
+            max: v,
+            argmax: s,
+            min_lower: v - slack,
+            max_upper: v + slack,
+        }
+    }
+
+    fn include(&mut self, v: f64, s: f64, slack: f64) {
+        if v < self.min || v.is_nan() {
+            self.min = v;
+            self.argmin = s;
+        }
+        if v > self.max || v.is_nan() {
+            self.max = v;
+            self.argmax = s;
+        }
+        self.min_lower = self.min_lower.min(v - slack);
+        self.max_upper = self.max_upper.max(v + slack);
+    }
+
+    /// Takes in another interval's extremes, its locations mapped by `to_s`.
+    fn merge(&mut self, other: &Extremes, to_s: impl Fn(f64) -> f64) {
+        self.include(other.min, to_s(other.argmin), 0.0);
+        self.include(other.max, to_s(other.argmax), 0.0);
+        self.min_lower = self.min_lower.min(other.min_lower);
+        self.max_upper = self.max_upper.max(other.max_upper);
+    }
+}
+
+/// Horner's value of Σ c_k x^k.
+fn horner(c: &[f64], x: f64) -> f64 {
+    c.iter().rev().fold(0.0, |acc, &ck| acc * x + ck)
+}
+
+/// Horner's rounding bound γ_2n Σ |c_k| |x|^k.
+fn horner_error(c: &[f64], x: f64) -> f64 {
+    let n = 2.0 * c.len() as f64 * f64::EPSILON;
+    n / (1.0 - n) * horner(&c.iter().map(|v| v.abs()).collect::<Vec<_>>(), x.abs())
+}
+
+fn derivative_of(c: &[f64]) -> Vec<f64> {
+    c.iter()
+        .enumerate()
+        .skip(1)
+        .map(|(k, ck)| k as f64 * ck)
+        .collect()
+}
+
+/// The roots of Σ c_k x^k in (a, b), each as a bracket [lo, hi] of
+/// adjacent floating-point numbers (or an exact root lo = hi), by the
+/// derivative cascade: between consecutive roots of the derivative the
+/// polynomial is monotone, so a sign change brackets its only root there.
+fn root_brackets(c: &[f64], a: f64, b: f64) -> Vec<(f64, f64)> {
+    let degree = c.iter().rposition(|&v| v != 0.0).unwrap_or(0);
+    if degree == 0 {
+        return vec![];
+    }
+    let c = &c[..=degree];
+    let mut splits = vec![a];
+    if degree >= 2 {
+        splits.extend(
+            root_brackets(&derivative_of(c), a, b)
+                .into_iter()
+                .map(|(lo, hi)| 0.5 * (lo + hi)),
+        );
+    }
+    splits.push(b);
+    let mut roots = vec![];
+    for w in splits.windows(2) {
+        let (mut lo, mut hi) = (w[0], w[1]);
+        let (flo, fhi) = (horner(c, lo), horner(c, hi));
+        if flo == 0.0 || fhi == 0.0 {
+            let x = if flo == 0.0 { lo } else { hi };
+            if x > a && x < b {
+                roots.push((x, x));
+            }
+            continue;
+        }
+        if (flo < 0.0) == (fhi < 0.0) {
+            continue;
+        }
+        let negative_at_lo = flo < 0.0;
+        loop {
+            let mid = 0.5 * (lo + hi);
+            if mid <= lo || mid >= hi {
+                break;
+            }
+            let f = horner(c, mid);
+            if f == 0.0 {
+                lo = mid;
+                hi = mid;
+                break;
+            }
+            if (f < 0.0) == negative_at_lo {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        roots.push((lo, hi));
+    }
+    roots
+}
+
+/// The extremes of Σ c_k x^k on [a, b] (locations reported in x).
+fn polynomial_extremes(c: &[f64], a: f64, b: f64) -> Extremes {
+    let mut e = Extremes::at(horner(c, a), a, horner_error(c, a));
+    e.include(horner(c, b), b, horner_error(c, b));
+    let dc = derivative_of(c);
+    for (lo, hi) in root_brackets(&dc, a, b) {
+        let slope = horner(&dc, lo).abs().max(horner(&dc, hi).abs());
+        for x in [lo, hi] {
+            e.include(horner(c, x), x, horner_error(c, x) + (hi - lo) * slope);
+        }
+    }
+    e
 }
 
 /// The table segment k holding s and the fraction t ∈ [0, 1] along it
@@ -297,6 +481,59 @@ mod tests {
             assert!((scaled.value(t) - fresh_scaled.value(t)).abs() < 1e-13);
         }
         assert!(sa.blend(&Profile::Constant(0.0), 0.5).is_none());
+    }
+
+    /// The exact minimum of a polynomial that dips below zero between
+    /// 1001 equally spaced samples: p(s) = (s − s0)² − δ on [0, 1] with
+    /// s0 = 0.43215 and δ = 1e-9. The nearest sample (0.432) is 1.5e-4
+    /// away, where p = 2.3e-8 − 1e-9 > 0; the true minimum is −δ at s0.
+    #[test]
+    fn polynomial_minimum_is_the_root_of_the_derivative() {
+        let (s0, delta) = (0.43215, 1e-9);
+        let p = Profile::Polynomial(vec![s0 * s0 - delta, -2.0 * s0, 1.0]);
+        let sampled = (0..=1000)
+            .map(|i| p.value(i as f64 / 1000.0))
+            .fold(f64::INFINITY, f64::min);
+        assert!(sampled > 0.0, "{sampled}");
+        let e = p.extremes_on(1.0);
+        assert!((e.min + delta).abs() < 1e-15, "{}", e.min);
+        assert!((e.argmin - s0).abs() < 1e-7, "{}", e.argmin);
+        assert!(e.min_lower <= -delta && e.min_lower > -delta - 1e-14);
+        // A quintic with three interior extremes: the cascade finds them
+        // all (p' = 5 (s − 0.1)(s − 0.3)(s − 0.6)(s − 0.9) integrated).
+        let roots = [0.1, 0.3, 0.6, 0.9];
+        let mut d = vec![5.0];
+        for r in roots {
+            let mut next = vec![0.0; d.len() + 1];
+            for (k, c) in d.iter().enumerate() {
+                next[k + 1] += c;
+                next[k] -= r * c;
+            }
+            d = next;
+        }
+        let mut c = vec![0.0];
+        c.extend(d.iter().enumerate().map(|(k, v)| v / (k + 1) as f64));
+        let q = Profile::Polynomial(c.clone());
+        let e = q.extremes_on(1.0);
+        let candidates = [0.0, 0.1, 0.3, 0.6, 0.9, 1.0].map(|s| q.value(s));
+        let min = candidates.iter().copied().fold(f64::INFINITY, f64::min);
+        let max = candidates.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        assert!((e.min - min).abs() < 1e-15 && (e.max - max).abs() < 1e-15);
+    }
+
+    /// A spline's piecewise cubic extremes against dense sampling.
+    #[test]
+    fn spline_extremes_match_dense_sampling() {
+        let s: Vec<f64> = (0..7).map(|i| i as f64 / 6.0).collect();
+        let v: Vec<f64> = s.iter().map(|x| (7.0 * x).sin()).collect();
+        let p = Profile::spline(s, v);
+        let e = p.extremes_on(1.0);
+        let dense = (0..=200_000).map(|i| p.value(i as f64 / 200_000.0));
+        let (lo, hi) = dense.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+            (a.min(x), b.max(x))
+        });
+        assert!(e.min <= lo && lo - e.min < 1e-9, "{} {lo}", e.min);
+        assert!(e.max >= hi && e.max - hi < 1e-9, "{} {hi}", e.max);
     }
 
     #[test]

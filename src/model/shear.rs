@@ -76,6 +76,16 @@ impl StoredEnergy for Shearable {
         self.bending.intrinsic_profiles()
     }
 
+    fn with_constant(
+        &self,
+        profile: super::energy::ProfileKind,
+        i: usize,
+        value: f64,
+    ) -> Option<Arc<dyn StoredEnergy>> {
+        let bending = self.bending.with_constant(profile, i, value)?;
+        Some(self.with_bending(bending))
+    }
+
     fn with_intrinsic_towards(
         &self,
         target: &dyn StoredEnergy,

@@ -99,15 +99,16 @@ impl Bordered {
         })
     }
 
-    /// neg(A) + pos(S) − m.
-    fn count_below(&self) -> usize {
+    /// neg(A) + pos(S) − m, or None when round-off made it negative (the
+    /// count cannot be trusted; it used to saturate to 0, "stable").
+    fn count_below(&self) -> Option<usize> {
         let pos = self
             .s
             .symmetric_eigenvalues()
             .iter()
             .filter(|&&v| v > 0.0)
             .count();
-        (self.a.negative_pivots() + pos).saturating_sub(self.s.nrows())
+        (self.a.negative_pivots() + pos).checked_sub(self.s.nrows())
     }
 
     /// y = (A⁻¹ − Z S⁻¹ Zᵀ) b.
@@ -145,7 +146,7 @@ fn try_count_below_constrained(
     let mut s = sigma;
     for _ in 0..8 {
         if let Some(b) = Bordered::new(k, g, c, s) {
-            return Some(b.count_below());
+            return b.count_below();
         }
         s += nudge;
     }

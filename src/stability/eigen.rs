@@ -30,6 +30,9 @@ pub enum EigenError {
     /// The metric (mass matrix or K0) is not positive definite.
     #[error("the reference matrix is not positive definite: {0}")]
     NotDefinite(String),
+    /// The matrices or their eigenvalues are not finite numbers.
+    #[error("not finite: {0}")]
+    NotFinite(String),
     /// Lanczos did not converge.
     #[error("Lanczos did not converge: residual {residual:.2e} after {steps} steps")]
     NoConvergence { residual: f64, steps: usize },
@@ -442,10 +445,35 @@ pub fn smallest_positive_load_factor(
         lanczos(k0.size(), 1, 60, apply, k0, |mu| mu, |a, b| a.total_cmp(&b))?
     };
     let mu = pairs.values[0];
-    if mu >= 0.0 {
+    if !mu.is_finite() || pairs.vectors[0].iter().any(|v| !v.is_finite()) {
+        // Overflow or underflow in K0 or K1 (stiffnesses or loads near the
+        // ends of the floating-point range): no number to report.
+        return Err(EigenError::NotFinite(format!(
+            "the pencil's lowest eigenvalue is {mu}: K0 or K1 left the floating-point range"
+        )));
+    }
+    if mu >= 0.0 || !destabilizing(k1, &pairs.vectors[0]) {
         return Ok(None);
     }
     Ok(Some((-1.0 / mu, pairs.vectors[0].clone())))
+}
+
+/// Whether the load lowers the energy along `v` by more than round-off:
+/// vᵀK1v < −n ε |v|ᵀ|K1||v| (the bound of the quadratic form's rounding,
+/// and of the entries' own relative rounding, over n terms). A shape
+/// whose load only stabilizes (a rod hanging in tension) has K1 ⪰ 0, yet
+/// its computed pencil shows a μ of −1e-17, i.e. a "critical load" of
+/// 1e17: that is round-off, not a load.
+fn destabilizing(k1: &SymmetricBanded, v: &[f64]) -> bool {
+    let n = k1.size();
+    let bw = k1.bandwidth();
+    let mut magnitude = 0.0;
+    for i in 0..n {
+        for j in i.saturating_sub(bw)..(i + bw + 1).min(n) {
+            magnitude += (k1.get(i, j) * v[i] * v[j]).abs();
+        }
+    }
+    k1.inner(v, v) < -(n as f64) * f64::EPSILON * magnitude
 }
 
 #[cfg(test)]

@@ -74,7 +74,7 @@ impl FixedShape {
                 |_| {},
             )
             .map_err(|e| {
-                StabilityError::FixedShape(format!("the shape's quadrature failed: {e:?}"))
+                StabilityError::FixedShape(format!("the shape's quadrature failed: {e}"))
             })?;
         let (_, tip) = *states.last().expect("the tip is a stop");
         // In-plane vectors to global: (a, b) ↦ a ex + b ez.
@@ -166,6 +166,7 @@ pub fn critical_load(
             "the loads must lie in the plane of d1(0), d3(0)".into(),
         ));
     }
+    opts.check()?;
     let fe = FiniteElements::new(rod.length, opts.elements, opts.order);
     let samples = shape.samples(rod, &fe.quadrature_points())?;
     let (c0, c1) = split_coefficients(rod, &samples);

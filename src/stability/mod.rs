@@ -35,6 +35,22 @@ pub struct StabilityOptions {
     pub eigenvalues: usize,
 }
 
+impl StabilityOptions {
+    /// The options a finite-element discretization can honour: at least
+    /// one element, order 1 to 3, at least one eigenvalue. (The elements
+    /// used to clamp other values silently: an order 5 ran at order 3.)
+    pub fn check(&self) -> Result<(), StabilityError> {
+        if self.elements < 1 || !(1..=3).contains(&self.order) || self.eigenvalues < 1 {
+            return Err(StabilityError::Options(format!(
+                "{} elements of order {} with {} eigenvalues: the elements need at least one \
+                 element, order 1, 2 or 3 and at least one eigenvalue",
+                self.elements, self.order, self.eigenvalues
+            )));
+        }
+        Ok(())
+    }
+}
+
 impl Default for StabilityOptions {
     fn default() -> Self {
         StabilityOptions {
@@ -60,6 +76,9 @@ pub enum StabilityError {
     /// A fixed-shape scene the method does not cover.
     #[error("fixed shape: {0}")]
     FixedShape(String),
+    /// Options no discretization can honour ([`StabilityOptions::check`]).
+    #[error("stability options: {0}")]
+    Options(String),
     /// A scene the second variation is not implemented for.
     #[error("not implemented: {0}")]
     Unsupported(String),
@@ -192,6 +211,7 @@ pub fn analyze(
     opts: &StabilityOptions,
 ) -> Result<Stability, StabilityError> {
     check_conservative(rod)?;
+    opts.check()?;
     let fe = FiniteElements::new(rod.length, opts.elements, opts.order)
         .with_hinged_base(rod.clamp.hinge);
     let mut points = fe.quadrature_points();

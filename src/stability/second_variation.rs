@@ -188,12 +188,19 @@ fn gauss(m: usize) -> (Vec<f64>, Vec<f64>) {
 }
 
 impl FiniteElements {
-    /// `elements` elements of order `order` (1 to 3) on [0, length].
+    /// `elements` ≥ 1 elements of order `order` (1 to 3) on [0, length].
+    /// Other values are a caller's error (the analyses check their options,
+    /// [`super::StabilityOptions::check`]); they used to be clamped
+    /// silently, so that an order 5 ran at order 3.
     pub fn new(length: f64, elements: usize, order: usize) -> Self {
+        assert!(
+            elements >= 1 && (1..=3).contains(&order),
+            "finite elements: {elements} elements of order {order}; need ≥ 1 of order 1 to 3"
+        );
         FiniteElements {
             length,
-            elements: elements.max(1),
-            order: order.clamp(1, 3),
+            elements,
+            order,
             hinged: false,
         }
     }
