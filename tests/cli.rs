@@ -260,14 +260,14 @@ fn solution_file_follows_the_contract() {
 /// error, not a result.
 #[test]
 fn impossible_tolerance_is_an_error_not_a_result() {
-    ends_with(
-        3,
+    rejects(
         "impossible-tolerance",
         CANTILEVER,
         &["--set", "solver.tolerance=1e-30"],
         &["solver.tolerance", "outside [1e-15, 1e-6]"],
     );
-    rejects(
+    ends_with(
+        3,
         "unreached-tolerance",
         CANTILEVER,
         &[
