@@ -205,6 +205,9 @@ pub fn run_plot(diagram: &Path, measure: &str, output: &Path, force: bool) -> Ex
 }
 
 fn report(d: &Diagram) {
+    for w in &d.warnings {
+        eprintln!("warning: {w}");
+    }
     for (i, b) in d.branches.iter().enumerate() {
         let (first, last) = (b.points.first(), b.points.last());
         println!(

@@ -544,6 +544,9 @@ fn write_path(
         last.morse_index,
         t.elapsed().as_secs_f64()
     );
+    for w in &diagram.warnings {
+        eprintln!("warning: {} path: {w}", kind.name);
+    }
     for s in &diagram.special_points {
         println!(
             "          {} at λ = {:.6} ({} block)",

@@ -12,7 +12,9 @@ use crate::stability::Block;
 type Located = (f64, Vec<f64>, f64, Vec<f64>);
 
 impl Run<'_> {
-    /// The special points between consecutive points `a` and `b`.
+    /// The special points between consecutive points `a` and `b`, and a
+    /// note for every event detected there that could not be located (it
+    /// is reported, never dropped).
     pub(super) fn events(
         &mut self,
         a: &Point,
@@ -20,12 +22,11 @@ impl Run<'_> {
         sign: f64,
         branch: usize,
         index: usize,
-    ) -> Vec<SpecialPoint> {
+    ) -> (Vec<SpecialPoint>, Vec<String>) {
         let n = a.unknowns.len();
         let fold = a.tangent[n] * b.tangent[n] < 0.0;
         let spectra_a = self.block_morse(a);
         let spectra_b = self.block_morse(b);
-        let mut out = vec![];
         let blocks: Vec<Block> = self.tracker.blocks().to_vec();
         let changed: Vec<(Block, usize)> = blocks
             .iter()
@@ -33,28 +34,33 @@ impl Run<'_> {
             .filter(|(_, (x, y))| x != y)
             .map(|(blk, (x, y))| (*blk, x.abs_diff(*y)))
             .collect();
-        if fold {
+        let wanted: Vec<(SpecialKind, Block, usize)> = if fold {
             let block = changed.first().map_or(blocks[0], |c| c.0);
-            if let Some(sp) = self.locate(a, b, sign, branch, index, SpecialKind::Fold, block, 1) {
-                out.push(sp);
+            vec![(SpecialKind::Fold, block, 1)]
+        } else {
+            changed
+                .into_iter()
+                .map(|(block, jump)| (SpecialKind::BranchPoint, block, jump))
+                .collect()
+        };
+        let (mut found, mut missed) = (vec![], vec![]);
+        for (kind, block, jump) in wanted {
+            match self.locate(a, b, sign, branch, index, kind, block, jump) {
+                Some(sp) => found.push(sp),
+                None => missed.push(format!(
+                    "branch {branch}: a {} ({} block, Morse index {} → {}) between points {index} \
+                     and {} at parameter {:.10} … {:.10} could not be located",
+                    kind.name(),
+                    block.name(),
+                    a.morse_index,
+                    b.morse_index,
+                    index + 1,
+                    a.parameter,
+                    b.parameter
+                )),
             }
-            return out;
         }
-        for (block, jump) in changed {
-            if let Some(sp) = self.locate(
-                a,
-                b,
-                sign,
-                branch,
-                index,
-                SpecialKind::BranchPoint,
-                block,
-                jump,
-            ) {
-                out.push(sp);
-            }
-        }
-        out
+        (found, missed)
     }
 
     fn block_morse(&mut self, p: &Point) -> Vec<usize> {

@@ -182,6 +182,9 @@ pub struct Diagram {
     /// Why the whole run ended: "in progress" while it runs (what a
     /// checkpoint records), then "completed" or "interrupted".
     pub stop_reason: String,
+    /// What the run noticed but could not settle: events detected (a Morse
+    /// index that changed) that could not be located.
+    pub warnings: Vec<String>,
 }
 
 /// The run's stop reason while it runs.
@@ -229,6 +232,7 @@ pub fn continuation(
         eigenvalue_names: run.tracker.names(),
         nodes: run.tracker.nodes(),
         stop_reason: IN_PROGRESS.into(),
+        warnings: vec![],
     };
     // (start point, direction sign, parent special point, depth)
     let mut queue = vec![(first, 1.0, None::<usize>, 0usize)];
@@ -650,10 +654,12 @@ impl<'a> Run<'a> {
                 Err(e) => return end(specials, format!("stopped: {e}"), false),
             };
             let index = diagram.branches[branch].points.len() - 1;
-            for sp in self.events(&last, &next, sign, branch, index) {
+            let (found, missed) = self.events(&last, &next, sign, branch, index);
+            for sp in found {
                 specials.push(diagram.special_points.len());
                 diagram.special_points.push(sp);
             }
+            diagram.warnings.extend(missed);
             diagram.branches[branch].points.push(next);
             self.total_points += 1;
             if iterations <= 3 {

@@ -63,6 +63,8 @@ pub struct SavedDiagram {
     pub specials: Vec<SavedSpecial>,
     /// Why the run ended.
     pub stop_reason: String,
+    /// Events detected but not located.
+    pub warnings: Vec<String>,
 }
 
 fn unfinished(reason: &str) -> bool {
@@ -142,6 +144,7 @@ pub fn resume(
         eigenvalue_names: run.tracker.names(),
         nodes: run.tracker.nodes(),
         stop_reason: super::IN_PROGRESS.into(),
+        warnings: saved.warnings.clone(),
     };
     for s in &saved.specials {
         diagram.special_points.push(rebuild_special(&run, s)?);

@@ -7,7 +7,8 @@
 //! `direction` (±1: travel along or against the stored tangents) and
 //! `next_step` (the arclength step a resumed run goes on with); `/special_points/kind` (strings), `branch`, `index`,
 //! `parameter`, `tip_position` (s×3), `block`, `symmetry_breaking`,
-//! `null_vectors` (s×nodes×3), `singularity` (s×2); the problem text as the
+//! `null_vectors` (s×nodes×3), `singularity` (s×2); `/warnings` (events
+//! detected but not located, as text); the problem text as the
 //! root attribute `problem`, the run's `stop_reason` and the parameter name
 //! as root attributes.
 
@@ -54,7 +55,9 @@ pub fn write_diagram(
             concat!("cosserat ", env!("CARGO_PKG_VERSION")),
         )?;
         write_branches(file, diagram)?;
-        write_special_points(file, diagram)
+        write_special_points(file, diagram)?;
+        let warnings: Vec<&str> = diagram.warnings.iter().map(String::as_str).collect();
+        strings(file, "warnings", &warnings)
     })
 }
 
@@ -272,6 +275,12 @@ pub fn read_saved(path: &Path) -> hdf5::Result<(String, SavedDiagram)> {
             branches,
             specials,
             stop_reason: read_string(&f, "stop_reason")?,
+            warnings: f
+                .dataset("warnings")?
+                .read_raw::<VarLenUnicode>()?
+                .iter()
+                .map(|w| w.as_str().to_string())
+                .collect(),
         },
     ))
 }
