@@ -1,0 +1,361 @@
+//! `cosserat bench work-precision`: error against wall time for every
+//! method and order on scenes with independent references.
+//!
+//! Scenes: the planar cantilever under a tip force k = F L²/B = 3 and 10
+//! (reference: the elliptic-integral closed form of Bisshopp & Drucker,
+//! Q. Appl. Math. 3, 1945, evaluated with Carlson's R_F and R_D), and a
+//! spatial scene solved with the 9-ODE model, the unloaded rod with constant
+//! intrinsic curvature κ⁰ (reference: the helix
+//! r(L) = [L I + (1 − cos ωL)/ω² K + (ωL − sin ωL)/ω³ K²] e3, K = [κ⁰]×,
+//! ω = |κ⁰|). Sweeps: the integrator tolerance for single and multiple
+//! shooting, the uniform mesh (no adaptation) for collocation of orders 4
+//! and 6. Recorded per point: tip error (max-norm), wall time (median of
+//! repeated solves in this process), Newton steps of the final solve, and
+//! the mesh size (integration steps for shooting, intervals for
+//! collocation). Output: `work_precision.csv`, `.png`, `.svg`.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::time::Instant;
+
+use clap::Subcommand;
+use nalgebra::{Matrix3, Vector3};
+use plotters::prelude::*;
+
+use cosserat::bvp::integrator::Tolerances;
+use cosserat::bvp::{solve, CollocationOptions, Discretization, Method, SolverOptions};
+use cosserat::model::{Clamp, DeadLoads, LinearElastic, ModelChoice, ModelLevel, Rod};
+
+/// The benchmarks of `cosserat bench`.
+#[derive(Debug, Clone, Subcommand)]
+pub enum BenchCommand {
+    /// Error against wall time for every method and order (CSV, PNG, SVG).
+    WorkPrecision {
+        /// Directory for work_precision.csv, .png and .svg.
+        #[arg(short, long, default_value = "work-precision")]
+        output: PathBuf,
+    },
+}
+
+/// Runs a benchmark; the exit code of the command.
+pub fn run(command: BenchCommand) -> ExitCode {
+    match command {
+        BenchCommand::WorkPrecision { output } => match work_precision(&output) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(e) => {
+                eprintln!("error: {e}");
+                ExitCode::from(3)
+            }
+        },
+    }
+}
+
+/// One point of a work-precision curve.
+#[derive(Debug, Clone)]
+pub struct Point {
+    pub scene: &'static str,
+    /// "shooting", "multiple-shooting (8)", "collocation m=2", …
+    pub method: String,
+    /// The swept parameter: integrator tolerance or intervals.
+    pub parameter: f64,
+    pub error: f64,
+    pub time: f64,
+    pub newton_steps: usize,
+    pub mesh: usize,
+}
+
+/// A scene with its reference tip position.
+pub struct Scene {
+    pub name: &'static str,
+    pub rod: Rod,
+    pub level: ModelLevel,
+    pub tip: Vector3<f64>,
+}
+
+/// The three scenes of the chart.
+pub fn scenes() -> Vec<Scene> {
+    let cantilever = |k: f64| {
+        let rod = Rod {
+            length: 1.0,
+            energy: Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
+            clamp: Clamp::paper(),
+            loads: DeadLoads {
+                tip_force: Vector3::new(k, 0.0, 0.0),
+                ..Default::default()
+            },
+            support: None,
+        };
+        let (x, z) = cantilever_tip(k);
+        (rod, Vector3::new(x, 0.0, z))
+    };
+    let (k3, tip3) = cantilever(3.0);
+    let (k10, tip10) = cantilever(10.0);
+    let kappa0 = Vector3::new(1.3, -0.7, 2.1);
+    let helix = Rod {
+        length: 3.0,
+        energy: Arc::new(LinearElastic::uniform([1.0, 2.0, 0.8], kappa0.into())),
+        clamp: Clamp::new(Vector3::zeros(), Vector3::x(), Vector3::z()),
+        loads: DeadLoads::default(),
+        support: None,
+    };
+    vec![
+        Scene {
+            name: "planar cantilever k = 3",
+            rod: k3,
+            level: ModelLevel::Planar,
+            tip: tip3,
+        },
+        Scene {
+            name: "planar cantilever k = 10",
+            rod: k10,
+            level: ModelLevel::Planar,
+            tip: tip10,
+        },
+        Scene {
+            name: "spatial helix (9-ODE)",
+            rod: helix,
+            level: ModelLevel::Kirchhoff,
+            tip: helix_tip(kappa0, 3.0),
+        },
+    ]
+}
+
+/// The sweeps: (label, options) for every method and setting.
+fn sweeps() -> Vec<(String, f64, SolverOptions)> {
+    let base = SolverOptions {
+        output_points: 2,
+        newton: cosserat::bvp::newton::NewtonOptions {
+            tolerance: 1e-12,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let mut out = Vec::new();
+    for (label, method) in [
+        ("shooting".to_string(), Method::Shooting),
+        (
+            "multiple shooting (8)".to_string(),
+            Method::MultipleShooting { segments: 8 },
+        ),
+    ] {
+        for e in 3..=12 {
+            let tol = 10f64.powi(-e);
+            out.push((
+                label.clone(),
+                tol,
+                SolverOptions {
+                    method,
+                    integration: Tolerances {
+                        rtol: tol,
+                        atol: tol,
+                        ..Default::default()
+                    },
+                    ..base.clone()
+                },
+            ));
+        }
+    }
+    for (stages, meshes) in [
+        (2usize, &[4usize, 8, 16, 32, 64, 128, 256, 512][..]),
+        (3, &[4, 8, 16, 32, 64, 128][..]),
+    ] {
+        for &n in meshes {
+            out.push((
+                format!("collocation order {}", 2 * stages),
+                n as f64,
+                SolverOptions {
+                    method: Method::Collocation { stages },
+                    collocation: CollocationOptions {
+                        stages,
+                        intervals: n,
+                        adapt: false,
+                        tolerance: f64::INFINITY,
+                        max_intervals: n,
+                    },
+                    ..base.clone()
+                },
+            ));
+        }
+    }
+    out
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(|a, b| a.total_cmp(b));
+    v[v.len() / 2]
+}
+
+/// Runs every sweep on every scene.
+pub fn measure() -> Vec<Point> {
+    let mut points = Vec::new();
+    for scene in scenes() {
+        let choice = ModelChoice::forced(&scene.rod, scene.level).expect("scene fits its level");
+        for (method, parameter, opts) in sweeps() {
+            let t = Instant::now();
+            let Ok(eq) = solve(&scene.rod, &choice, &opts) else {
+                eprintln!("{} / {method} / {parameter:e}: no solution", scene.name);
+                continue;
+            };
+            let first = t.elapsed().as_secs_f64();
+            let repeats = ((0.05 / first) as usize).clamp(2, 21) | 1;
+            let times: Vec<f64> = (0..repeats)
+                .map(|_| {
+                    let t = Instant::now();
+                    let _ = solve(&scene.rod, &choice, &opts);
+                    t.elapsed().as_secs_f64()
+                })
+                .collect();
+            let error = (eq.tip().position - scene.tip).amax();
+            let (newton_steps, mesh) = match &eq.discretization {
+                Discretization::Collocation(sol) => (sol.newton_steps, sol.intervals()),
+                Discretization::Shooting => (eq.iterations, eq.integration.accepted),
+            };
+            let p = Point {
+                scene: scene.name,
+                method,
+                parameter,
+                error,
+                time: median(times),
+                newton_steps,
+                mesh,
+            };
+            eprintln!(
+                "{:<26} {:<22} {:>8.0e} error {:>8.1e} time {:>9.1} µs",
+                p.scene,
+                p.method,
+                p.parameter,
+                p.error,
+                p.time * 1e6
+            );
+            points.push(p);
+        }
+    }
+    points
+}
+
+fn work_precision(dir: &Path) -> Result<(), Box<dyn std::error::Error>> {
+    std::fs::create_dir_all(dir)?;
+    let points = measure();
+    let mut csv = String::from("scene,method,parameter,tip_error,time_s,newton_steps,mesh_size\n");
+    for p in &points {
+        csv += &format!(
+            "{},{},{:e},{:e},{:e},{},{}\n",
+            p.scene, p.method, p.parameter, p.error, p.time, p.newton_steps, p.mesh
+        );
+    }
+    std::fs::write(dir.join("work_precision.csv"), csv)?;
+    crate::plot::register_font();
+    let png = dir.join("work_precision.png");
+    let svg = dir.join("work_precision.svg");
+    chart(
+        BitMapBackend::new(&png, (1800, 620)).into_drawing_area(),
+        &points,
+    )?;
+    chart(
+        SVGBackend::new(&svg, (1800, 620)).into_drawing_area(),
+        &points,
+    )?;
+    println!(
+        "written   {}, {}, {}",
+        dir.join("work_precision.csv").display(),
+        png.display(),
+        svg.display()
+    );
+    Ok(())
+}
+
+const FLOOR: f64 = 1e-16;
+
+fn chart<DB: DrawingBackend>(
+    root: DrawingArea<DB, plotters::coord::Shift>,
+    points: &[Point],
+) -> Result<(), Box<dyn std::error::Error>>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE)?;
+    let names: Vec<&str> = scenes().iter().map(|s| s.name).collect();
+    let panels = root.split_evenly((1, names.len()));
+    let mut methods: Vec<String> = points.iter().map(|p| p.method.clone()).collect();
+    methods.dedup();
+    let mut order: Vec<String> = Vec::new();
+    for m in methods {
+        if !order.contains(&m) {
+            order.push(m);
+        }
+    }
+    let colors = [
+        RGBColor(0, 114, 178),
+        RGBColor(230, 159, 0),
+        RGBColor(0, 158, 115),
+        RGBColor(204, 121, 167),
+    ];
+    for (panel, name) in panels.iter().zip(&names) {
+        let mine: Vec<&Point> = points.iter().filter(|p| p.scene == *name).collect();
+        let (tmin, tmax) = mine.iter().fold((f64::MAX, f64::MIN), |(a, b), p| {
+            (a.min(p.time), b.max(p.time))
+        });
+        let mut c = ChartBuilder::on(panel)
+            .caption(*name, ("sans-serif", 26))
+            .margin(12)
+            .x_label_area_size(50)
+            .y_label_area_size(80)
+            .build_cartesian_2d(
+                (tmin / 1.5..tmax * 1.5).log_scale(),
+                (FLOOR..1.0).log_scale(),
+            )?;
+        c.configure_mesh()
+            .x_desc("wall time per equilibrium (s)")
+            .y_desc("tip error")
+            .x_label_formatter(&|v| format!("{v:.0e}"))
+            .y_label_formatter(&|v| format!("{v:.0e}"))
+            .label_style(("sans-serif", 16))
+            .axis_desc_style(("sans-serif", 18))
+            .draw()?;
+        for (i, m) in order.iter().enumerate() {
+            let color = colors[i % colors.len()];
+            let series: Vec<(f64, f64)> = mine
+                .iter()
+                .filter(|p| &p.method == m)
+                .map(|p| (p.time, p.error.clamp(FLOOR, 1.0)))
+                .collect();
+            c.draw_series(LineSeries::new(series.clone(), color.stroke_width(2)))?
+                .label(m.as_str())
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(3))
+                });
+            c.draw_series(
+                series
+                    .iter()
+                    .map(|&(x, y)| Circle::new((x, y), 4, color.filled())),
+            )?;
+        }
+        c.configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .label_font(("sans-serif", 16))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()?;
+    }
+    root.present()?;
+    Ok(())
+}
+
+/// Tip (x, z) of the unit cantilever under a tip force perpendicular to the
+/// clamp (Bisshopp & Drucker 1945), from the validation references.
+pub fn cantilever_tip(k: f64) -> (f64, f64) {
+    let (x, z, _) = cosserat::references::cantilever_tip(k);
+    (x, z)
+}
+
+/// Tip of the unloaded rod with constant intrinsic curvature κ⁰ clamped
+/// with d1 = e1, d3 = e3 at the origin.
+pub fn helix_tip(kappa0: Vector3<f64>, s: f64) -> Vector3<f64> {
+    let w = kappa0.norm();
+    let k = kappa0.cross_matrix();
+    let m = Matrix3::identity() * s
+        + k * ((1.0 - (w * s).cos()) / (w * w))
+        + k * k * ((w * s - (w * s).sin()) / (w * w * w));
+    m * Vector3::z()
+}

@@ -1,0 +1,251 @@
+//! `cosserat continue` and `cosserat plot`: bifurcation diagrams from a
+//! problem file's `[continuation]` table, saved as they grow.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::{Duration, Instant};
+
+use crate::plot::{draw, read_diagram};
+use cosserat::continuation::{continuation, Diagram, Progress};
+use cosserat::io::target::replace_atomically;
+use cosserat::io::{read_saved, write_diagram, Problem, MEASURES};
+use indicatif::{ProgressBar, ProgressStyle};
+
+use crate::exit::{fail, BAD_INPUT, INTERRUPTED, NO_RESULT, OUTPUT};
+use crate::signals;
+
+/// How often a growing diagram is saved.
+const CHECKPOINT: Duration = Duration::from_secs(2);
+
+/// A string key of the `[continuation]` table of the effective problem
+/// text (the parsed value, never a scan of the raw text).
+fn section_key(text: &str, key: &str) -> Option<String> {
+    let table: toml::Table = toml::from_str(text).ok()?;
+    Some(table.get("continuation")?.get(key)?.as_str()?.to_string())
+}
+
+/// Runs the continuation of a problem file.
+pub fn run_continue(
+    path: PathBuf,
+    output: PathBuf,
+    plot: Option<PathBuf>,
+    set: &[String],
+    force: bool,
+    resume: bool,
+) -> ExitCode {
+    let problem = match Problem::from_path(&path, set) {
+        Ok(p) => p,
+        Err(e) => return fail(BAD_INPUT, format!("{}: {e}", path.display())),
+    };
+    let Some((family, opts)) = &problem.continuation else {
+        return fail(
+            BAD_INPUT,
+            format!(
+                "{}: continuation: the problem has no [continuation] table",
+                path.display()
+            ),
+        );
+    };
+    let mut outputs: Vec<&Path> = vec![&output];
+    outputs.extend(plot.as_deref());
+    let _claims = match crate::solve_command::claim_outputs(&outputs, &[&path], force || resume) {
+        Ok(c) => c,
+        Err(code) => return code,
+    };
+    let saved = if resume && output.exists() {
+        match read_saved(&output) {
+            Ok((text, _)) if text != problem.text => {
+                return fail(
+                    BAD_INPUT,
+                    format!(
+                        "{}: made from a different problem (or other --set values); cannot resume",
+                        output.display()
+                    ),
+                )
+            }
+            Ok((_, saved)) if saved.stop_reason == "completed" => {
+                println!("nothing to resume: {} is complete", output.display());
+                return ExitCode::SUCCESS;
+            }
+            Ok((_, saved)) => Some(saved),
+            Err(e) => {
+                return fail(
+                    BAD_INPUT,
+                    format!("{}: cannot resume: {e}", output.display()),
+                )
+            }
+        }
+    } else {
+        if resume && !force {
+            println!(
+                "nothing to resume: {} does not exist; starting",
+                output.display()
+            );
+        }
+        None
+    };
+    let parameter_name = section_key(&problem.text, "parameter")
+        .unwrap_or_else(|| format!("{:?}", family.parameter()));
+    println!("problem   {}", path.display());
+    println!(
+        "model     {} ({})",
+        problem.model.level.name(),
+        problem.model.reason
+    );
+    println!(
+        "continue  {parameter_name} from {} in [{}, {}]",
+        opts.start, opts.bounds.0, opts.bounds.1
+    );
+    let bar = spinner();
+    let start = Instant::now();
+    let mut last_save = Instant::now();
+    let mut checkpoint_error = None;
+    let mut monitor = |progress: Progress, diagram: &Diagram| {
+        bar.set_message(format!(
+            "{} points, branch {}, parameter {:.6}",
+            progress.points, progress.branch, progress.parameter
+        ));
+        bar.tick();
+        if last_save.elapsed() >= CHECKPOINT {
+            if let Err(e) = write_diagram(&output, &problem.text, &parameter_name, diagram, true) {
+                checkpoint_error.get_or_insert_with(|| e.to_string());
+            }
+            last_save = Instant::now();
+        }
+        !signals::requested()
+    };
+    if let Some(saved) = &saved {
+        let points: usize = saved.branches.iter().map(|b| b.parameter.len()).sum();
+        println!(
+            "resume    {} branches, {points} points from {}",
+            saved.branches.len(),
+            output.display()
+        );
+    }
+    signals::set_mode(signals::Mode::NextPoint);
+    let outcome = match &saved {
+        Some(saved) => cosserat::continuation::resume(family, opts, saved, &mut monitor),
+        None => continuation(family, opts, &mut monitor),
+    };
+    bar.finish_and_clear();
+    signals::set_mode(signals::Mode::Immediate);
+    if let Some(e) = checkpoint_error {
+        eprintln!("warning: a checkpoint was not written: {e}");
+    }
+    let diagram = match outcome {
+        Ok(d) => d,
+        Err(e) => return fail(NO_RESULT, e),
+    };
+    let elapsed = start.elapsed();
+    report(&diagram);
+    println!("time      {:.1} ms", elapsed.as_secs_f64() * 1e3);
+    if let Err(e) = write_diagram(&output, &problem.text, &parameter_name, &diagram, true) {
+        return fail(OUTPUT, e);
+    }
+    println!("written   {}", output.display());
+    if diagram.stop_reason == "interrupted" {
+        eprintln!(
+            "interrupted: every point computed so far is in {}; go on with --resume",
+            output.display()
+        );
+        return ExitCode::from(INTERRUPTED);
+    }
+    if let Some(png) = plot {
+        let measure = section_key(&problem.text, "measure").unwrap_or_else(|| "tip_x".into());
+        if let Err(e) = plot_file(&output, &measure, &png) {
+            return fail(OUTPUT, e);
+        }
+    }
+    ExitCode::SUCCESS
+}
+
+/// A spinner on a terminal; plain lines every few seconds elsewhere are
+/// left to the checkpoints.
+fn spinner() -> ProgressBar {
+    if !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let b = ProgressBar::new_spinner();
+    b.set_style(
+        ProgressStyle::with_template("{spinner} {msg} [{elapsed}]").expect("a valid template"),
+    );
+    b
+}
+
+/// `cosserat plot`: the chart of a diagram file, claimed like every output
+/// (never the input, never a non-regular file, `--force` to replace).
+pub fn run_plot(diagram: &Path, measure: &str, output: &Path, force: bool) -> ExitCode {
+    if !MEASURES.contains(&measure) {
+        return fail(
+            BAD_INPUT,
+            format!("--measure: unknown measure `{measure}`; expected one of {MEASURES:?}"),
+        );
+    }
+    let _claims = match crate::solve_command::claim_outputs(&[output], &[diagram], force) {
+        Ok(c) => c,
+        Err(code) => return code,
+    };
+    let data = match read_diagram(diagram) {
+        Ok(d) => d,
+        Err(e) => {
+            return fail(
+                BAD_INPUT,
+                format!("{}: not a diagram file: {e}", diagram.display()),
+            )
+        }
+    };
+    match replace_atomically(output, |tmp| draw(&data, measure, tmp)) {
+        Ok(()) => {
+            println!("plotted   {}", output.display());
+            ExitCode::SUCCESS
+        }
+        Err(e) => fail(OUTPUT, e),
+    }
+}
+
+fn report(d: &Diagram) {
+    for w in &d.warnings {
+        eprintln!("warning: {w}");
+    }
+    for (i, b) in d.branches.iter().enumerate() {
+        let (first, last) = (b.points.first(), b.points.last());
+        println!(
+            "branch {i}  {} points, parameter {:.6} → {:.6}{}; {}",
+            b.points.len(),
+            first.map_or(f64::NAN, |p| p.parameter),
+            last.map_or(f64::NAN, |p| p.parameter),
+            b.parent
+                .map_or(String::new(), |p| format!(", from special point {p}")),
+            b.stop_reason
+        );
+    }
+    for (i, s) in d.special_points.iter().enumerate() {
+        println!(
+            "special {i}  {} on branch {} at parameter {:.12}, {} block{}, Morse index {}",
+            s.kind.name(),
+            s.branch,
+            s.point.parameter,
+            s.block.name(),
+            if s.symmetry_breaking {
+                ", symmetry-breaking"
+            } else {
+                ""
+            },
+            s.point.morse_index
+        );
+    }
+}
+
+/// Draws a diagram file (the output already claimed by the caller).
+pub fn plot_file(input: &Path, measure: &str, out: &Path) -> Result<(), String> {
+    if !MEASURES.contains(&measure) {
+        return Err(format!(
+            "unknown measure `{measure}`; expected one of {MEASURES:?}"
+        ));
+    }
+    let data = read_diagram(input).map_err(|e| format!("{}: {e}", input.display()))?;
+    replace_atomically(out, |tmp| draw(&data, measure, tmp))?;
+    println!("plotted   {}", out.display());
+    Ok(())
+}

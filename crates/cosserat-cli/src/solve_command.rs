@@ -1,0 +1,259 @@
+//! `cosserat solve` and `cosserat stability`: one equilibrium (or a fixed
+//! loaded shape) and its stability verdict.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use cosserat::bvp::{solve, Equilibrium};
+use cosserat::io::target::{claim, Claim};
+use cosserat::io::{write_equilibrium, write_stability, Problem, StabilityResult};
+use cosserat::stability::{analyze, critical_load, CriticalLoad, Stability};
+
+use crate::exit::{fail, BAD_INPUT, NO_RESULT, OUTPUT};
+use crate::signals;
+
+/// Reads the problem and claims the output before any work.
+fn prepare(
+    path: &std::path::Path,
+    output: &Option<PathBuf>,
+    set: &[String],
+    force: bool,
+) -> Result<(Problem, Option<Claim>), ExitCode> {
+    let problem = Problem::from_path(path, set)
+        .map_err(|e| fail(BAD_INPUT, format!("{}: {e}", path.display())))?;
+    let claimed = output
+        .as_ref()
+        .map(|out| claim(out, &[path], force).map(hold))
+        .transpose()
+        .map_err(|e| fail(BAD_INPUT, e))?;
+    println!("problem   {}", path.display());
+    Ok((problem, claimed))
+}
+
+/// A failed solve: options the solver cannot run are bad input (2), a
+/// solver that found no equilibrium is no result (3); each with what to
+/// try next.
+fn solve_failed(e: &cosserat::bvp::SolveError) -> ExitCode {
+    use cosserat::bvp::SolveError as E;
+    let (code, hint) = match e {
+        E::Options(_) | E::Model(_) => (BAD_INPUT, "correct the problem file"),
+        E::NoConvergence { .. } | E::RampStalled { .. } => (
+            NO_RESULT,
+            "try solver.strategy = \"ramp\", --method multiple-shooting or collocation, \
+             or a guess solver.initial_curvature",
+        ),
+        E::Sampling(_) => (
+            NO_RESULT,
+            "raise solver.max_steps or loosen solver.integration_tolerance",
+        ),
+        E::Collocation { .. } => (
+            NO_RESULT,
+            "raise solver.max_intervals or loosen solver.collocation_tolerance",
+        ),
+    };
+    fail(code, format!("{e}\n  what to do: {hint}"))
+}
+
+/// Registers a claim's scratch files for removal on an immediate stop.
+pub fn hold(claim: Claim) -> Claim {
+    for f in claim.scratch_files() {
+        signals::litter(f);
+    }
+    claim
+}
+
+/// Claims every output of a command (none named twice, none an input).
+pub fn claim_outputs(
+    outputs: &[&std::path::Path],
+    inputs: &[&std::path::Path],
+    replace: bool,
+) -> Result<Vec<Claim>, ExitCode> {
+    cosserat::io::target::claim_all(outputs, inputs, replace)
+        .map(|claims| claims.into_iter().map(hold).collect())
+        .map_err(|e| fail(BAD_INPUT, e))
+}
+
+pub fn run_stability(
+    path: PathBuf,
+    output: Option<PathBuf>,
+    set: &[String],
+    force: bool,
+) -> ExitCode {
+    let (problem, _claim) = match prepare(&path, &output, set, force) {
+        Ok(p) => p,
+        Err(code) => return code,
+    };
+    let opts = &problem.stability;
+    println!(
+        "mesh      {} elements of order {}",
+        opts.elements, opts.order
+    );
+    let result = match &problem.shape {
+        Some(shape) => match critical_load(&problem.rod, shape, opts) {
+            Ok(c) => {
+                report_critical(&c);
+                StabilityResult::FixedShape(c)
+            }
+            Err(e) => return fail(NO_RESULT, e),
+        },
+        None => {
+            println!(
+                "model     {} ({})",
+                problem.model.level.name(),
+                problem.model.reason
+            );
+            let eq = match solve(&problem.rod, &problem.model, &problem.options) {
+                Ok(eq) => eq,
+                Err(e) => return solve_failed(&e),
+            };
+            match analyze(&problem.rod, &eq, &problem.options, opts) {
+                Ok(st) => {
+                    report_spectrum(&st);
+                    StabilityResult::Equilibrium(Box::new(eq), st)
+                }
+                Err(e) => return fail(NO_RESULT, e),
+            }
+        }
+    };
+    if let Some(out) = output {
+        if let Err(e) = write_stability(&out, &problem.text, &result, true) {
+            return fail(OUTPUT, e);
+        }
+        println!("written   {}", out.display());
+    }
+    ExitCode::SUCCESS
+}
+
+fn report_spectrum(st: &Stability) {
+    for b in &st.blocks {
+        let values: Vec<String> = b.eigenvalues.iter().map(|v| format!("{v:+.6e}")).collect();
+        println!(
+            "{:<13} lowest eigenvalues [{}], Morse index {}",
+            b.block.name(),
+            values.join(", "),
+            b.morse_index
+        );
+    }
+    println!("morse     {}", st.morse_index);
+    println!(
+        "verdict   {}",
+        if st.stable { "stable" } else { "unstable" }
+    );
+}
+
+fn report_critical(c: &CriticalLoad) {
+    for (block, factor, _) in &c.blocks {
+        match factor {
+            Some(f) => println!("{:<13} critical load factor {f:.10e}", block.name()),
+            None => println!("{:<13} no positive critical load", block.name()),
+        }
+    }
+    match (c.load_factor, c.gamma) {
+        (Some(f), Some(g)) => {
+            println!("critical  load factor {f:.10e}");
+            println!("          γ_crit = F L²/B2 = {g:.10e}");
+        }
+        _ => println!("critical  none: the shape is stable under any positive load"),
+    }
+}
+
+pub fn run_solve(path: PathBuf, output: Option<PathBuf>, set: &[String], force: bool) -> ExitCode {
+    let (problem, _claim) = match prepare(&path, &output, set, force) {
+        Ok(p) => p,
+        Err(code) => return code,
+    };
+    if problem.shape.is_some() {
+        return fail(
+            BAD_INPUT,
+            "a fixed-shape scene ([shape]) has no fixed intrinsic curvature to solve for; \
+             use `cosserat stability`",
+        );
+    }
+    println!(
+        "model     {} ({})",
+        problem.model.level.name(),
+        problem.model.reason
+    );
+    println!("energy    {}", problem.rod.energy.name());
+    let eq = match solve(&problem.rod, &problem.model, &problem.options) {
+        Ok(eq) => eq,
+        Err(e) => return solve_failed(&e),
+    };
+    report(&eq);
+    verdict(&problem, &eq);
+    let tolerance = problem.options.newton.tolerance;
+    if eq.residual.is_nan() || eq.residual > tolerance {
+        // Belt and braces: solve() returns only converged results, but a
+        // result whose residual exceeds the tolerance is never written.
+        return fail(
+            NO_RESULT,
+            format!(
+                "residual {:.3e} exceeds the tolerance {tolerance:.1e}",
+                eq.residual
+            ),
+        );
+    }
+    if let Some(out) = output {
+        if let Err(e) = write_equilibrium(&out, &eq, &problem.text, true) {
+            return fail(OUTPUT, e);
+        }
+        println!("written   {}", out.display());
+    }
+    ExitCode::SUCCESS
+}
+
+/// The stability verdict of a solved equilibrium (conservative loads), on a
+/// mesh refined from the problem's `[stability]` settings until the Morse
+/// index and the signs of the lowest eigenvalues are certain
+/// ([`cosserat::stability::decide`]): a converged but unstable equilibrium
+/// is one the loading does not reach — say so rather than let it pass as
+/// the answer — and an uncertain one is "undecided".
+fn verdict(problem: &Problem, eq: &Equilibrium) {
+    use cosserat::stability::{decide, Verdict};
+    match decide(&problem.rod, eq, &problem.options, &problem.stability) {
+        Ok(d) => match d.verdict {
+            Verdict::Stable => println!(
+                "stability stable (Morse index 0; {} elements, eigenvalue error ≤ {:.1e})",
+                d.elements, d.eigenvalue_error
+            ),
+            Verdict::Unstable { morse_index } => {
+                println!(
+                    "stability UNSTABLE (Morse index {morse_index}; {} elements, eigenvalue error ≤ {:.1e})",
+                    d.elements, d.eigenvalue_error
+                );
+                eprintln!(
+                    "warning: this equilibrium is unstable (Morse index {morse_index}): loading the rod \
+                     would not settle here; follow the load with `cosserat continue` or try \
+                     --method multiple-shooting / collocation"
+                );
+            }
+            Verdict::Undecided { reason } => {
+                println!("stability undecided: {reason}");
+                eprintln!(
+                    "warning: the stability of this equilibrium is undecided ({reason}); \
+                     raise stability.elements or run `cosserat stability` on it"
+                );
+            }
+        },
+        Err(e) => println!("stability not decided: {e}"),
+    }
+}
+
+fn report(eq: &Equilibrium) {
+    let tip = eq.tip();
+    let v = |x: nalgebra::Vector3<f64>| format!("[{:+.12e}, {:+.12e}, {:+.12e}]", x[0], x[1], x[2]);
+    println!("method    {}", eq.method.name());
+    if eq.load_steps > 0 {
+        println!("load ramp {} steps", eq.load_steps);
+    }
+    println!("newton    {} iterations", eq.iterations);
+    println!("residual  {:.3e} (scaled max-norm)", eq.residual);
+    println!("tip       position {}", v(tip.position));
+    println!("          tangent  {}", v(tip.directors[2]));
+    println!("drift     {:.1e} (max |d_i·d_j − δ_ij|)", eq.director_drift);
+    println!(
+        "work      {} steps, {} rejected, {} evaluations",
+        eq.integration.accepted, eq.integration.rejected, eq.integration.evaluations
+    );
+    println!("time      {:.3} ms", eq.wall_time * 1e3);
+}

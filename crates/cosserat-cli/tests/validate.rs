@@ -1,0 +1,98 @@
+//! The quick validation set through the library API: every case passes,
+//! and the runner's closed forms agree with the independent ones in
+//! tests/support.
+#[path = "../../cosserat/tests/support/mod.rs"]
+mod support;
+
+use std::path::Path;
+
+use cosserat_cli::validate::{self, reference, RunOptions, Status};
+
+fn cases_dir() -> &'static Path {
+    Path::new(concat!(
+        concat!(env!("CARGO_MANIFEST_DIR"), "/../.."),
+        "/validation"
+    ))
+}
+
+#[test]
+fn quick_set_passes() {
+    let cases = validate::load_cases(cases_dir()).expect("case files");
+    let opts = RunOptions {
+        quick: true,
+        ..Default::default()
+    };
+    let rows = validate::run(&cases, &opts).expect("valid cases");
+    assert!(rows.len() >= 20, "only {} rows", rows.len());
+    let failed: Vec<String> = rows
+        .iter()
+        .filter(|r| r.status == Status::Fail)
+        .map(|r| {
+            format!(
+                "{} {} {} {}: reference {}, computed {:?} ({})",
+                r.case, r.point, r.method, r.quantity, r.reference, r.computed, r.message
+            )
+        })
+        .collect();
+    assert!(failed.is_empty(), "failing rows:\n{}", failed.join("\n"));
+    // Every BVP method ran.
+    for m in [
+        "shooting",
+        "multiple-shooting",
+        "collocation-2",
+        "collocation-3",
+        "fe",
+    ] {
+        assert!(rows.iter().any(|r| r.method == m), "no row for {m}");
+    }
+    let report = validate::markdown(&cases, &rows, &opts);
+    assert!(report.contains("| case | point | method |"));
+}
+
+#[test]
+fn runner_closed_forms_match_the_test_support() {
+    for k in [0.5, 1.0, 2.0, 3.0, 5.0, 10.0] {
+        let a = support::references::cantilever_tip(k);
+        let (x, z, angle) = reference::cantilever_tip(k);
+        assert!((a.x - x).abs() < 1e-13 && (a.z - z).abs() < 1e-13);
+        assert!((a.angle - angle).abs() < 1e-13);
+    }
+    let j = support::bessel::first_zero(-0.25, 1.0, 3.0);
+    assert!((reference::bessel_first_zero(-0.25, 1.0, 3.0) - j).abs() < 1e-14);
+    for tau in [0.0, 2.0, 5.0] {
+        let a = support::columns::greenhill_clamped(tau, 1.0, 1.0);
+        assert!((reference::greenhill_clamped(tau) - a).abs() < 1e-10 * a);
+    }
+}
+
+#[test]
+fn bad_input_is_an_input_error() {
+    let dir = std::env::temp_dir().join(format!("cosserat-validate-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let case = dir.join("bad.toml");
+    std::fs::write(
+        &case,
+        r#"
+title = "bad"
+problem = "nowhere.toml"
+analysis = "solve"
+methods = ["shooting"]
+[[point]]
+label = "p"
+[[check]]
+quantity = "tip_x"
+reference = { kind = "closed-form", formula = "no_such_formula", source = "none" }
+tolerance = { relative = 1e-8 }
+"#,
+    )
+    .unwrap();
+    let err = validate::load_case(&case).unwrap_err();
+    assert!(err.to_string().contains("no_such_formula"), "{err}");
+    let cases = validate::load_cases(cases_dir()).unwrap();
+    let opts = RunOptions {
+        method: Some("euler".into()),
+        ..Default::default()
+    };
+    assert!(validate::run(&cases, &opts).is_err());
+    std::fs::remove_dir_all(&dir).ok();
+}
