@@ -52,8 +52,12 @@ pub struct DiagramData {
     pub specials: Vec<SpecialData>,
 }
 
-fn rows3(v: Vec<f64>) -> Vec<[f64; 3]> {
-    v.chunks(3).map(|c| [c[0], c[1], c[2]]).collect()
+/// Rows of three; a length that is not a multiple of three is an error.
+fn rows3(v: Vec<f64>) -> hdf5::Result<Vec<[f64; 3]>> {
+    if v.len() % 3 != 0 {
+        return Err("a dataset of 3-vectors has a length that is not a multiple of 3".into());
+    }
+    Ok(v.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
 }
 
 /// Reads a diagram written by `cosserat continue`.
@@ -76,7 +80,7 @@ pub fn read_diagram(path: &Path) -> hdf5::Result<DiagramData> {
         let shapes = shapes_ds.read_raw::<f64>()?;
         branches.push(BranchData {
             parameter: read("parameter")?,
-            tip: rows3(read("tip_position")?),
+            tip: rows3(read("tip_position")?)?,
             tip_angle: read("tip_angle")?,
             norm: read("norm")?,
             stable: g
@@ -88,7 +92,7 @@ pub fn read_diagram(path: &Path) -> hdf5::Result<DiagramData> {
             shapes: shapes
                 .chunks((per * 3).max(1))
                 .map(|c| rows3(c.to_vec()))
-                .collect(),
+                .collect::<hdf5::Result<_>>()?,
         });
     }
     let sp = f.group("special_points")?;
@@ -98,8 +102,12 @@ pub fn read_diagram(path: &Path) -> hdf5::Result<DiagramData> {
     let branch = sp.dataset("branch")?.read_raw::<u64>()?;
     let index = sp.dataset("index")?.read_raw::<u64>()?;
     let parameter = sp.dataset("parameter")?.read_raw::<f64>()?;
-    let tip = rows3(sp.dataset("tip_position")?.read_raw::<f64>()?);
-    let specials = (0..kinds.len())
+    let tip = rows3(sp.dataset("tip_position")?.read_raw::<f64>()?)?;
+    let n = kinds.len();
+    if [branch.len(), index.len(), parameter.len(), tip.len()] != [n; 4] {
+        return Err("the special-point datasets have different lengths".into());
+    }
+    let specials = (0..n)
         .map(|i| SpecialData {
             kind: kinds[i].as_str().to_string(),
             branch: branch[i] as usize,
@@ -108,11 +116,56 @@ pub fn read_diagram(path: &Path) -> hdf5::Result<DiagramData> {
             tip: tip[i],
         })
         .collect();
-    Ok(DiagramData {
+    let data = DiagramData {
         parameter_name,
         branches,
         specials,
-    })
+    };
+    data.check().map_err(|e| hdf5::Error::from(e.as_str()))?;
+    Ok(data)
+}
+
+impl DiagramData {
+    /// A diagram file is input like any other: every branch's columns of
+    /// one length, special points on existing points, numbers finite.
+    fn check(&self) -> Result<(), String> {
+        for (i, b) in self.branches.iter().enumerate() {
+            let m = b.parameter.len();
+            let lengths = [
+                b.tip.len(),
+                b.tip_angle.len(),
+                b.norm.len(),
+                b.stable.len(),
+                b.shapes.len(),
+            ];
+            if lengths.iter().any(|&l| l != m) {
+                return Err(format!("branch {i}: datasets of different lengths"));
+            }
+            let finite = b
+                .parameter
+                .iter()
+                .chain(b.tip.iter().flatten())
+                .all(|v| v.is_finite());
+            if !finite {
+                return Err(format!("branch {i}: a parameter or tip that is not finite"));
+            }
+        }
+        for (i, s) in self.specials.iter().enumerate() {
+            let exists = self
+                .branches
+                .get(s.branch)
+                .is_some_and(|b| s.index < b.parameter.len());
+            if !exists {
+                return Err(format!(
+                    "special point {i}: its branch point does not exist"
+                ));
+            }
+            if !(s.parameter.is_finite() && s.tip.iter().all(|v| v.is_finite())) {
+                return Err(format!("special point {i}: not finite"));
+            }
+        }
+        Ok(())
+    }
 }
 
 /// The value of `measure` at a tip.

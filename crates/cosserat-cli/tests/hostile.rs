@@ -1001,3 +1001,82 @@ fn hostile_inputs_get_named_errors_and_leave_nothing_behind() {
         failures.join("\n")
     );
 }
+
+/// Replaces dataset `name` of the HDF5 file at `path` by `data` (shape
+/// `[data.len()]`), keeping its type family.
+fn replace_dataset<T: hdf5::H5Type>(path: &Path, name: &str, data: &[T]) {
+    let f = hdf5::File::open_rw(path).unwrap();
+    f.unlink(name).unwrap();
+    f.new_dataset::<T>()
+        .shape([data.len()])
+        .create(name)
+        .unwrap()
+        .write_raw(data)
+        .unwrap();
+}
+
+/// Files whose datasets contradict each other (a special point on a branch
+/// that does not exist, 3-vectors of length 4, a point index outside the
+/// grid, a column with too few rows) are named errors of `plot`, `merge`
+/// and `--resume`, never a panic or a silently truncated result.
+#[test]
+fn inconsistent_result_files_are_named_errors() {
+    let dir = std::env::temp_dir().join(format!("cosserat-hostile-files-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let fx = fixtures(&dir);
+    let cases: Vec<(&str, Box<dyn Fn(&Path)>, Vec<&str>)> = vec![
+        (
+            "d.h5",
+            Box::new(|p: &Path| replace_dataset(p, "special_points/branch", &[99u64, 99])),
+            vec!["plot", "d.h5", "-o", "f.png"],
+        ),
+        (
+            "d.h5",
+            Box::new(|p: &Path| {
+                replace_dataset(p, "branches/0/tip_position", &[1.0f64, 2.0, 3.0, 4.0])
+            }),
+            vec!["plot", "d.h5", "-o", "f.png"],
+        ),
+        (
+            "d.h5",
+            Box::new(|p: &Path| replace_dataset(p, "branches/0/parameter", &[f64::NAN])),
+            vec!["plot", "d.h5", "-o", "f.png"],
+        ),
+        (
+            "s.h5",
+            Box::new(|p: &Path| replace_dataset(p, "points/index", &[1_000_000u64, 1])),
+            vec!["merge", "s.h5", "-o", "m.h5"],
+        ),
+        (
+            "s.h5",
+            Box::new(|p: &Path| replace_dataset(p, "points/index", &[0u64, 0])),
+            vec!["merge", "s.h5", "-o", "m.h5"],
+        ),
+    ];
+    for (k, (file, damage, args)) in cases.iter().enumerate() {
+        let case_dir = dir.join(format!("case{k}"));
+        std::fs::create_dir_all(&case_dir).unwrap();
+        let bytes = if *file == "d.h5" {
+            &fx.diagram
+        } else {
+            &fx.shards[0]
+        };
+        std::fs::write(case_dir.join(file), bytes).unwrap();
+        damage(&case_dir.join(file));
+        let o = Command::new(BIN)
+            .args(args)
+            .current_dir(&case_dir)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "case {k} {args:?}: {err}");
+        assert!(
+            err.contains("error:") && err.contains(file),
+            "case {k}: {err}"
+        );
+        let left: Vec<_> = std::fs::read_dir(&case_dir).unwrap().collect();
+        assert_eq!(left.len(), 1, "case {k}: nothing written");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

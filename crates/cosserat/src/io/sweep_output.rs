@@ -231,6 +231,14 @@ pub fn read_sweep(path: &Path) -> hdf5::Result<(SweepHeader, Vec<Record>)> {
     };
     let g = f.group("points")?;
     let index = g.dataset("index")?.read_raw::<u64>()?;
+    let points: usize = header.axes.iter().map(Vec::len).product();
+    let mut seen = std::collections::BTreeSet::new();
+    if index
+        .iter()
+        .any(|&i| i as usize >= points || !seen.insert(i))
+    {
+        return Err("a point index is outside the grid or repeated".into());
+    }
     let mut records: Vec<Record> = index.iter().map(|i| Record::new(*i as usize)).collect();
     let names = |attr: &str| -> hdf5::Result<Vec<String>> {
         Ok(read_string(&g, attr)?
@@ -243,12 +251,20 @@ pub fn read_sweep(path: &Path) -> hdf5::Result<(SweepHeader, Vec<Record>)> {
         let d = g.dataset(&name)?;
         let width = d.shape().get(1).copied().unwrap_or(1);
         let data = d.read_raw::<f64>()?;
+        if data.len() != width.max(1) * records.len() {
+            return Err(format!("column {name}: not one row per point")
+                .as_str()
+                .into());
+        }
         for (r, row) in records.iter_mut().zip(data.chunks(width.max(1))) {
             r.set(&name, row.to_vec());
         }
     }
     for name in names("labels")? {
         let data = g.dataset(&name)?.read_raw::<VarLenUnicode>()?;
+        if data.len() != records.len() {
+            return Err(format!("label {name}: not one per point").as_str().into());
+        }
         for (r, v) in records.iter_mut().zip(data) {
             if !v.as_str().is_empty() {
                 r.label(&name, v.as_str());
