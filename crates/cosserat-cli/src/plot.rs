@@ -54,7 +54,7 @@ pub struct DiagramData {
 
 /// Rows of three; a length that is not a multiple of three is an error.
 fn rows3(v: Vec<f64>) -> hdf5::Result<Vec<[f64; 3]>> {
-    if v.len() % 3 != 0 {
+    if !v.len().is_multiple_of(3) {
         return Err("a dataset of 3-vectors has a length that is not a multiple of 3".into());
     }
     Ok(v.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
