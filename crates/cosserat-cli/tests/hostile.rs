@@ -1025,7 +1025,8 @@ fn inconsistent_result_files_are_named_errors() {
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     let fx = fixtures(&dir);
-    let cases: Vec<(&str, Box<dyn Fn(&Path)>, Vec<&str>)> = vec![
+    type Damage = Box<dyn Fn(&Path)>;
+    let cases: Vec<(&str, Damage, Vec<&str>)> = vec![
         (
             "d.h5",
             Box::new(|p: &Path| replace_dataset(p, "special_points/branch", &[99u64, 99])),
