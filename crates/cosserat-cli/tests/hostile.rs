@@ -1003,8 +1003,16 @@ fn hostile_inputs_get_named_errors_and_leave_nothing_behind() {
 }
 
 /// Replaces dataset `name` of the HDF5 file at `path` by `data` (shape
-/// `[data.len()]`), keeping its type family.
+/// `[data.len()]`), keeping its type family. The seal is taken off first:
+/// the file stands for one written by another program, which is read
+/// unverified, so the dataset checks themselves are what is tested.
 fn replace_dataset<T: hdf5::H5Type>(path: &Path, name: &str, data: &[T]) {
+    let bytes = std::fs::read(path).unwrap();
+    assert_eq!(
+        &bytes[bytes.len() - 24..bytes.len() - 8],
+        b"cosserat-seal-v1"
+    );
+    std::fs::write(path, &bytes[..bytes.len() - 24]).unwrap();
     let f = hdf5::File::open_rw(path).unwrap();
     f.unlink(name).unwrap();
     f.new_dataset::<T>()
@@ -1078,6 +1086,41 @@ fn inconsistent_result_files_are_named_errors() {
         );
         let left: Vec<_> = std::fs::read_dir(&case_dir).unwrap().collect();
         assert_eq!(left.len(), 1, "case {k}: nothing written");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A sealed result file with one byte changed is refused by its checksum
+/// before the HDF5 library reads it (damaged files crashed it: SIGSEGV in
+/// `merge`, an impossible allocation in `plot`).
+#[test]
+fn damaged_sealed_files_are_refused_before_hdf5_reads_them() {
+    let dir = std::env::temp_dir().join(format!("cosserat-hostile-seal-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let fx = fixtures(&dir);
+    for (k, (bytes, args)) in [
+        (&fx.diagram, vec!["plot", "x.h5", "-o", "f.png"]),
+        (&fx.shards[0], vec!["merge", "x.h5", "-o", "m.h5"]),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        for at in [100, bytes.len() / 2, bytes.len() - 30] {
+            let case_dir = dir.join(format!("case{k}-{at}"));
+            std::fs::create_dir_all(&case_dir).unwrap();
+            let mut b = bytes.clone();
+            b[at] ^= 0x5a;
+            std::fs::write(case_dir.join("x.h5"), &b).unwrap();
+            let o = Command::new(BIN)
+                .args(&args)
+                .current_dir(&case_dir)
+                .output()
+                .unwrap();
+            let err = String::from_utf8_lossy(&o.stderr);
+            assert_eq!(o.status.code(), Some(2), "{args:?} at {at}: {err}");
+            assert!(err.contains("damaged"), "{err}");
+        }
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }

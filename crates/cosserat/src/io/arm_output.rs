@@ -241,7 +241,7 @@ pub struct SavedSearch {
 /// Reads what [`write_arm_study`] kept of a search.
 pub fn read_search(path: &Path) -> hdf5::Result<SavedSearch> {
     use hdf5::types::VarLenUnicode;
-    let file = hdf5::File::open(path)?;
+    let file = super::seal::open(path)?;
     let text = |name: &str| -> hdf5::Result<String> {
         Ok(file
             .attr(name)?

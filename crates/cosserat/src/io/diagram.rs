@@ -201,7 +201,7 @@ fn read_string(loc: &hdf5::Location, name: &str) -> hdf5::Result<String> {
 /// The problem text and what a diagram file keeps of its run (for
 /// `cosserat continue --resume`).
 pub fn read_saved(path: &Path) -> hdf5::Result<(String, SavedDiagram)> {
-    let f = hdf5::File::open(path)?;
+    let f = super::seal::open(path)?;
     let problem = read_string(&f, "problem")?;
     let root = f.group("branches")?;
     let mut branches = vec![];

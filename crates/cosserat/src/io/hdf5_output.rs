@@ -108,6 +108,12 @@ pub(crate) fn write_atomically(
             path: path.display().to_string(),
             message: e.to_string(),
         });
+    let result = result.and_then(|()| {
+        super::seal::seal(&tmp).map_err(|e| OutputError::Hdf5 {
+            path: path.display().to_string(),
+            message: format!("sealing: {e}"),
+        })
+    });
     if let Err(e) = result {
         let _ = std::fs::remove_file(&tmp);
         return Err(e);

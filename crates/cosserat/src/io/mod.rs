@@ -12,6 +12,7 @@ mod diagram;
 mod hdf5_output;
 pub mod memory;
 mod problem;
+pub mod seal;
 mod strict;
 mod support_section;
 #[cfg(feature = "hdf5")]

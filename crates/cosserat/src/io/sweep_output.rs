@@ -209,7 +209,7 @@ fn read_string(loc: &hdf5::Location, name: &str) -> hdf5::Result<String> {
 
 /// Reads a sweep file: its header and records.
 pub fn read_sweep(path: &Path) -> hdf5::Result<(SweepHeader, Vec<Record>)> {
-    let f = hdf5::File::open(path)?;
+    let f = super::seal::open(path)?;
     let grid = f.group("grid")?;
     let keys: Vec<String> = grid
         .dataset("keys")?
