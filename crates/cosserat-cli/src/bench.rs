@@ -6,7 +6,7 @@
 //! Q. Appl. Math. 3, 1945, evaluated with Carlson's R_F and R_D), and a
 //! spatial scene solved with the 9-ODE model, the unloaded rod with constant
 //! intrinsic curvature κ⁰ (reference: the helix
-//! r(L) = [L I + (1 − cos ωL)/ω² K + (ωL − sin ωL)/ω³ K²] e3, K = [κ⁰]×,
+//! `r(L) = [L I + (1 − cos ωL)/ω² K + (ωL − sin ωL)/ω³ K²] e3`, `K = [κ⁰]×`,
 //! ω = |κ⁰|). Sweeps: the integrator tolerance for single and multiple
 //! shooting, the uniform mesh (no adaptation) for collocation of orders 4
 //! and 6. Recorded per point: tip error (max-norm), wall time (median of

@@ -6,7 +6,7 @@
 //! — a quantity, a reference with its kind and source, a tolerance. One
 //! generic runner runs every point of every case with every method that
 //! applies and compares. References are closed forms evaluated in
-//! [`reference`] from their formulas, or published values typed with their
+//! [`mod@reference`] from their formulas, or published values typed with their
 //! citation; never the solver's own output. The file format is described
 //! in validation/README.md.
 

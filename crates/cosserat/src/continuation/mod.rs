@@ -175,7 +175,7 @@ pub struct Diagram {
     pub branches: Vec<Branch>,
     /// Folds and branch points.
     pub special_points: Vec<SpecialPoint>,
-    /// Column names of the eigenvalues: "in_plane[0]", ...
+    /// Column names of the eigenvalues: `"in_plane[0]"`, ...
     pub eigenvalue_names: Vec<String>,
     /// Finite-element nodes of the null modes.
     pub nodes: Vec<f64>,
