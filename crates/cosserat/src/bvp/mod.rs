@@ -383,8 +383,9 @@ impl Solved {
     }
 }
 
-/// The energy Hessian must be positive definite for κ' to exist (DESIGN.md:
-/// "positive definite Hessian"); checked on the undeformed rod at 65
+/// The energy Hessian H = ∂²W/∂κ² must be positive definite for
+/// κ' = H⁻¹(M' − ∂s∇W) to exist (see [`crate::model::StoredEnergy`]);
+/// checked on the undeformed rod at 65
 /// points, and along the solution by the integrator (a singular H there
 /// makes the state non-finite, reported as a blow-up).
 fn check_energy(rod: &Rod) -> Result<(), SolveError> {
