@@ -171,6 +171,7 @@ pub enum Command {
     },
     /// Benchmarks: `cosserat bench work-precision [-o DIR]`.
     Bench {
+        /// Which benchmark.
         #[command(subcommand)]
         which: crate::bench::BenchCommand,
     },

@@ -4,6 +4,8 @@
 //! computations are the `cosserat` library's; this crate reads arguments,
 //! claims outputs, reports progress and draws.
 
+#![warn(missing_docs)]
+
 pub mod arm_chart;
 pub mod bench;
 pub mod cli;

@@ -6,6 +6,8 @@
 //! file: build a [`model::Rod`] (with any [`model::StoredEnergy`]), pick a
 //! [`model::ModelChoice`], and call [`bvp::solve`].
 
+#![warn(missing_docs)]
+
 pub mod bvp;
 pub mod continuation;
 pub mod equations;

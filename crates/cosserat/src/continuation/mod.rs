@@ -195,7 +195,12 @@ pub const IN_PROGRESS: &str = "in progress";
 pub enum ContinuationError {
     /// No equilibrium at the start value.
     #[error("no equilibrium at the start value p = {p}: {message}")]
-    Start { p: f64, message: String },
+    Start {
+        /// The start value of the parameter.
+        p: f64,
+        /// Why no equilibrium was found there.
+        message: String,
+    },
     /// A point could not be evaluated.
     #[error(transparent)]
     Point(#[from] PointError),

@@ -17,11 +17,18 @@ pub enum Profile {
     Polynomial(Vec<f64>),
     /// Piecewise-linear interpolation of (s_k, v_k), s strictly increasing;
     /// held constant outside the table.
-    Table { s: Vec<f64>, values: Vec<f64> },
+    Table {
+        /// Knots s_k, strictly increasing.
+        s: Vec<f64>,
+        /// Values v_k at the knots.
+        values: Vec<f64>,
+    },
     /// The natural cubic spline through (s_k, v_k) (C², so that equations
     /// using the derivative stay continuous); build with [`Profile::spline`].
     Spline {
+        /// Knots s_k, strictly increasing.
         s: Vec<f64>,
+        /// Values v_k at the knots.
         values: Vec<f64>,
         /// Second derivatives at the knots.
         curvature: Vec<f64>,
