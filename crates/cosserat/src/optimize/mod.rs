@@ -117,7 +117,7 @@ pub struct ArmOptimum {
 }
 
 /// How far a search has come: what `cosserat optimize --resume` keeps of an
-/// interrupted run to go on where it stopped (issue 9).
+/// interrupted run to go on where it stopped.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct SearchProgress {
     /// Samples evaluated: the global stage goes on from the next one.
