@@ -19,7 +19,11 @@ pub struct Cli {
 }
 
 /// The subcommands.
+// The doc comments below are also clap's `--help` text, printed verbatim,
+// so they keep TOML's table syntax (`[sweep]`) and values (`[5,0,0]`)
+// unescaped, which rustdoc would otherwise take for intra-doc links.
 #[derive(Subcommand, Debug)]
+#[allow(rustdoc::broken_intra_doc_links)]
 pub enum Command {
     /// Solve for the equilibrium of a rod problem.
     Solve {
@@ -167,6 +171,7 @@ pub enum Command {
     },
     /// Benchmarks: `cosserat bench work-precision [-o DIR]`.
     Bench {
+        /// Which benchmark.
         #[command(subcommand)]
         which: crate::bench::BenchCommand,
     },

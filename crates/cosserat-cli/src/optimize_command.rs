@@ -409,7 +409,7 @@ fn report_optimum(opt: &ArmOptimum, time: f64) {
     report_mesh(opt);
 }
 
-/// The discretization error of R* (issue 14, item 11), and a warning on
+/// The discretization error of R* (`optimize::Resolution`), and a warning on
 /// stderr when the search's mesh did not resolve its optimum.
 fn report_mesh(opt: &ArmOptimum) {
     let Some(r) = &opt.resolution else {

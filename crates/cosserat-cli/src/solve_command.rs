@@ -73,6 +73,9 @@ pub fn claim_outputs(
         .map_err(|e| fail(BAD_INPUT, e))
 }
 
+/// `cosserat stability`: the stability of the problem's equilibrium
+/// (spectra, Morse index) or the critical load of its `[shape]`, printed
+/// and written to `output`; returns the exit code.
 pub fn run_stability(
     path: PathBuf,
     output: Option<PathBuf>,
@@ -157,6 +160,8 @@ fn report_critical(c: &CriticalLoad) {
     }
 }
 
+/// `cosserat solve`: the problem's equilibrium, printed and written to
+/// `output`; returns the exit code.
 pub fn run_solve(path: PathBuf, output: Option<PathBuf>, set: &[String], force: bool) -> ExitCode {
     let (problem, _claim) = match prepare(&path, &output, set, force) {
         Ok(p) => p,

@@ -22,13 +22,21 @@ const CHECKPOINT: Duration = Duration::from_secs(1);
 
 /// The options of `cosserat sweep`.
 pub struct SweepArgs {
+    /// The problem file with a `[sweep]` table.
     pub path: PathBuf,
+    /// The HDF5 results, also the checkpoint.
     pub output: PathBuf,
+    /// `I/N`: compute shard I of N (every N-th line of the grid).
     pub shard: Option<String>,
+    /// Worker threads (default: all cores).
     pub threads: Option<u16>,
+    /// Go on with the run saved in `output`.
     pub resume: bool,
+    /// Also draw the sweep to this .png or .svg.
     pub plot: Option<PathBuf>,
+    /// `KEY=VALUE` overrides of the problem file.
     pub set: Vec<String>,
+    /// Overwrite an existing output.
     pub force: bool,
 }
 

@@ -6,7 +6,7 @@
 //! — a quantity, a reference with its kind and source, a tolerance. One
 //! generic runner runs every point of every case with every method that
 //! applies and compares. References are closed forms evaluated in
-//! [`reference`] from their formulas, or published values typed with their
+//! [`mod@reference`] from their formulas, or published values typed with their
 //! citation; never the solver's own output. The file format is described
 //! in validation/README.md.
 
@@ -102,9 +102,13 @@ fn one() -> f64 {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Scan {
+    /// The name of the scanned parameter.
     pub parameter: String,
+    /// Its first value.
     pub lo: f64,
+    /// Its last value.
     pub hi: f64,
+    /// Steps from `lo` to `hi`.
     pub steps: usize,
 }
 
@@ -155,8 +159,10 @@ pub struct Reference {
     /// (a table value, `value`), or `converged-study` (`value`, made
     /// independently of this code).
     pub kind: String,
+    /// The closed form (for `closed-form`), in the parameters of the point.
     #[serde(default)]
     pub formula: Option<String>,
+    /// The value (for `published` and `converged-study`).
     #[serde(default)]
     pub value: Option<f64>,
     /// The citation.
@@ -167,8 +173,11 @@ pub struct Reference {
 #[derive(Debug, Clone, Copy, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Tolerance {
+    /// Relative tolerance: pass when |computed − reference| ≤
+    /// relative·|reference|.
     #[serde(default)]
     pub relative: Option<f64>,
+    /// Absolute tolerance, used when no relative one is given.
     #[serde(default)]
     pub absolute: Option<f64>,
 }
@@ -176,21 +185,29 @@ pub struct Tolerance {
 /// A case with its name (the file stem) and location.
 #[derive(Debug, Clone)]
 pub struct Case {
+    /// The file stem.
     pub name: String,
+    /// The case file.
     pub path: PathBuf,
+    /// Its parsed contents.
     pub file: CaseFile,
 }
 
 /// The verdict of one row.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Status {
+    /// Within the tolerance.
     Pass,
+    /// Outside the tolerance, or no value computed.
     Fail,
+    /// Informational: reported, never failed.
     Info,
+    /// Skipped: the comparison does not apply at this point.
     Skip,
 }
 
 impl Status {
+    /// The word printed in the report ("pass", "FAIL", "info", "skip").
     pub fn name(self) -> &'static str {
         match self {
             Status::Pass => "pass",
@@ -204,20 +221,32 @@ impl Status {
 /// One line of the report.
 #[derive(Debug, Clone)]
 pub struct Row {
+    /// The case name.
     pub case: String,
+    /// The point's label.
     pub point: String,
+    /// The method the analysis ran with.
     pub method: String,
+    /// The quantity compared.
     pub quantity: String,
+    /// The reference value.
     pub reference: f64,
+    /// Where the reference comes from (`closed-form`, `published`,
+    /// `converged-study`).
     pub kind: String,
+    /// The computed value (None when the analysis failed).
     pub computed: Option<f64>,
     /// Relative error (absolute when the reference is zero).
     pub relative_error: Option<f64>,
+    /// |computed − reference|.
     pub absolute_error: Option<f64>,
+    /// The tolerance of the check (None for informational checks).
     pub tolerance: Option<Tolerance>,
     /// Wall time of the analysis the row comes from, s.
     pub time: f64,
+    /// The verdict.
     pub status: Status,
+    /// The error or remark of the analysis.
     pub message: String,
 }
 

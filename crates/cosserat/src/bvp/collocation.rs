@@ -217,15 +217,23 @@ pub enum CollocationError {
     /// Newton stopped without reaching its tolerance.
     #[error("collocation Newton did not converge on {intervals} intervals: {reason}; scaled residual history {}", format_history(.history))]
     NoConvergence {
+        /// Mesh intervals of the failed Newton solve.
         intervals: usize,
+        /// Why Newton stopped (the `NewtonFailure` in words).
         reason: String,
+        /// Scaled residual (max-norm) at every Newton iterate, the last at the
+        /// failure.
         history: Vec<f64>,
     },
     /// The condensed Jacobian could not be factored.
     #[error("singular collocation Jacobian at Newton iteration {iteration} on {intervals} intervals (a fold or bifurcation, or a degenerate guess); scaled residual history {}", format_history(.history))]
     SingularJacobian {
+        /// The Newton iteration whose condensed Jacobian was singular.
         iteration: usize,
+        /// Mesh intervals at the failure.
         intervals: usize,
+        /// Scaled residual (max-norm) at every Newton iterate, the last at the
+        /// failure.
         history: Vec<f64>,
     },
     /// Without adaptation, the fixed mesh is too coarse for the tolerance
@@ -234,17 +242,26 @@ pub enum CollocationError {
     /// `error_estimate`).
     #[error("error estimate {estimate:.3e} on the fixed mesh of {intervals} intervals exceeds the tolerance {tolerance:.1e} (mesh adaptation is off)")]
     CoarseMesh {
+        /// The mesh error tolerance asked for.
         tolerance: f64,
+        /// The largest error estimate on the fixed mesh.
         estimate: f64,
+        /// Intervals of the fixed mesh.
         intervals: usize,
     },
     /// Adaptation would need more than `max_intervals` intervals.
     #[error("mesh error tolerance {tolerance:.1e} not reached within {max_intervals} intervals: error estimate {estimate:.3e} on {intervals} intervals, {flagged} of them above their share")]
     ToleranceNotReached {
+        /// The mesh error tolerance asked for.
         tolerance: f64,
+        /// The largest error estimate on the last mesh.
         estimate: f64,
+        /// Intervals of the last mesh.
         intervals: usize,
+        /// The budget of intervals adaptation may use.
         max_intervals: usize,
+        /// Intervals whose estimate exceeds their share of the tolerance (those
+        /// to be split).
         flagged: usize,
     },
 }

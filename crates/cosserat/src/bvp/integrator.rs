@@ -58,13 +58,24 @@ impl std::ops::AddAssign for IntegrationStats {
 pub enum IntegrationError {
     /// The solution left the finite numbers (blow-up).
     #[error("the solution is not finite at s = {s:.6e} (blow-up)")]
-    NotFinite { s: f64 },
+    NotFinite {
+        /// Arc length where the state stopped being finite.
+        s: f64,
+    },
     /// The step size fell below round-off of s.
     #[error("step size underflow at s = {s:.6e} (stiff or singular equations)")]
-    StepSizeUnderflow { s: f64 },
+    StepSizeUnderflow {
+        /// Arc length where the step fell below round-off.
+        s: f64,
+    },
     /// The step budget ran out.
     #[error("more than {steps} steps before s = {s:.6e}")]
-    TooManySteps { s: f64, steps: usize },
+    TooManySteps {
+        /// Arc length reached when the budget ran out.
+        s: f64,
+        /// The step budget.
+        steps: usize,
+    },
 }
 
 // Butcher tableau of DOP853 (Hairer's dop853.f; stages 1..12, c12 = 1).

@@ -35,13 +35,20 @@ pub enum Method {
     /// Single shooting on the curvature at the clamp.
     Shooting,
     /// Multiple shooting on `segments` equal segments.
-    MultipleShooting { segments: usize },
+    MultipleShooting {
+        /// Number of equal shooting segments, each with its own unknown initial
+        /// state.
+        segments: usize,
+    },
     /// Gauss–Legendre collocation with `stages` points per interval (order
     /// 2·stages at the nodes) on a mesh adapted until the error estimate
     /// meets [`SolverOptions::collocation`]'s tolerance; the other settings
     /// (starting mesh, tolerance, budget) come from there, its `stages`
     /// field is overridden by this one.
-    Collocation { stages: usize },
+    Collocation {
+        /// Gauss points per interval (order 2·stages at the nodes).
+        stages: usize,
+    },
 }
 
 impl Method {
@@ -208,8 +215,11 @@ pub enum SolveError {
     /// Newton did not converge.
     #[error("{method} did not converge: {failure}; scaled residual history {history}")]
     NoConvergence {
+        /// The method that failed ([`Method::name`]).
         method: &'static str,
+        /// Why Newton stopped.
         failure: NewtonFailure,
+        /// The scaled residual at every iterate, formatted for the message.
         history: String,
     },
     /// The load ramp stalled.
@@ -217,9 +227,14 @@ pub enum SolveError {
         "{method} with a load ramp stalled at load factor {reached:.4} (step {step:.2e}): {last}"
     )]
     RampStalled {
+        /// The method that failed.
         method: &'static str,
+        /// The last load factor in [0, 1] at which an equilibrium was found.
         reached: f64,
+        /// The load-factor step when the ramp gave up (below 1e-4, or
+        /// after 400 steps).
         step: f64,
+        /// The last failure, in words.
         last: String,
     },
     /// The converged solution could not be re-integrated for output.
@@ -229,7 +244,9 @@ pub enum SolveError {
     /// Jacobian, or the mesh tolerance not reached within the budget).
     #[error("collocation (order {order}) failed: {failure}")]
     Collocation {
+        /// Order of the collocation (2·stages).
         order: usize,
+        /// Why collocation failed.
         failure: CollocationError,
     },
     /// Options that cannot work.
@@ -383,8 +400,9 @@ impl Solved {
     }
 }
 
-/// The energy Hessian must be positive definite for κ' to exist (DESIGN.md:
-/// "positive definite Hessian"); checked on the undeformed rod at 65
+/// The energy Hessian H = ∂²W/∂κ² must be positive definite for
+/// κ' = H⁻¹(M' − ∂s∇W) to exist (see [`crate::model::StoredEnergy`]);
+/// checked on the undeformed rod at 65
 /// points, and along the solution by the integrator (a singular H there
 /// makes the state non-finite, reported as a blow-up).
 fn check_energy(rod: &Rod) -> Result<(), SolveError> {

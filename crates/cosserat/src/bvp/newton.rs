@@ -130,19 +130,30 @@ pub enum NewtonFailure {
     #[error(
         "singular Jacobian at iteration {iteration} (a fold or bifurcation, or a degenerate guess)"
     )]
-    SingularJacobian { iteration: usize, history: Vec<f64> },
+    SingularJacobian {
+        /// The iteration whose Jacobian could not be factored.
+        iteration: usize,
+        /// Scaled residual (max-norm) at every iterate so far.
+        history: Vec<f64>,
+    },
     /// No damped step reduced the residual.
     #[error("no damped step (down to λ = {min_damping}) passed the natural monotonicity test at iteration {iteration}; last trial: {last_trial}")]
     LineSearch {
+        /// The iteration whose damped steps all failed.
         iteration: usize,
+        /// The smallest damping factor λ tried.
         min_damping: f64,
+        /// The last trial step's outcome, in words.
         last_trial: String,
+        /// Scaled residual (max-norm) at every iterate so far.
         history: Vec<f64>,
     },
     /// The iteration budget ran out.
     #[error("{iterations} iterations without reaching the tolerance")]
     IterationLimit {
+        /// The iteration budget.
         iterations: usize,
+        /// Scaled residual (max-norm) at every iterate.
         history: Vec<f64>,
     },
 }

@@ -50,7 +50,7 @@ impl<'a> ShootingSystem<'a> {
     /// The collocation equations of Gauss–Legendre collocation with
     /// `stages` points (1 to 3; order 2·stages at the nodes) on `intervals`
     /// equal intervals, posed as multiple shooting whose segments are
-    /// single Gauss steps ([`super::gauss_step`]); None for a stage count
+    /// single Gauss steps (the private `bvp/gauss_step.rs`); None for a stage count
     /// without a tableau. Samples between the nodes are integrated from
     /// the node states by DOP853.
     pub fn collocation(

@@ -131,7 +131,12 @@ pub enum FamilyError {
         "continuation.parameter = {parameter} is not physical at {value} (a length or stiffness \
          must be positive): narrow continuation.bounds"
     )]
-    NotPhysical { parameter: Parameter, value: f64 },
+    NotPhysical {
+        /// The continuation parameter.
+        parameter: Parameter,
+        /// Its value outside the physical range.
+        value: f64,
+    },
 }
 
 impl Family {

@@ -175,7 +175,7 @@ pub struct Diagram {
     pub branches: Vec<Branch>,
     /// Folds and branch points.
     pub special_points: Vec<SpecialPoint>,
-    /// Column names of the eigenvalues: "in_plane[0]", ...
+    /// Column names of the eigenvalues: `"in_plane[0]"`, ...
     pub eigenvalue_names: Vec<String>,
     /// Finite-element nodes of the null modes.
     pub nodes: Vec<f64>,
@@ -195,7 +195,12 @@ pub const IN_PROGRESS: &str = "in progress";
 pub enum ContinuationError {
     /// No equilibrium at the start value.
     #[error("no equilibrium at the start value p = {p}: {message}")]
-    Start { p: f64, message: String },
+    Start {
+        /// The start value of the parameter.
+        p: f64,
+        /// Why no equilibrium was found there.
+        message: String,
+    },
     /// A point could not be evaluated.
     #[error(transparent)]
     Point(#[from] PointError),

@@ -1,7 +1,11 @@
 //! The planar model: bending about d2 = d2(0) in the plane of d1(0), d3(0).
 //!
 //! With the turning angle φ measured from d3(0) towards d1(0) and the
-//! coordinates x along d1(0), z along d3(0) (DESIGN.md "Planar reduction"):
+//! coordinates x along d1(0), z along d3(0), the Kirchhoff equations
+//! ([`super::KirchhoffEquations`]) with κ = κ2 e2 and d2 constant have
+//! d3 = (sin φ, 0, cos φ), d1 = (cos φ, 0, −sin φ), and the d2 component of
+//! the moment balance m' + d3 × n = 0 leaves (Antman, *Nonlinear Problems
+//! of Elasticity*, 2nd ed., Ch. 4, the planar elastica):
 //!
 //!   x' = sin φ,  z' = cos φ,  φ' = κ2,  M2' = −N1,
 //!

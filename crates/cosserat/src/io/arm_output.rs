@@ -184,7 +184,7 @@ fn write_design(g: &hdf5::Group, o: &ArmOptimum) -> hdf5::Result<()> {
     array(g, "intrinsic_curvature", &[k.len()], k)
 }
 
-/// The discretization check of a design (issue 14, item 11).
+/// The discretization check of a design (`optimize::Resolution`).
 fn write_resolution(g: &hdf5::Group, r: &Resolution) -> hdf5::Result<()> {
     let s = &r.study;
     let elements: Vec<f64> = s.elements.iter().map(|n| *n as f64).collect();

@@ -30,11 +30,18 @@ pub enum OutputError {
     Unusable(String),
     /// The HDF5 library reported an error.
     #[error("writing {path}: {message}")]
-    Hdf5 { path: String, message: String },
+    Hdf5 {
+        /// The file being written.
+        path: String,
+        /// The HDF5 library's error.
+        message: String,
+    },
     /// The rename into place failed.
     #[error("moving the result to {path}: {source}")]
     Rename {
+        /// The final path of the result.
         path: String,
+        /// The error of the rename.
         source: std::io::Error,
     },
 }

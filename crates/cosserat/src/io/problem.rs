@@ -36,7 +36,9 @@ pub enum ProblemError {
     /// The file could not be read.
     #[error("cannot read {path}: {source}")]
     Read {
+        /// The problem file.
         path: String,
+        /// The error of the read.
         source: std::io::Error,
     },
     /// TOML syntax, an unknown or missing key, or a wrong type.
@@ -44,10 +46,20 @@ pub enum ProblemError {
     Parse(String),
     /// A `--set` override that cannot be applied.
     #[error("--set {assignment}: {message}")]
-    Override { assignment: String, message: String },
+    Override {
+        /// The `KEY=VALUE` as given.
+        assignment: String,
+        /// Why it cannot be applied.
+        message: String,
+    },
     /// A value that is well-formed but not physical or not consistent.
     #[error("{field}: {message}")]
-    Invalid { field: String, message: String },
+    Invalid {
+        /// The dotted key of the offending value (e.g. `rod.length`).
+        field: String,
+        /// What is wrong with it.
+        message: String,
+    },
 }
 
 pub(crate) fn invalid(field: impl Into<String>, message: impl Into<String>) -> ProblemError {
@@ -186,9 +198,17 @@ pub enum ProfileSpec {
     /// A constant.
     Constant(f64),
     /// Polynomial coefficients in increasing powers of s.
-    Polynomial { polynomial: Vec<f64> },
+    Polynomial {
+        /// c_0, c_1, … of Σ c_k s^k.
+        polynomial: Vec<f64>,
+    },
     /// A piecewise-linear table.
-    Table { s: Vec<f64>, values: Vec<f64> },
+    Table {
+        /// Arc lengths s_k, strictly increasing.
+        s: Vec<f64>,
+        /// Values v_k at the s_k.
+        values: Vec<f64>,
+    },
 }
 
 impl Default for ProfileSpec {

@@ -24,22 +24,45 @@ pub enum ClaimError {
     /// The path exists and is not a regular file (a directory, a device
     /// such as /dev/null, a FIFO, a symbolic link).
     #[error("{path} is {what}, not a regular file; cosserat only ever replaces regular files")]
-    NotRegular { path: String, what: &'static str },
+    NotRegular {
+        /// The output path.
+        path: String,
+        /// What it is instead ("a directory", "a symbolic link", …).
+        what: &'static str,
+    },
     /// The path is an input of the same command.
     #[error("{path} is also an input of this command ({input}); write the result elsewhere")]
-    IsInput { path: String, input: String },
+    IsInput {
+        /// The output path.
+        path: String,
+        /// The input it names (as given).
+        input: String,
+    },
     /// Two outputs of one command are the same file.
     #[error("{path} is named twice as an output of this command")]
-    Twice { path: String },
+    Twice {
+        /// The output path named twice.
+        path: String,
+    },
     /// The directory does not exist or cannot be written.
     #[error("cannot write {path}: {reason}")]
-    Directory { path: String, reason: String },
+    Directory {
+        /// The output path.
+        path: String,
+        /// Why its directory cannot be written.
+        reason: String,
+    },
     /// Another process holds the lock.
     #[error(
         "another cosserat process is writing {path} (its lock {lock} is held); \
          wait for it or write elsewhere"
     )]
-    Locked { path: String, lock: String },
+    Locked {
+        /// The output path.
+        path: String,
+        /// The lock file held by the other process.
+        lock: String,
+    },
 }
 
 /// What a command reads, to be sure it never overwrites it.

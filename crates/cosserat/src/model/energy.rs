@@ -1,8 +1,13 @@
 //! Stored energy densities W(s, κ) of a hyperelastic Kirchhoff rod.
 //!
 //! The body moment is M = ∂W/∂κ and the bending/torsion stiffness is the
-//! Hessian H = ∂²W/∂κ² (DESIGN.md, "The mathematics"). The equilibrium
-//! equations need κ', which follows from M' = H κ' + ∂s∇W; their variational
+//! Hessian H = ∂²W/∂κ², κ the director components of the Darboux vector
+//! k = κ_i d_i (d_i' = k × d_i). The equilibrium equations are the balance
+//! laws n' + f = 0 and m' + r' × n = 0, in director components
+//! M' = M × κ + N × ν (ν = e3 for the Kirchhoff rod; Antman, *Nonlinear
+//! Problems of Elasticity*, 2nd ed., Ch. 8). They need κ', which follows
+//! from M' = H κ' + ∂s∇W as κ' = H⁻¹(M' − ∂s∇W), so H must be positive
+//! definite; their variational
 //! equations (the shooting Jacobian) need the derivative of H κ' in κ, a
 //! third derivative of W. Every energy supplies all of these, so that any
 //! hyperelastic material plugs into the same equations.

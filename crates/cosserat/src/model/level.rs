@@ -1,7 +1,8 @@
-//! The model level a scene needs: "model no more than a scene needs"
-//! (DESIGN.md). A planar scene runs the 4-ODE planar model, a spatial one the
-//! 9-ODE Kirchhoff model, a shearable, extensible one the Cosserat model;
-//! the choice comes with its reason.
+//! The model level a scene needs: the least model that represents it
+//! exactly, since every higher level only adds equations whose solution is
+//! known (zero out-of-plane bending, ν = e3). A planar scene runs the 4-ODE
+//! planar model, a spatial one the 9-ODE Kirchhoff model, a shearable,
+//! extensible one the Cosserat model; the choice comes with its reason.
 
 use nalgebra::Vector3;
 

@@ -26,7 +26,9 @@ impl Default for DeadLoads {
 
 impl DeadLoads {
     /// The internal force n(s) = P + ∫_s^L f, exerted on the part [0, s) by
-    /// the part (s, L] (DESIGN.md: known in advance for dead loads).
+    /// the part (s, L]: the force balance n' + f = 0 integrated from
+    /// n(L) = P. Dead loads keep their direction as the rod deforms, so
+    /// n(s) is known before the shape is.
     pub fn internal_force(&self, s: f64, length: f64) -> Vector3<f64> {
         self.tip_force + self.distributed_force * (length - s)
     }

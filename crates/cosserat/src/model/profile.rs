@@ -3,8 +3,10 @@
 //!
 //! A profile is a constant, a polynomial in s (coefficients in increasing
 //! powers, s in the same length unit as the rod), or a piecewise-linear table.
-//! Energies need the value and its s-derivative (the explicit s-dependence of
-//! the body moment, DESIGN.md "κ' from M' = Hκ' + ∂s∇W").
+//! Energies need the value and its s-derivative: the body moment
+//! M = ∇W(s, κ) depends on s explicitly, so M' = H κ' + ∂s∇W and the
+//! equations solve κ' = H⁻¹(M' − ∂s∇W) with H = ∂²W/∂κ² (Antman,
+//! *Nonlinear Problems of Elasticity*, 2nd ed., Ch. 8).
 
 /// A scalar function of the arc length s.
 #[derive(Debug, Clone, PartialEq)]
@@ -15,11 +17,18 @@ pub enum Profile {
     Polynomial(Vec<f64>),
     /// Piecewise-linear interpolation of (s_k, v_k), s strictly increasing;
     /// held constant outside the table.
-    Table { s: Vec<f64>, values: Vec<f64> },
+    Table {
+        /// Knots s_k, strictly increasing.
+        s: Vec<f64>,
+        /// Values v_k at the knots.
+        values: Vec<f64>,
+    },
     /// The natural cubic spline through (s_k, v_k) (C², so that equations
     /// using the derivative stay continuous); build with [`Profile::spline`].
     Spline {
+        /// Knots s_k, strictly increasing.
         s: Vec<f64>,
+        /// Values v_k at the knots.
         values: Vec<f64>,
         /// Second derivatives at the knots.
         curvature: Vec<f64>,

@@ -1,5 +1,6 @@
 //! Shear and extension: the part of a Cosserat rod's stored energy that
-//! depends on the strain ν = Rᵀr' (DESIGN.md, "Cosserat level").
+//! depends on the strain ν = Rᵀr', the tangent r' in the director frame
+//! R = (d1 d2 d3), so that r' = ν_i d_i.
 //!
 //! The Kirchhoff rod is unshearable and inextensible, ν = e3. The Cosserat
 //! rod has W(s, κ, ν) = W_b(s, κ) + ½ (ν − e3)ᵀ S (ν − e3) with

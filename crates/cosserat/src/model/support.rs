@@ -31,7 +31,7 @@ pub enum Freedom {
 pub struct TipSupport {
     /// The prescribed tip position r(L) (used unless translation is free).
     pub position: Vector3<f64>,
-    /// The prescribed tip frame [d1 d2 d3](L) as columns (used unless
+    /// The prescribed tip frame (d1 d2 d3)(L), the directors as columns (used unless
     /// rotation is free).
     pub frame: Matrix3<f64>,
     /// Translation freedom of the tip.

@@ -1,4 +1,4 @@
-//! The control path of a designed arm (paper Sec. 5, issue 6 item 5).
+//! The control path of a designed arm (Sipos & Várkonyi 2019, Sec. 5).
 //!
 //! The paper warns that an optimal arm, highly curved when unloaded, need
 //! not reach its designed shape when the tip load is applied to it, and

@@ -12,7 +12,7 @@
 //! moment of the unit tip load on the shape.
 //!
 //! The search is deterministic: an Owen-scrambled Sobol' set over the box
-//! of c2..cM (the global stage, [`sampling`]), then Nelder–Mead (argmin)
+//! of c2..cM (the global stage, the private `optimize/sampling.rs`), then Nelder–Mead (argmin)
 //! from the best few (the polish).
 
 use std::sync::Arc;
@@ -117,7 +117,7 @@ pub struct ArmOptimum {
 }
 
 /// How far a search has come: what `cosserat optimize --resume` keeps of an
-/// interrupted run to go on where it stopped (issue 9).
+/// interrupted run to go on where it stopped.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct SearchProgress {
     /// Samples evaluated: the global stage goes on from the next one.

@@ -1,4 +1,4 @@
-//! The discretization error of a reported optimum (issue 14, item 11).
+//! The discretization error of a reported optimum.
 //!
 //! The reach of a design is γ_crit of a finite-element pencil. Conforming
 //! elements overestimate γ_crit (a Rayleigh–Ritz upper bound), and a

@@ -5,10 +5,11 @@
 //!
 //! It replaces a Halton sequence whose 12 prime bases repeated from the
 //! 13th coordinate on: coordinates d and d + 12 were identical, so for
-//! M > 13 the samples lay on a diagonal of the box (issue 14, item 10).
+//! M > 13 the samples lay on a diagonal of the box.
 //!
-//! Properties the search relies on (and tests/optimizer_trust.rs checks):
-//! the first 2^m points are a (t, m, s)-net in base 2 — in particular every
+//! Properties the search relies on (and
+//! crates/cosserat-cli/tests/optimizer_trust.rs checks): the first 2^m
+//! points are a (t, m, s)-net in base 2 — in particular every
 //! coordinate alone is stratified, one point in each interval of width
 //! 2^−m — and the scrambling preserves that while removing the lattice
 //! structure of the unscrambled sequence.

@@ -12,7 +12,7 @@ use super::{sampling, ArmDesign, ArmOptimum, ArmProblem, ArmScene};
 impl ArmProblem {
     /// The i-th sample (i ≥ 1) of the box of c2..cM — the samples of the
     /// global stage of [`ArmProblem::optimize`]: point i − 1 of the
-    /// scrambled Sobol' sequence ([`sampling`]) mapped onto the bounds.
+    /// scrambled Sobol' sequence (`optimize/sampling.rs`) mapped onto the bounds.
     pub fn sample_point(&self, i: usize) -> Vec<f64> {
         assert!(i >= 1, "samples are numbered from 1");
         sampling::unit_point(i - 1, self.bounds.len())

@@ -9,7 +9,7 @@
 
 use nalgebra::DMatrix;
 
-/// A symmetric n×n matrix with A[i][j] = 0 for |i − j| > bw, stored by its
+/// A symmetric n×n matrix with Aᵢⱼ = 0 for |i − j| > bw, stored by its
 /// lower band row by row.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SymmetricBanded {
@@ -52,7 +52,7 @@ impl SymmetricBanded {
         i * (self.bw + 1) + (i - j)
     }
 
-    /// A[i][j] (zero outside the band).
+    /// Aᵢⱼ (zero outside the band).
     pub fn get(&self, i: usize, j: usize) -> f64 {
         if i.abs_diff(j) > self.bw {
             0.0
@@ -61,7 +61,7 @@ impl SymmetricBanded {
         }
     }
 
-    /// A[i][j] += v (and so A[j][i]); |i − j| ≤ bw.
+    /// Aᵢⱼ += v (and so Aⱼᵢ); |i − j| ≤ bw.
     pub fn add(&mut self, i: usize, j: usize, v: f64) {
         let k = self.index(i, j);
         self.data[k] += v;

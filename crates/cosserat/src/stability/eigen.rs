@@ -35,7 +35,13 @@ pub enum EigenError {
     NotFinite(String),
     /// Lanczos did not converge.
     #[error("Lanczos did not converge: residual {residual:.2e} after {steps} steps")]
-    NoConvergence { residual: f64, steps: usize },
+    NoConvergence {
+        /// The residual that failed its test: a Ritz pair's relative
+        /// backward error, or the Lanczos residual bound.
+        residual: f64,
+        /// Lanczos steps taken.
+        steps: usize,
+    },
 }
 
 /// Size up to which the dense solver is used.

@@ -66,10 +66,10 @@ use crate::model::{across, Freedom, TipSupport};
 pub struct FormCoefficients {
     /// A = H.
     pub a: Matrix3<f64>,
-    /// B = H[κ]× − ½[M]×.
+    /// `B = H[κ]× − ½[M]×`.
     pub b: Matrix3<f64>,
-    /// C = [κ]×ᵀH[κ]× + sym(Mκᵀ) − (M·κ)I − sym(Nνᵀ) + (N·ν) I
-    ///     − [N]×ᵀ S⁻¹ [N]× (ν = e3 and S⁻¹ = 0 for the Kirchhoff rod).
+    /// `C = [κ]×ᵀH[κ]× + sym(Mκᵀ) − (M·κ)I − sym(Nνᵀ) + (N·ν) I
+    ///     − [N]×ᵀ S⁻¹ [N]×` (ν = e3 and S⁻¹ = 0 for the Kirchhoff rod).
     pub c: Matrix3<f64>,
 }
 

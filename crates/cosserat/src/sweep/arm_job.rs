@@ -60,7 +60,7 @@ pub fn shape_distance(a: &[f64], b: &[f64]) -> f64 {
 }
 
 /// Two designs are one local optimum unless their loaded shapes differ
-/// (by more than [`SAME_SHAPE`]) *and* a valley separates them: the reach
+/// (by more than `SAME_SHAPE` = 0.1 in [`shape_distance`]) *and* a valley separates them: the reach
 /// dips below the lower of the two (by more than 0.1 %) somewhere on the
 /// straight path between their coefficients. The reach is flat along a
 /// ridge of different shapes, so a shape difference alone would count

@@ -2,7 +2,7 @@
 //! interpolation on cell edges) and the fit of the paper's eq. (61),
 //! B̄3 = Ω B̄1^(−ι), to contours of R* (Sec. 4.2: ι ≈ 0.9).
 
-/// A value on a rectilinear grid: `z[i * y.len() + j]` at (x[i], y[j]);
+/// A value on a rectilinear grid: `z[i * y.len() + j]` at `(x[i], y[j])`;
 /// NaN where unknown.
 #[derive(Debug, Clone, Copy)]
 pub struct GridField<'a> {
