@@ -19,7 +19,7 @@
 //! The short form (a few hundred cases) runs in `cargo test`. The long form
 //! runs on demand:
 //!
-//!     COSSERAT_HOSTILE_CASES=5000 cargo test --release --test hostile -- --nocapture
+//!     COSSERAT_HOSTILE_CASES=5000 cargo test --release -p cosserat-cli --test hostile -- --nocapture
 //!
 //! `COSSERAT_HOSTILE_SEED` picks other cases, `COSSERAT_HOSTILE_TIME` the
 //! time limit per case in seconds (default 1.5), and
