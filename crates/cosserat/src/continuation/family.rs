@@ -272,11 +272,8 @@ impl Family {
                 rod.length = p;
             }
             Parameter::ClampAngle => {
-                let axis = self.base.clamp.director(1);
                 // About d2 by +p: d3 turns towards d1 (R d3 = d3 cos p + d1 sin p).
-                let turn =
-                    nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(axis), p);
-                rod.clamp.frame = turn.matrix() * self.base.clamp.frame;
+                rod.clamp.frame = self.base.clamp.turned_frame(p);
             }
             Parameter::Stiffness(_) | Parameter::IntrinsicCurvature(_) => {
                 rod.energy = self.linear_with(p)?;

@@ -588,9 +588,7 @@ impl ArmProblem {
     fn straight_rod(&self, gamma: f64, theta: f64) -> Rod {
         let mut rod = self.rod();
         rod.loads = rod.loads.scaled(gamma);
-        let axis = nalgebra::Unit::new_normalize(rod.clamp.director(1));
-        rod.clamp.frame =
-            nalgebra::Rotation3::from_axis_angle(&axis, theta).matrix() * rod.clamp.frame;
+        rod.clamp.frame = rod.clamp.turned_frame(theta);
         rod
     }
 
@@ -845,8 +843,7 @@ pub fn designed_rod(
             Profile::Constant(0.0),
         ],
     });
-    let axis = nalgebra::Unit::new_normalize(rod.clamp.director(1));
-    rod.clamp.frame = nalgebra::Rotation3::from_axis_angle(&axis, c[0]).matrix() * rod.clamp.frame;
+    rod.clamp.frame = rod.clamp.turned_frame(c[0]);
     rod.loads = rod.loads.scaled(design.gamma);
     rod
 }
