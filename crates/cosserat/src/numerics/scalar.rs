@@ -220,7 +220,7 @@ mod tests {
             },
             |_, _| false,
         );
-        assert_eq!(stopped, ControlFlow::Break(1.375));
+        assert_eq!(stopped, ControlFlow::Break(1.25));
     }
 
     #[test]
