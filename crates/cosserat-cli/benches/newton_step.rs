@@ -13,12 +13,12 @@
 
 use std::time::Instant;
 
-use cosserat_cli::bench::scenes;
 use cosserat::bvp::newton::NewtonOptions;
 use cosserat::bvp::{
     equations, solve, solve_collocation, CollocationOptions, Discretization, Method, SolverOptions,
 };
 use cosserat::model::{ModelChoice, ModelLevel};
+use cosserat_cli::bench::scenes;
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(|a, b| a.total_cmp(b));
