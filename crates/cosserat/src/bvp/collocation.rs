@@ -30,9 +30,9 @@ use nalgebra::DMatrix;
 #[cfg(test)]
 use nalgebra::DVector;
 
-use super::integrator::{Dop853, Tolerances};
 use super::newton::{Convergence, NewtonOptions};
 use crate::equations::{RodEquations, RodSample};
+use crate::numerics::integrator::{Dop853, Tolerances};
 
 /// Settings of the collocation method.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -9,11 +9,11 @@
 
 use nalgebra::{DMatrix, DVector, Matrix3};
 
-use crate::bvp::integrator::{IntegrationError, Tolerances};
 use crate::bvp::newton::NonlinearSystem;
 use crate::bvp::{equations, ShootingSystem};
 use crate::equations::RodSample;
 use crate::model::{ModelLevel, ProfileKind, Rod};
+use crate::numerics::integrator::{IntegrationError, Tolerances};
 
 /// Which number of the rod the parameter sets.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -19,7 +19,6 @@ use super::continuation_section::ContinuationSection;
 use super::strict;
 use super::sweep_section::{Sweep, SweepSection};
 use super::SupportSection;
-use crate::bvp::integrator::Tolerances;
 use crate::bvp::newton::NewtonOptions;
 use crate::bvp::{Method, SolverOptions, Strategy};
 use crate::continuation::{ContinuationOptions, Family, Parameter};
@@ -27,6 +26,7 @@ use crate::model::{
     Clamp, DeadLoads, EnergyCatalog, EnergySpec, ModelChoice, ModelLevel, Profile, Rod, Shearable,
     StoredEnergy,
 };
+use crate::numerics::integrator::Tolerances;
 use crate::optimize::{ArmProblem, ArmScene, SearchOptions};
 use crate::stability::{FixedShape, StabilityOptions};
 

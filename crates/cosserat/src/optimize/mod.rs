@@ -862,7 +862,7 @@ pub(crate) fn continue_to_design(
         parameter,
         crate::model::ModelLevel::Planar,
         32,
-        crate::bvp::integrator::Tolerances::default(),
+        crate::numerics::integrator::Tolerances::default(),
     );
     continue_family(problem, &family, stop)
 }

@@ -13,7 +13,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::banded::{PivotBreakdown, SymmetricBanded};
+use crate::numerics::banded::{PivotBreakdown, SymmetricBanded};
 
 /// Eigenvalues in increasing order with G-orthonormal eigenvectors.
 #[derive(Debug, Clone, PartialEq)]

@@ -55,10 +55,10 @@
 
 use nalgebra::{DVector, Matrix3, Vector3};
 
-use super::banded::SymmetricBanded;
 use super::constrained::Constraints;
 use crate::equations::RodSample;
 use crate::model::{across, Freedom, TipSupport};
+use crate::numerics::banded::SymmetricBanded;
 
 /// The coefficients of the quadratic form at one point:
 /// q(ω, ω') = ω'ᵀAω' + 2ω'ᵀBω + ωᵀCω.
