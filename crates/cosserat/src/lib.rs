@@ -46,6 +46,7 @@ pub mod continuation;
 pub mod equations;
 pub mod io;
 pub mod model;
+pub mod numerics;
 pub mod optimize;
 pub mod references;
 pub mod stability;

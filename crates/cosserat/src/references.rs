@@ -10,6 +10,8 @@
 use std::collections::BTreeMap;
 use std::f64::consts::{FRAC_1_SQRT_2, FRAC_PI_2, PI};
 
+use crate::numerics::scalar::bisect;
+
 /// Carlson's R_F(x, y, z).
 pub fn carlson_rf(x: f64, y: f64, z: f64) -> f64 {
     let (mut x, mut y, mut z) = (x, y, z);
@@ -89,19 +91,11 @@ pub fn bessel_first_zero(nu: f64, lo: f64, hi: f64) -> f64 {
         }
         sum
     };
-    let (mut a, mut b) = (lo, hi);
-    let fa = series(a);
-    if fa * series(b) >= 0.0 {
+    let fa = series(lo);
+    if fa * series(hi) >= 0.0 {
         return f64::NAN;
     }
-    for _ in 0..200 {
-        let m = 0.5 * (a + b);
-        if series(m) * fa > 0.0 {
-            a = m;
-        } else {
-            b = m;
-        }
-    }
+    let (a, b) = bisect(lo, hi, 200, |m| series(m) * fa > 0.0, |_, _| false);
     0.5 * (a + b)
 }
 
@@ -117,15 +111,7 @@ pub fn cantilever_tip(k: f64) -> (f64, f64, f64) {
         let theta0 = (1.0 / (p * 2f64.sqrt())).asin();
         ellip_f(FRAC_PI_2, p) - ellip_f(theta0, p)
     };
-    let (mut lo, mut hi) = (FRAC_1_SQRT_2, 1.0);
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if lhs(mid) < sqrt_k {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
+    let (lo, hi) = bisect(FRAC_1_SQRT_2, 1.0, 200, |m| lhs(m) < sqrt_k, |_, _| false);
     let p = 0.5 * (lo + hi);
     let theta0 = (1.0 / (p * 2f64.sqrt())).asin();
     let sin_phi0 = 2.0 * p * p - 1.0;
@@ -275,15 +261,16 @@ pub fn greenhill_clamped(tau: f64) -> f64 {
     while f(lo) * f(lo + step) > 0.0 && lo < 100.0 {
         lo += step;
     }
-    let mut hi = lo + step;
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if f(lo) * f(mid) <= 0.0 {
-            hi = mid;
-        } else {
-            lo = mid;
+    // The sign test is against f at the bracket's current lower end.
+    let mut below = lo;
+    let keep_upper = |mid: f64| {
+        let lower = f(below) * f(mid) <= 0.0;
+        if !lower {
+            below = mid;
         }
-    }
+        !lower
+    };
+    let (lo, hi) = bisect(lo, lo + step, 200, keep_upper, |_, _| false);
     0.5 * (lo + hi)
 }
 

@@ -30,9 +30,9 @@ use nalgebra::DMatrix;
 #[cfg(test)]
 use nalgebra::DVector;
 
-use super::integrator::{Dop853, Tolerances};
 use super::newton::{Convergence, NewtonOptions};
 use crate::equations::{RodEquations, RodSample};
+use crate::numerics::integrator::{Dop853, Tolerances};
 
 /// Settings of the collocation method.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -447,21 +447,10 @@ pub(crate) struct Tableau {
 
 impl Tableau {
     pub(crate) fn gauss(m: usize) -> Option<Tableau> {
-        let (c, b) = match m {
-            1 => (vec![0.5], vec![1.0]),
-            2 => {
-                let d = 3f64.sqrt() / 6.0;
-                (vec![0.5 - d, 0.5 + d], vec![0.5, 0.5])
-            }
-            3 => {
-                let d = 15f64.sqrt() / 10.0;
-                (
-                    vec![0.5 - d, 0.5, 0.5 + d],
-                    vec![5.0 / 18.0, 4.0 / 9.0, 5.0 / 18.0],
-                )
-            }
-            _ => return None,
-        };
+        if m > 3 {
+            return None;
+        }
+        let (c, b) = crate::numerics::quadrature::gauss_legendre(m, 0.0, 1.0)?;
         let a = c
             .iter()
             .flat_map(|&cj| integral_weights(&c, &b, cj))
@@ -478,17 +467,11 @@ impl Tableau {
 /// their count m + 1 (the Gauss points of [`Tableau::gauss`], without its
 /// allocations).
 fn interpolation_nodes(m: usize) -> ([f64; 4], usize) {
-    match m {
-        1 => ([0.0, 0.5, 0.0, 0.0], 2),
-        2 => {
-            let d = 3f64.sqrt() / 6.0;
-            ([0.0, 0.5 - d, 0.5 + d, 0.0], 3)
-        }
-        _ => {
-            let d = 15f64.sqrt() / 10.0;
-            ([0.0, 0.5 - d, 0.5, 0.5 + d], 4)
-        }
-    }
+    let m = if matches!(m, 1 | 2) { m } else { 3 };
+    let (c, _) = crate::numerics::quadrature::gauss_legendre_unit(m).expect("tabulated");
+    let mut nodes = [0.0; 4];
+    nodes[1..=c.len()].copy_from_slice(c);
+    (nodes, c.len() + 1)
 }
 
 /// ℓ_q(t) for the Lagrange basis on `nodes`.

@@ -14,8 +14,8 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::collocation::Tableau;
-use super::integrator::IntegrationError;
 use crate::equations::RodEquations;
+use crate::numerics::integrator::IntegrationError;
 
 /// The stage Jacobians J_i = ∂f/∂y (n × n each) at the stage states.
 fn stage_jacobians(

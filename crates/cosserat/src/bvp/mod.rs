@@ -11,7 +11,7 @@
 
 mod collocation;
 mod gauss_step;
-pub mod integrator;
+pub use crate::numerics::integrator;
 pub mod newton;
 mod shooting;
 
@@ -21,11 +21,11 @@ use nalgebra::DMatrix;
 
 use crate::equations::{KirchhoffEquations, PlanarEquations, RodEquations, RodSample};
 use crate::model::{ModelChoice, ModelLevel, Rod};
+use crate::numerics::integrator::{IntegrationStats, Tolerances};
 pub use collocation::{
     solve_collocation, solve_collocation_from, CollocationError, CollocationOptions,
     CollocationSolution,
 };
-use integrator::{IntegrationStats, Tolerances};
 use newton::{NewtonFailure, NewtonOptions};
 pub use shooting::ShootingSystem;
 

@@ -13,7 +13,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::integrator::IntegrationError;
+use crate::numerics::integrator::IntegrationError;
 
 /// A square nonlinear system F(x) = 0 with its Jacobian. Residuals are
 /// expected to be scaled so that their max-norm is dimensionless.

@@ -14,9 +14,9 @@ use nalgebra::{DMatrix, DVector};
 
 use super::collocation::Tableau;
 use super::gauss_step::gauss_step;
-use super::integrator::{Dop853, IntegrationError, IntegrationStats, Tolerances};
 use super::newton::NonlinearSystem;
 use crate::equations::{RodEquations, RodSample};
+use crate::numerics::integrator::{Dop853, IntegrationError, IntegrationStats, Tolerances};
 
 /// The shooting formulation of a rod BVP on K segments.
 pub struct ShootingSystem<'a> {

@@ -6,6 +6,7 @@ use nalgebra::{DMatrix, DVector};
 
 use super::{Point, Run, SpecialKind, SpecialPoint};
 use crate::model::ModelLevel;
+use crate::numerics::scalar::{End, Illinois};
 use crate::stability::Block;
 
 /// A test function along the step from a point: f(σ) and the point there.
@@ -140,47 +141,22 @@ impl Run<'_> {
             .map(|(t, (y, x))| t * (y - x))
             .sum();
         let use_det = jump == 1 && self.representable(block);
-        let (mut lo, mut hi) = (0.0, span);
-        let mut f_lo = self.test_at(a, sign, 1e-12 * span, kind, block, use_det)?.0;
-        let mut f_hi = self.test_at(a, sign, span, kind, block, use_det)?.0;
-        if f_lo * f_hi > 0.0 {
-            return None;
-        }
+        let f_lo = self.test_at(a, sign, 1e-12 * span, kind, block, use_det)?.0;
+        let f_hi = self.test_at(a, sign, span, kind, block, use_det)?.0;
+        let mut bracket = Illinois::new(0.0, span, f_lo, f_hi)?;
         let mut best = self.test_at(a, sign, 0.5 * span, kind, block, use_det)?;
-        let (mut side, mut p_lo, mut p_hi) = (0i32, a.parameter, b.parameter);
+        let (mut p_lo, mut p_hi) = (a.parameter, b.parameter);
         for _ in 0..80 {
-            let sigma = if f_hi != f_lo {
-                (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
-            } else {
-                0.5 * (lo + hi)
-            };
-            let sigma = if sigma <= lo || sigma >= hi {
-                0.5 * (lo + hi)
-            } else {
-                sigma
-            };
+            let sigma = bracket.next_point();
             best = self.test_at(a, sign, sigma, kind, block, use_det)?;
-            if best.0 * f_lo > 0.0 {
-                lo = sigma;
-                f_lo = best.0;
-                p_lo = best.2;
-                if side == -1 {
-                    f_hi *= 0.5;
-                }
-                side = -1;
-            } else {
-                hi = sigma;
-                f_hi = best.0;
-                p_hi = best.2;
-                if side == 1 {
-                    f_lo *= 0.5;
-                }
-                side = 1;
+            match bracket.update(sigma, best.0) {
+                End::Lower => p_lo = best.2,
+                End::Upper => p_hi = best.2,
             }
             let tol = self.opts.event_tolerance * best.2.abs().max(1.0);
-            if (p_hi - p_lo).abs() <= tol && (hi - lo) <= 1e3 * tol
+            if (p_hi - p_lo).abs() <= tol && bracket.width() <= 1e3 * tol
                 || best.0 == 0.0
-                || hi - lo <= 1e-15 * span
+                || bracket.width() <= 1e-15 * span
             {
                 break;
             }

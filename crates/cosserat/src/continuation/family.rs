@@ -9,11 +9,11 @@
 
 use nalgebra::{DMatrix, DVector, Matrix3};
 
-use crate::bvp::integrator::{IntegrationError, Tolerances};
 use crate::bvp::newton::NonlinearSystem;
 use crate::bvp::{equations, ShootingSystem};
 use crate::equations::RodSample;
 use crate::model::{ModelLevel, ProfileKind, Rod};
+use crate::numerics::integrator::{IntegrationError, Tolerances};
 
 /// Which number of the rod the parameter sets.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -277,11 +277,8 @@ impl Family {
                 rod.length = p;
             }
             Parameter::ClampAngle => {
-                let axis = self.base.clamp.director(1);
                 // About d2 by +p: d3 turns towards d1 (R d3 = d3 cos p + d1 sin p).
-                let turn =
-                    nalgebra::Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(axis), p);
-                rod.clamp.frame = turn.matrix() * self.base.clamp.frame;
+                rod.clamp.frame = self.base.clamp.turned_frame(p);
             }
             Parameter::Stiffness(_) | Parameter::IntrinsicCurvature(_) => {
                 rod.energy = self.linear_with(p)?;

@@ -9,7 +9,7 @@ use nalgebra::Vector3;
 
 use super::family::{Family, PointError};
 use crate::equations::RodSample;
-use crate::stability::banded::SymmetricBanded;
+use crate::numerics::banded::SymmetricBanded;
 use crate::stability::constrained::{
     count_below_constrained, lowest_eigenpairs_constrained, Constraints,
 };

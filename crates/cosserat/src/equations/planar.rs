@@ -90,16 +90,10 @@ impl PlanarEquations {
     /// the linear energy), by Newton from κ2 = 0.
     fn hinge_curvature(&self) -> f64 {
         let e = &self.rod.energy;
-        let mut k2 = 0.0;
-        for _ in 0..50 {
+        crate::numerics::scalar::newton(0.0, 50, 1e-15, |k2| {
             let kappa = Self::kappa(k2);
-            let step = e.moment(0.0, &kappa)[1] / e.stiffness(0.0, &kappa)[(1, 1)];
-            k2 -= step;
-            if step.abs() <= 1e-15 * k2.abs().max(1.0) {
-                break;
-            }
-        }
-        k2
+            e.moment(0.0, &kappa)[1] / e.stiffness(0.0, &kappa)[(1, 1)]
+        })
     }
 
     /// The residuals (3) and Jacobian (3 × dim) of a supported tip, each
@@ -268,15 +262,10 @@ impl RodEquations for PlanarEquations {
         let m = straight_rod_clamp_moment(&self.rod);
         let m2 = m.dot(&self.rod.clamp.director(1));
         let e = &self.rod.energy;
-        let mut k2 = 0.0;
-        for _ in 0..50 {
+        let k2 = crate::numerics::scalar::newton(0.0, 50, 1e-14, |k2| {
             let kappa = Self::kappa(k2);
-            let step = (e.moment(0.0, &kappa)[1] - m2) / e.stiffness(0.0, &kappa)[(1, 1)];
-            k2 -= step;
-            if step.abs() <= 1e-14 * k2.abs().max(1.0) {
-                break;
-            }
-        }
+            (e.moment(0.0, &kappa)[1] - m2) / e.stiffness(0.0, &kappa)[(1, 1)]
+        });
         let mut u = vec![if self.rod.clamp.hinge { 0.0 } else { k2 }];
         u.resize(self.unknowns(), 0.0);
         u

@@ -19,7 +19,6 @@ use super::continuation_section::ContinuationSection;
 use super::strict;
 use super::sweep_section::{Sweep, SweepSection};
 use super::SupportSection;
-use crate::bvp::integrator::Tolerances;
 use crate::bvp::newton::NewtonOptions;
 use crate::bvp::{Method, SolverOptions, Strategy};
 use crate::continuation::{ContinuationOptions, Family, Parameter};
@@ -27,6 +26,7 @@ use crate::model::{
     Clamp, DeadLoads, EnergyCatalog, EnergySpec, ModelChoice, ModelLevel, Profile, Rod, Shearable,
     StoredEnergy,
 };
+use crate::numerics::integrator::Tolerances;
 use crate::optimize::{ArmProblem, ArmScene, SearchOptions};
 use crate::stability::{FixedShape, StabilityOptions};
 
@@ -937,16 +937,10 @@ fn build_clamp(c: &ClampSection) -> Result<Clamp, ProblemError> {
     let angle = finite("clamp.angle", c.angle)?;
     let clamp = Clamp::new(position, d1, d3);
     Ok(Clamp {
-        frame: turned(&clamp, angle),
+        frame: clamp.turned_frame(angle),
         hinge: c.hinge,
         ..clamp
     })
-}
-
-/// The clamp frame turned by `angle` about d2, d3 towards d1.
-fn turned(clamp: &Clamp, angle: f64) -> nalgebra::Matrix3<f64> {
-    let axis = nalgebra::Unit::new_normalize(clamp.director(1));
-    nalgebra::Rotation3::from_axis_angle(&axis, angle).matrix() * clamp.frame
 }
 
 /// The model level: automatic, or forced by `solver.model`. `sheared` says
@@ -1025,7 +1019,7 @@ fn build_continuation(
     let mut base = rod.clone();
     if parameter == Parameter::ClampAngle {
         // The parameter is the absolute angle: start from the unturned frame.
-        base.clamp.frame = turned(&rod.clamp, -file.clamp.angle);
+        base.clamp.frame = rod.clamp.turned_frame(-file.clamp.angle);
     }
     let family = match stages {
         None => Family::new(base, parameter, model.level, segments, options.integration),

@@ -381,6 +381,8 @@ fn derivative_of(c: &[f64]) -> Vec<f64> {
 /// derivative cascade: between consecutive roots of the derivative the
 /// polynomial is monotone, so a sign change brackets its only root there.
 fn root_brackets(c: &[f64], a: f64, b: f64) -> Vec<(f64, f64)> {
+    use crate::numerics::scalar::{adjacent, bisect_or_break};
+    use std::ops::ControlFlow;
     let degree = c.iter().rposition(|&v| v != 0.0).unwrap_or(0);
     if degree == 0 {
         return vec![];
@@ -397,7 +399,7 @@ fn root_brackets(c: &[f64], a: f64, b: f64) -> Vec<(f64, f64)> {
     splits.push(b);
     let mut roots = vec![];
     for w in splits.windows(2) {
-        let (mut lo, mut hi) = (w[0], w[1]);
+        let (lo, hi) = (w[0], w[1]);
         let (flo, fhi) = (horner(c, lo), horner(c, hi));
         if flo == 0.0 || fhi == 0.0 {
             let x = if flo == 0.0 { lo } else { hi };
@@ -410,24 +412,23 @@ fn root_brackets(c: &[f64], a: f64, b: f64) -> Vec<(f64, f64)> {
             continue;
         }
         let negative_at_lo = flo < 0.0;
-        loop {
-            let mid = 0.5 * (lo + hi);
-            if mid <= lo || mid >= hi {
-                break;
-            }
+        if adjacent(lo, hi) {
+            roots.push((lo, hi));
+            continue;
+        }
+        // Halved until adjacent, or an exact root at a midpoint.
+        let side = |mid: f64| {
             let f = horner(c, mid);
             if f == 0.0 {
-                lo = mid;
-                hi = mid;
-                break;
-            }
-            if (f < 0.0) == negative_at_lo {
-                lo = mid;
+                ControlFlow::Break(mid)
             } else {
-                hi = mid;
+                ControlFlow::Continue((f < 0.0) == negative_at_lo)
             }
-        }
-        roots.push((lo, hi));
+        };
+        roots.push(match bisect_or_break(lo, hi, usize::MAX, side, adjacent) {
+            ControlFlow::Break(x) => (x, x),
+            ControlFlow::Continue(bracket) => bracket,
+        });
     }
     roots
 }

@@ -43,6 +43,14 @@ impl Clamp {
     pub fn director(&self, i: usize) -> Vector3<f64> {
         self.frame.column(i).into_owned()
     }
+
+    /// The frame turned by `angle` (rad) about d2(0), d3 towards d1:
+    /// R [d1 d2 d3] with R d3 = d3 cos θ + d1 sin θ (the clamp angle of the
+    /// paper's Fig. 2; a negative angle turns back).
+    pub fn turned_frame(&self, angle: f64) -> Matrix3<f64> {
+        let axis = nalgebra::Unit::new_normalize(self.director(1));
+        nalgebra::Rotation3::from_axis_angle(&axis, angle).matrix() * self.frame
+    }
 }
 
 /// The units in which tip residuals are measured ([`Rod::residual_scales`]).

@@ -122,7 +122,7 @@ pub fn shape_holding_path_until(
         target.energy,
         ModelLevel::Planar,
         32,
-        crate::bvp::integrator::Tolerances::default(),
+        crate::numerics::integrator::Tolerances::default(),
     );
     continue_family(problem, &family, stop)
 }

@@ -15,12 +15,14 @@
 //! of c2..cM (the global stage, the private `optimize/sampling.rs`), then Nelder–Mead (argmin)
 //! from the best few (the polish).
 
+use std::ops::ControlFlow;
 use std::sync::Arc;
 
 use argmin::core::{CostFunction, Error as ArgminError, Executor, State};
 use argmin::solver::neldermead::NelderMead;
 
 use crate::model::{Clamp, LinearElastic, Profile, Rod};
+use crate::numerics::scalar::{bisect_or_break, golden_section_max};
 use crate::stability::{critical_load, FixedShape, StabilityOptions};
 
 pub mod control_path;
@@ -588,9 +590,7 @@ impl ArmProblem {
     fn straight_rod(&self, gamma: f64, theta: f64) -> Rod {
         let mut rod = self.rod();
         rod.loads = rod.loads.scaled(gamma);
-        let axis = nalgebra::Unit::new_normalize(rod.clamp.director(1));
-        rod.clamp.frame =
-            nalgebra::Rotation3::from_axis_angle(&axis, theta).matrix() * rod.clamp.frame;
+        rod.clamp.frame = rod.clamp.turned_frame(theta);
         rod
     }
 
@@ -661,7 +661,7 @@ impl ArmProblem {
                 return (f1.abs() < 1e-6).then_some((t1, eq));
             }
             k = Self::clamp_curvature(&eq);
-            let next = t1 - f1 * (t1 - t0) / (f1 - f0);
+            let next = crate::numerics::scalar::secant_step(t0, f0, t1, f1);
             (t0, f0, t1) = (t1, f1, next.clamp(t1 - 0.1, t1 + 0.1));
         }
         None
@@ -735,43 +735,41 @@ impl ArmProblem {
                 return None;
             }
         }
-        for _ in 0..40 {
+        let side = |mid: f64| {
             if stop() {
-                return interrupted(&marched);
+                return ControlFlow::Break(());
             }
-            let mid = 0.5 * (lo + hi);
-            match level(mid, &state) {
+            ControlFlow::Continue(match level(mid, &state) {
                 Some((true, next, r)) => {
                     marched.push((mid, next.clone(), r));
-                    (lo, state) = (mid, next);
+                    state = next;
+                    true
                 }
-                found => (hi, limit) = (mid, reason(&found)),
-            }
-            if hi - lo < 1e-10 * hi {
-                break;
-            }
+                found => {
+                    limit = reason(&found);
+                    false
+                }
+            })
+        };
+        if bisect_or_break(lo, hi, 40, side, |lo, hi| hi - lo < 1e-10 * hi).is_break() {
+            return interrupted(&marched);
         }
         let best = best_of(&marched)?;
         let (mut gamma, mut from) = (marched[best].0, marched[best].1.clone());
         if best > 0 && best + 1 < marched.len() {
             // Golden-section search for the largest R̂ between the neighbours.
-            let (mut a, mut b) = (marched[best - 1].0, marched[best + 1].0);
-            let g = 0.5 * (5f64.sqrt() - 1.0);
-            let f = |x: f64, from: &Level| level(x, from).map_or(f64::NEG_INFINITY, |l| l.2);
-            for _ in 0..60 {
+            let (a, b) = (marched[best - 1].0, marched[best + 1].0);
+            let f = |x: f64| {
                 if stop() {
-                    return interrupted(&marched);
+                    return ControlFlow::Break(());
                 }
-                let (c, d) = (b - g * (b - a), a + g * (b - a));
-                if f(c, &from) > f(d, &from) {
-                    b = d;
-                } else {
-                    a = c;
-                }
-                if b - a < 1e-9 * b {
-                    break;
-                }
-            }
+                ControlFlow::Continue(level(x, &from).map_or(f64::NEG_INFINITY, |l| l.2))
+            };
+            let ControlFlow::Continue((a, b)) =
+                golden_section_max(a, b, 60, f, |a, b| b - a < 1e-9 * b)
+            else {
+                return interrupted(&marched);
+            };
             gamma = 0.5 * (a + b);
             if let Some((_, l, _)) = level(gamma, &from) {
                 from = l;
@@ -845,8 +843,7 @@ pub fn designed_rod(
             Profile::Constant(0.0),
         ],
     });
-    let axis = nalgebra::Unit::new_normalize(rod.clamp.director(1));
-    rod.clamp.frame = nalgebra::Rotation3::from_axis_angle(&axis, c[0]).matrix() * rod.clamp.frame;
+    rod.clamp.frame = rod.clamp.turned_frame(c[0]);
     rod.loads = rod.loads.scaled(design.gamma);
     rod
 }
@@ -865,7 +862,7 @@ pub(crate) fn continue_to_design(
         parameter,
         crate::model::ModelLevel::Planar,
         32,
-        crate::bvp::integrator::Tolerances::default(),
+        crate::numerics::integrator::Tolerances::default(),
     );
     continue_family(problem, &family, stop)
 }

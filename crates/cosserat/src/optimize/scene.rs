@@ -92,15 +92,9 @@ impl ArmScene {
         let steps = 256;
         let grid = |j: usize| lambda_crit * j as f64 / steps as f64;
         let j = (1..steps).rev().find(|&j| excess(grid(j)) <= 0.0)?;
-        let (mut lo, mut hi) = (grid(j), grid(j + 1));
-        for _ in 0..60 {
-            let mid = 0.5 * (lo + hi);
-            if excess(mid) <= 0.0 {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
+        let feasible = |mid: f64| excess(mid) <= 0.0;
+        let (lo, _) =
+            crate::numerics::scalar::bisect(grid(j), grid(j + 1), 60, feasible, |_, _| false);
         Some(lo)
     }
 }

@@ -18,11 +18,11 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::banded::{BandedLdlt, SymmetricBanded};
 use super::eigen::{
     count_below, dense_pencil, diagonal_ratio, lowest_eigenpairs_near, shift_below,
     shift_invert_lanczos, verify_with, EigenError, Eigenpairs, DENSE_LIMIT,
 };
+use crate::numerics::banded::{BandedLdlt, SymmetricBanded};
 
 /// Linear constraints C v = 0 with orthonormal rows (m × n).
 #[derive(Debug, Clone, PartialEq)]

@@ -13,7 +13,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::banded::{PivotBreakdown, SymmetricBanded};
+use crate::numerics::banded::{PivotBreakdown, SymmetricBanded};
 
 /// Eigenvalues in increasing order with G-orthonormal eigenvectors.
 #[derive(Debug, Clone, PartialEq)]
@@ -207,17 +207,9 @@ pub(super) fn shift_below(scale: f64, count: impl Fn(f64) -> Option<usize>) -> f
     while none_below(hi) && hi < 1e6 * scale {
         hi *= 4.0;
     }
-    for _ in 0..60 {
-        let mid = 0.5 * (lo + hi);
-        if none_below(mid) {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-        if hi - lo <= (0.05 * (hi.abs() + lo.abs())).max(FLOOR * scale) {
-            break;
-        }
-    }
+    let (lo, hi) = crate::numerics::scalar::bisect(lo, hi, 60, none_below, |lo, hi| {
+        hi - lo <= (0.05 * (hi.abs() + lo.abs())).max(FLOOR * scale)
+    });
     // Not closer to λ_1 than FLOOR·scale: a shift on top of a (near) zero
     // eigenvalue, as at a bifurcation, would make the shifted operator so
     // lopsided that the other Ritz pairs lose their accuracy.

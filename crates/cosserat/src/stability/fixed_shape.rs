@@ -14,9 +14,9 @@ use nalgebra::{Matrix3, Vector3};
 use super::eigen::smallest_positive_load_factor;
 use super::second_variation::{Block, FiniteElements, FormCoefficients};
 use super::{StabilityError, StabilityOptions};
-use crate::bvp::integrator::{Dop853, Tolerances};
 use crate::equations::RodSample;
 use crate::model::{Profile, Rod};
+use crate::numerics::integrator::{Dop853, Tolerances};
 
 /// A loaded shape held fixed while the load varies.
 #[derive(Debug, Clone, PartialEq)]

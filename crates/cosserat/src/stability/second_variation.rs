@@ -55,10 +55,10 @@
 
 use nalgebra::{DVector, Matrix3, Vector3};
 
-use super::banded::SymmetricBanded;
 use super::constrained::Constraints;
 use crate::equations::RodSample;
 use crate::model::{across, Freedom, TipSupport};
+use crate::numerics::banded::SymmetricBanded;
 
 /// The coefficients of the quadratic form at one point:
 /// q(ω, ω') = ω'ᵀAω' + 2ω'ᵀBω + ωᵀCω.
@@ -162,29 +162,8 @@ pub struct FiniteElements {
 
 /// Gauss–Legendre nodes and weights on [0, 1] with `m` points (m = 2..4).
 fn gauss(m: usize) -> (Vec<f64>, Vec<f64>) {
-    let (x, w): (Vec<f64>, Vec<f64>) = match m {
-        2 => {
-            let a = 1.0 / 3f64.sqrt();
-            (vec![-a, a], vec![1.0, 1.0])
-        }
-        3 => {
-            let a = (0.6f64).sqrt();
-            (vec![-a, 0.0, a], vec![5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0])
-        }
-        _ => {
-            let r = (6.0f64 / 5.0).sqrt();
-            let (a, b) = (
-                ((3.0 - 2.0 * r) / 7.0).sqrt(),
-                ((3.0 + 2.0 * r) / 7.0).sqrt(),
-            );
-            let (wa, wb) = ((18.0 + 30f64.sqrt()) / 36.0, (18.0 - 30f64.sqrt()) / 36.0);
-            (vec![-b, -a, a, b], vec![wb, wa, wa, wb])
-        }
-    };
-    (
-        x.iter().map(|v| 0.5 * (v + 1.0)).collect(),
-        w.iter().map(|v| 0.5 * v).collect(),
-    )
+    let m = if matches!(m, 2 | 3) { m } else { 4 };
+    crate::numerics::quadrature::gauss_legendre(m, 0.0, 1.0).expect("tabulated")
 }
 
 impl FiniteElements {

@@ -1,11 +1,12 @@
 //! Symmetric banded matrices and their LDLᵀ factorization.
 //!
-//! The discretized second variation couples only neighbouring finite
-//! elements, so K and the mass matrix G are banded with a half-bandwidth of
-//! a few entries. LDLᵀ without pivoting costs O(n·b²); by Sylvester's law of
+//! Finite elements couple only neighbouring elements, so a stiffness K and
+//! mass matrix G assembled from them are banded with a half-bandwidth of a
+//! few entries. LDLᵀ without pivoting costs O(n·b²); by Sylvester's law of
 //! inertia the number of negative pivots of K − σG counts the eigenvalues of
-//! the pencil (K, G) below σ (a Sturm count), and all pivots positive is the
-//! cheap stability test of the paper's Sec. 3.2 ("a try of Cholesky").
+//! the pencil (K, G) below σ (a Sturm count), and all pivots positive shows
+//! K positive definite (a "try of Cholesky"; the stability stage's test of
+//! the second variation).
 
 use nalgebra::DMatrix;
 
