@@ -2,27 +2,15 @@
 //! class of bad input (exit code 2, a message naming the field, no output).
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-const BIN: &str = env!("CARGO_BIN_EXE_cosserat");
-const CANTILEVER: &str = include_str!("../../../problems/cantilever_tip_load.toml");
+#[path = "common/run.rs"]
+mod common_run;
+use common_run::{run, stderr};
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("cosserat-cli-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    common_run::scratch("cli", name)
 }
-
-fn run(args: &[&str]) -> Output {
-    Command::new(BIN)
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+const CANTILEVER: &str = include_str!("../../../problems/cantilever_tip_load.toml");
 
 /// Writes `text` as a problem file, runs `solve` with an output file, and
 /// checks exit code 2, that stderr contains every one of `expect`, and that

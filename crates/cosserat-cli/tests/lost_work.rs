@@ -9,31 +9,19 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-const BIN: &str = env!("CARGO_BIN_EXE_cosserat");
+#[path = "common/run.rs"]
+mod common_run;
+use common_run::{run, stderr, BIN};
+
+fn scratch(name: &str) -> PathBuf {
+    common_run::scratch("lost", name)
+}
 
 fn shipped(name: &str) -> String {
     format!(
         "{}/problems/{name}.toml",
         concat!(env!("CARGO_MANIFEST_DIR"), "/../..")
     )
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("cosserat-lost-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-fn run(args: &[&str]) -> Output {
-    Command::new(BIN)
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
 fn files(dir: &Path) -> Vec<String> {
