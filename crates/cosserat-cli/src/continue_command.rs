@@ -7,7 +7,7 @@ use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
 use crate::plot::{draw, read_diagram};
-use cosserat::continuation::{continuation, Diagram, Progress};
+use cosserat::continuation::{continuation, Diagram, Progress, RunState};
 use cosserat::io::target::replace_atomically;
 use cosserat::io::{read_saved, write_diagram, Problem, MEASURES};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -64,7 +64,7 @@ pub fn run_continue(
                     ),
                 )
             }
-            Ok((_, saved)) if saved.stop_reason == "completed" => {
+            Ok((_, saved)) if !saved.stop_reason.resumable() => {
                 println!("nothing to resume: {} is complete", output.display());
                 return ExitCode::SUCCESS;
             }
@@ -144,7 +144,7 @@ pub fn run_continue(
         return fail(OUTPUT, e);
     }
     println!("written   {}", output.display());
-    if diagram.stop_reason == "interrupted" {
+    if diagram.stop_reason == RunState::Interrupted {
         eprintln!(
             "interrupted: every point computed so far is in {}; go on with --resume",
             output.display()

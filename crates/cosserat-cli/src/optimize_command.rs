@@ -7,6 +7,7 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use crate::arm_chart::{draw_arm, ArmChart};
+use cosserat::continuation::RunState;
 use cosserat::io::target::{replace_atomically, Claim};
 use cosserat::io::{read_search, write_arm_study, ArmStudy, Problem};
 use cosserat::optimize::{
@@ -30,7 +31,7 @@ fn interrupted_study<'a>(opt: &'a ArmOptimum, progress: &'a SearchProgress) -> A
         closest: None,
         least_curvature: None,
         progress: Some(progress),
-        stop_reason: "interrupted",
+        stop_reason: RunState::Interrupted,
     }
 }
 
@@ -248,7 +249,7 @@ fn write_study(
             closest: extras.closest.as_ref(),
             least_curvature: extras.least.as_ref(),
             progress: Some(progress),
-            stop_reason: "completed",
+            stop_reason: RunState::Completed,
         };
         write_arm_study(out, text, &study, true).map_err(|e| fail(OUTPUT, e))?;
         println!("written   {}", out.display());
@@ -316,7 +317,7 @@ fn start_from(
             ),
         ));
     }
-    if saved.stop_reason == "completed" {
+    if !saved.stop_reason.resumable() {
         println!("nothing to resume: {} is complete", out.display());
         return Err(ExitCode::SUCCESS);
     }

@@ -9,6 +9,7 @@ use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 use crate::sweep_figure as figure;
+use cosserat::continuation::RunState;
 use cosserat::io::target::{replace_atomically, Claim};
 use cosserat::io::{read_sweep, write_sweep, Problem, Sweep, SweepHeader};
 use cosserat::sweep::{run, ArmJob, Job, Record, Shard, SolveJob, SweepPlan};
@@ -98,7 +99,7 @@ fn prepare(args: &SweepArgs) -> Result<Option<Setup>, ExitCode> {
         }),
         None => Box::new(SolveJob),
     };
-    let expected = header(&problem, &sweep, shard, job.kind(), "running");
+    let expected = header(&problem, &sweep, shard, job.kind(), RunState::InProgress);
     if args.plot.is_some() {
         figure::chartable(&expected.kind, &expected.keys).map_err(|e| at(&e))?;
     }
@@ -141,7 +142,13 @@ fn threads(asked: Option<u16>) -> Result<usize, ExitCode> {
     }
 }
 
-fn header(problem: &Problem, sweep: &Sweep, shard: Shard, kind: &str, reason: &str) -> SweepHeader {
+fn header(
+    problem: &Problem,
+    sweep: &Sweep,
+    shard: Shard,
+    kind: &str,
+    reason: RunState,
+) -> SweepHeader {
     let plan = SweepPlan {
         text: &problem.text,
         sweep,
@@ -151,7 +158,7 @@ fn header(problem: &Problem, sweep: &Sweep, shard: Shard, kind: &str, reason: &s
         problem: problem.text.clone(),
         kind: kind.to_string(),
         shard: shard.to_string(),
-        stop_reason: reason.to_string(),
+        stop_reason: reason,
         keys: sweep.axes.iter().map(|a| a.key.clone()).collect(),
         axes: sweep.axes.iter().map(|a| a.values.clone()).collect(),
         members: plan.members().len(),
@@ -178,7 +185,7 @@ fn resumable(path: &Path, expected: &SweepHeader) -> Result<Option<Vec<Record>>,
             ),
         ));
     }
-    if saved.stop_reason == "completed" {
+    if !saved.stop_reason.resumable() {
         println!("nothing to resume: {} is complete", path.display());
         return Ok(None);
     }
@@ -234,7 +241,13 @@ fn execute(args: &SweepArgs, setup: Setup) -> ExitCode {
     let before = setup.done.len();
     let bar = progress_bar(members, before);
     let kind = setup.job.kind();
-    let running = header(&setup.problem, &setup.sweep, setup.shard, kind, "running");
+    let running = header(
+        &setup.problem,
+        &setup.sweep,
+        setup.shard,
+        kind,
+        RunState::InProgress,
+    );
     let last_save = Mutex::new(Instant::now());
     let on_point = |all: &[Record]| {
         bar.set_position(all.len() as u64);
@@ -283,9 +296,13 @@ fn execute(args: &SweepArgs, setup: Setup) -> ExitCode {
 /// Writes the final file (marked completed or interrupted), reports, and
 /// draws the chart of a completed sweep.
 fn finish(args: &SweepArgs, running: SweepHeader, records: &[Record], stopped: bool) -> ExitCode {
-    let reason = if stopped { "interrupted" } else { "completed" };
+    let reason = if stopped {
+        RunState::Interrupted
+    } else {
+        RunState::Completed
+    };
     let header = SweepHeader {
-        stop_reason: reason.into(),
+        stop_reason: reason,
         ..running
     };
     if let Err(e) = write_sweep(&args.output, &header, records, true) {
@@ -411,7 +428,7 @@ pub fn run_merge(inputs: &[PathBuf], output: &Path, chart: Option<&Path>, force:
                 );
             }
         }
-        complete &= h.stop_reason == "completed";
+        complete &= h.stop_reason == RunState::Completed;
         let seen: std::collections::BTreeSet<usize> = records.iter().map(|r| r.index).collect();
         if let Some(dup) = r.iter().find(|x| seen.contains(&x.index)) {
             return fail(
@@ -438,9 +455,9 @@ pub fn run_merge(inputs: &[PathBuf], output: &Path, chart: Option<&Path>, force:
     header.shard = "merged".into();
     header.members = header.points();
     header.stop_reason = if complete && records.len() == header.points() {
-        "completed".into()
+        RunState::Completed
     } else {
-        "partial".into()
+        RunState::Partial
     };
     if let Err(e) = write_sweep(output, &header, &records, true) {
         return fail(OUTPUT, e);

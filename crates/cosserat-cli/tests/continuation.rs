@@ -77,7 +77,11 @@ fn euler_branch_point_and_the_elastica() {
     // (Timoshenko & Gere, Sec. 2.7).
     for &child in &bp.children {
         let b = &d.branches[child];
-        assert!(b.stop_reason.contains("tip angle"), "{}", b.stop_reason);
+        assert!(
+            b.stop_reason.to_string().contains("tip angle"),
+            "{}",
+            b.stop_reason
+        );
         for p in b.points.iter().skip(1) {
             let k = (p.tip_angle / 2.0).sin();
             let exact = ellip_f(PI / 2.0, k).powi(2);

@@ -1106,7 +1106,7 @@ fn damaged_sealed_files_are_refused_before_hdf5_reads_them() {
     .into_iter()
     .enumerate()
     {
-        for at in [100, bytes.len() / 2, bytes.len() - 30] {
+        for at in [100, bytes.len() / 2, bytes.len() - 30, bytes.len() - 20] {
             let case_dir = dir.join(format!("case{k}-{at}"));
             std::fs::create_dir_all(&case_dir).unwrap();
             let mut b = bytes.clone();

@@ -492,3 +492,27 @@ fn long_computations_stop_when_asked() {
         assert!((1..=7).contains(&points), "{points} points");
     }
 }
+
+/// A stop that arrives inside a Nelder–Mead polish — even while argmin
+/// evaluates its first simplex, which unwraps every cost — ends the search
+/// as interrupted, never as a panic (found by the hostile-input harness).
+#[test]
+fn search_stops_inside_a_polish() {
+    let (arm, search) = arm_from_file("longest_arm_fig5.toml", &[]);
+    let scene = ArmScene::default();
+    let opts = SearchOptions {
+        samples: 32,
+        ..search
+    };
+    for calls in [32, 33, 34, 36, 40, 60, 120] {
+        let (_, progress, interrupted) = arm.search(
+            &scene,
+            &opts,
+            cosserat::optimize::SearchProgress::default(),
+            &stop_after(calls),
+            &mut |_| {},
+        );
+        assert!(interrupted, "stopped after {calls} calls");
+        assert!(progress.polishes_done < opts.starts, "{calls}");
+    }
+}

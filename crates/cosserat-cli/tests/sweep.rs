@@ -93,7 +93,7 @@ fn bits(records: &[Record]) -> Vec<Bits> {
         .collect()
 }
 
-fn stop_reason(path: &Path) -> String {
+fn stop_reason(path: &Path) -> cosserat::continuation::RunState {
     read_sweep(path).unwrap().0.stop_reason
 }
 
@@ -250,7 +250,7 @@ fn killed_sweep_resumes_to_the_same_results() {
     child.kill().unwrap();
     let _ = child.wait();
     let (h, saved) = read_sweep(&partial).expect("the checkpoint is a valid sweep file");
-    assert_eq!(h.stop_reason, "running");
+    assert_eq!(h.stop_reason, "in progress");
     assert!(
         !saved.is_empty() && saved.len() < 60,
         "{} points saved",

@@ -335,7 +335,11 @@ fn continuation_recovers_on_multiple_shooting_for_a_long_rod() {
             let b = &d.branches[0];
             let last = b.points.last().unwrap().parameter;
             assert!(last < 1.0, "single shooting reached the end: {last}");
-            assert!(!b.stop_reason.contains("bound"), "{}", b.stop_reason);
+            assert!(
+                !b.stop_reason.to_string().contains("bound"),
+                "{}",
+                b.stop_reason
+            );
         }
     }
     let multiple = Problem::from_str_with(&text("multiple-shooting"), &[]).unwrap();

@@ -157,8 +157,8 @@ pub struct Branch {
     pub points: Vec<Point>,
     /// The special point it was switched from.
     pub parent: Option<usize>,
-    /// Why it ended ("in progress" while it is followed).
-    pub stop_reason: String,
+    /// Why it ended ([`BranchEnd::InProgress`] while it is followed).
+    pub stop_reason: BranchEnd,
     /// The direction of travel: +1 along the stored tangents, −1 against
     /// them (the backward half of a `both_directions` start).
     pub direction: f64,
@@ -181,14 +181,11 @@ pub struct Diagram {
     pub nodes: Vec<f64>,
     /// Why the whole run ended: "in progress" while it runs (what a
     /// checkpoint records), then "completed" or "interrupted".
-    pub stop_reason: String,
+    pub stop_reason: RunState,
     /// What the run noticed but could not settle: events detected (a Morse
     /// index that changed) that could not be located.
     pub warnings: Vec<String>,
 }
-
-/// The run's stop reason while it runs.
-pub const IN_PROGRESS: &str = "in progress";
 
 /// Why continuation could not start.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -236,7 +233,7 @@ pub fn continuation(
         special_points: vec![],
         eigenvalue_names: run.tracker.names(),
         nodes: run.tracker.nodes(),
-        stop_reason: IN_PROGRESS.into(),
+        stop_reason: RunState::InProgress,
         warnings: vec![],
     };
     // (start point, direction sign, parent special point, depth)
@@ -262,14 +259,14 @@ fn drain(
     mut queue: Vec<Pending>,
     monitor: &mut dyn FnMut(Progress, &Diagram) -> bool,
 ) {
-    diagram.stop_reason = IN_PROGRESS.into();
+    diagram.stop_reason = RunState::InProgress;
     while !queue.is_empty() {
         let (start, sign, parent, depth) = queue.remove(0);
         let index = diagram.branches.len();
         diagram.branches.push(Branch {
             points: vec![],
             parent,
-            stop_reason: IN_PROGRESS.into(),
+            stop_reason: BranchEnd::InProgress,
             direction: sign,
             next_step: run.opts.step,
         });
@@ -279,12 +276,12 @@ fn drain(
         let outcome = run.follow(start, sign, index, diagram, monitor);
         diagram.branches[index].stop_reason = outcome.stop_reason.clone();
         if outcome.interrupted {
-            diagram.stop_reason = "interrupted".into();
+            diagram.stop_reason = RunState::Interrupted;
             return;
         }
         queue.extend(run.switches(diagram, &outcome.special_points, depth));
     }
-    diagram.stop_reason = "completed".into();
+    diagram.stop_reason = RunState::Completed;
 }
 
 impl Run<'_> {
@@ -329,7 +326,7 @@ type Stepped = (Vec<f64>, f64, Vec<f64>, usize);
 /// What following one branch produced.
 struct Outcome {
     special_points: Vec<usize>,
-    stop_reason: String,
+    stop_reason: BranchEnd,
     interrupted: bool,
 }
 
@@ -530,25 +527,28 @@ impl<'a> Run<'a> {
         Ok(Some((z[..n].to_vec(), z[n], stored, iterations)))
     }
 
-    fn stop_reason(&self, point: &Point, count: usize) -> Option<String> {
+    fn stop_reason(&self, point: &Point, count: usize) -> Option<BranchEnd> {
         let (lo, hi) = self.opts.bounds;
         if point.parameter < lo || point.parameter > hi {
-            return Some(format!("parameter {} left [{lo}, {hi}]", point.parameter));
+            return Some(BranchEnd::LeftBounds {
+                parameter: point.parameter,
+                bounds: (lo, hi),
+            });
         }
         if count > 1 && (point.parameter == lo || point.parameter == hi) {
-            return Some(format!("reached the bound {}", point.parameter));
+            return Some(BranchEnd::ReachedBound(point.parameter));
         }
         if count >= self.opts.max_points {
-            return Some(format!("{count} points"));
+            return Some(BranchEnd::MaxPoints(count));
         }
-        if let Some(limit) = self.opts.tip_angle_limit {
-            let rod = self.family.rod_at(point.parameter).ok()?;
-            let angle = tip_angle(&rod.clamp.frame, &point.tip);
-            if angle >= limit {
-                return Some(format!("tip angle {:.2}° reached", angle.to_degrees()));
+        // The point's own tip angle, measured against its clamp when the
+        // point was made.
+        match self.opts.tip_angle_limit {
+            Some(limit) if point.tip_angle >= limit => {
+                Some(BranchEnd::TipAngle(point.tip_angle.to_degrees()))
             }
+            _ => None,
         }
-        None
     }
 
     /// A step that leaves [min, max] is pulled back onto the bound it
@@ -606,7 +606,7 @@ impl<'a> Run<'a> {
             Err(e) => {
                 return Outcome {
                     special_points: vec![],
-                    stop_reason: format!("start point failed: {e}"),
+                    stop_reason: BranchEnd::StartFailed(e.to_string()),
                     interrupted: false,
                 }
             }
@@ -626,7 +626,7 @@ impl<'a> Run<'a> {
         monitor: &mut dyn FnMut(Progress, &Diagram) -> bool,
     ) -> Outcome {
         let mut specials = vec![];
-        let end = |specials: Vec<usize>, reason: String, interrupted: bool| Outcome {
+        let end = |specials: Vec<usize>, reason: BranchEnd, interrupted: bool| Outcome {
             special_points: specials,
             stop_reason: reason,
             interrupted,
@@ -643,20 +643,17 @@ impl<'a> Run<'a> {
                 Ok(None) => {
                     ds *= 0.5;
                     if ds < self.opts.min_step {
-                        let reason = format!(
-                            "step size below {:.1e}: the corrector does not converge",
-                            self.opts.min_step
-                        );
+                        let reason = BranchEnd::StepTooSmall(self.opts.min_step);
                         return end(specials, reason, false);
                     }
                     continue;
                 }
-                Err(e) => return end(specials, format!("stopped: {e}"), false),
+                Err(e) => return end(specials, BranchEnd::Failed(e.to_string()), false),
             };
             let (x, p, tangent) = self.land_on_bound(&last, x, p, tangent);
             let next = match self.point(x, p, tangent) {
                 Ok(pt) => pt,
-                Err(e) => return end(specials, format!("stopped: {e}"), false),
+                Err(e) => return end(specials, BranchEnd::Failed(e.to_string()), false),
             };
             let index = diagram.branches[branch].points.len() - 1;
             let (found, missed) = self.events(&last, &next, sign, branch, index);
@@ -677,7 +674,7 @@ impl<'a> Run<'a> {
                 parameter: p,
             };
             if !monitor(progress, diagram) {
-                return end(specials, "interrupted".into(), true);
+                return end(specials, BranchEnd::Interrupted, true);
             }
         }
     }
@@ -685,5 +682,8 @@ impl<'a> Run<'a> {
 
 mod events;
 mod resume;
+mod status;
+
+pub use status::{BranchEnd, RunState};
 
 pub use resume::{resume, SavedBranch, SavedDiagram, SavedSpecial};

@@ -9,7 +9,7 @@
 use super::{
     drain, Branch, ContinuationError, Diagram, Pending, Point, Run, SpecialKind, SpecialPoint,
 };
-use super::{ContinuationOptions, Family};
+use super::{BranchEnd, ContinuationOptions, Family, RunState};
 use crate::stability::Block;
 
 /// One saved branch.
@@ -23,8 +23,8 @@ pub struct SavedBranch {
     pub tangent: Vec<Vec<f64>>,
     /// The special point it was switched from.
     pub parent: Option<usize>,
-    /// Why it ended ("interrupted" and "in progress" are resumed).
-    pub stop_reason: String,
+    /// Why it ended (in progress and interrupted branches are resumed).
+    pub stop_reason: BranchEnd,
     /// The direction of travel along the stored tangents (±1).
     pub direction: f64,
     /// The arclength step the next point would be tried with.
@@ -62,13 +62,9 @@ pub struct SavedDiagram {
     /// Special points.
     pub specials: Vec<SavedSpecial>,
     /// Why the run ended.
-    pub stop_reason: String,
+    pub stop_reason: RunState,
     /// Events detected but not located.
     pub warnings: Vec<String>,
-}
-
-fn unfinished(reason: &str) -> bool {
-    reason == "interrupted" || reason == super::IN_PROGRESS
 }
 
 impl SavedDiagram {
@@ -143,7 +139,7 @@ pub fn resume(
         special_points: vec![],
         eigenvalue_names: run.tracker.names(),
         nodes: run.tracker.nodes(),
-        stop_reason: super::IN_PROGRESS.into(),
+        stop_reason: RunState::InProgress,
         warnings: saved.warnings.clone(),
     };
     for s in &saved.specials {
@@ -173,14 +169,14 @@ pub fn resume(
     }
     // The interrupted branch goes on from its last point.
     if let Some(last) = diagram.branches.len().checked_sub(1) {
-        if unfinished(&diagram.branches[last].stop_reason)
+        if diagram.branches[last].stop_reason.resumable()
             && !diagram.branches[last].points.is_empty()
         {
             let sign = diagram.branches[last].direction;
             let outcome = run.walk(sign, last, &mut diagram, monitor);
             diagram.branches[last].stop_reason = outcome.stop_reason.clone();
             if outcome.interrupted {
-                diagram.stop_reason = "interrupted".into();
+                diagram.stop_reason = RunState::Interrupted;
                 return Ok(diagram);
             }
         }

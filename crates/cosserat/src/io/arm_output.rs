@@ -41,6 +41,7 @@
 //! attributes `samples_done`, `polishes_done`, `evaluations`, and the
 //! datasets `leader_reach` (k) and `leader_points` (k×(M−1)).
 
+use crate::continuation::RunState;
 use std::path::Path;
 
 use super::hdf5_output::{array, string_attr, write_atomically, OutputError};
@@ -72,9 +73,9 @@ fn count(g: &hdf5::Location, name: &str, v: usize) -> hdf5::Result<()> {
 
 fn stop_reason(interrupted: bool) -> &'static str {
     if interrupted {
-        "interrupted"
+        RunState::Interrupted.name()
     } else {
-        "completed"
+        RunState::Completed.name()
     }
 }
 
@@ -93,8 +94,8 @@ pub struct ArmStudy<'a> {
     pub least_curvature: Option<&'a ClosestStraight>,
     /// How far the search came (to resume from).
     pub progress: Option<&'a SearchProgress>,
-    /// `completed` or `interrupted`.
-    pub stop_reason: &'a str,
+    /// Completed, or interrupted (resumable).
+    pub stop_reason: RunState,
 }
 
 /// Writes the optimum (and the straight arm, if computed) atomically.
@@ -103,7 +104,7 @@ pub fn write_arm(
     problem: &str,
     optimum: &ArmOptimum,
     straight: Option<&StraightArm>,
-    stop_reason: &str,
+    stop_reason: RunState,
     force: bool,
 ) -> Result<(), OutputError> {
     let study = ArmStudy {
@@ -127,7 +128,7 @@ pub fn write_arm_study(
 ) -> Result<(), OutputError> {
     write_atomically(path, force, |file| {
         string_attr(file, "problem", problem)?;
-        string_attr(file, "stop_reason", study.stop_reason)?;
+        string_attr(file, "stop_reason", study.stop_reason.name())?;
         let g = file.create_group("optimum")?;
         write_design(&g, study.optimum)?;
         scalar(&g, "gamma_crit", study.optimum.critical_load)?;
@@ -230,8 +231,8 @@ fn write_progress(file: &hdf5::File, p: &SearchProgress) -> hdf5::Result<()> {
 pub struct SavedSearch {
     /// The effective problem text the run was made from.
     pub problem: String,
-    /// `completed` or `interrupted`.
-    pub stop_reason: String,
+    /// Completed, or interrupted (resumable).
+    pub stop_reason: RunState,
     /// How far the search came.
     pub progress: SearchProgress,
     /// c1..cM of the best design so far.
@@ -266,7 +267,12 @@ pub fn read_search(path: &Path) -> hdf5::Result<SavedSearch> {
         .collect();
     Ok(SavedSearch {
         problem: text("problem")?,
-        stop_reason: text("stop_reason")?,
+        stop_reason: {
+            let name = text("stop_reason")?;
+            RunState::from_name(&name).ok_or_else(|| {
+                hdf5::Error::from(format!("unknown stop_reason `{name}`").as_str())
+            })?
+        },
         progress: SearchProgress {
             samples_done: n("samples_done")?,
             polishes_done: n("polishes_done")?,

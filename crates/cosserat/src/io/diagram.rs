@@ -17,7 +17,9 @@ use std::path::Path;
 use hdf5::types::VarLenUnicode;
 
 use super::hdf5_output::{array, string_attr, text, write_atomically, OutputError};
-use crate::continuation::{Diagram, SavedBranch, SavedDiagram, SavedSpecial, SpecialKind};
+use crate::continuation::{
+    BranchEnd, Diagram, RunState, SavedBranch, SavedDiagram, SavedSpecial, SpecialKind,
+};
 use crate::stability::Block;
 
 fn integers(group: &hdf5::Group, name: &str, data: &[u64]) -> hdf5::Result<()> {
@@ -48,7 +50,7 @@ pub fn write_diagram(
     write_atomically(path, force, |file| {
         string_attr(file, "problem", problem)?;
         string_attr(file, "parameter_name", parameter)?;
-        string_attr(file, "stop_reason", &diagram.stop_reason)?;
+        string_attr(file, "stop_reason", diagram.stop_reason.name())?;
         string_attr(
             file,
             "generator",
@@ -107,7 +109,7 @@ fn write_branches(file: &hdf5::File, d: &Diagram) -> hdf5::Result<()> {
         g.new_attr::<i64>()
             .create("parent")?
             .write_scalar(&b.parent.map_or(-1, |p| p as i64))?;
-        string_attr(&g, "stop_reason", &b.stop_reason)?;
+        string_attr(&g, "stop_reason", &b.stop_reason.to_string())?;
         g.new_attr::<f64>()
             .create("direction")?
             .write_scalar(&b.direction)?;
@@ -215,7 +217,7 @@ pub fn read_saved(path: &Path) -> hdf5::Result<(String, SavedDiagram)> {
             unknowns: rows(&g, "unknowns")?,
             tangent: rows(&g, "tangent")?,
             parent: usize::try_from(parent).ok(),
-            stop_reason: read_string(&g, "stop_reason")?,
+            stop_reason: BranchEnd::from_text(&read_string(&g, "stop_reason")?),
             direction: g.attr("direction")?.read_scalar::<f64>()?,
             next_step: g.attr("next_step")?.read_scalar::<f64>()?,
         });
@@ -274,7 +276,12 @@ pub fn read_saved(path: &Path) -> hdf5::Result<(String, SavedDiagram)> {
         SavedDiagram {
             branches,
             specials,
-            stop_reason: read_string(&f, "stop_reason")?,
+            stop_reason: {
+                let name = read_string(&f, "stop_reason")?;
+                RunState::from_name(&name).ok_or_else(|| {
+                    hdf5::Error::from(format!("unknown stop_reason `{name}`").as_str())
+                })?
+            },
             warnings: f
                 .dataset("warnings")?
                 .read_raw::<VarLenUnicode>()?

@@ -70,7 +70,10 @@ pub fn check(path: &Path) -> Result<Seal, String> {
     let mut tail = [0u8; 24];
     f.seek(SeekFrom::Start(len - TRAILER)).map_err(fail)?;
     f.read_exact(&mut tail).map_err(fail)?;
-    if &tail[..16] != MAGIC {
+    // A seal whose magic is itself damaged is still a seal: 12 of its 16
+    // bytes in place cannot happen by chance in an unsealed file.
+    let alike = tail[..16].iter().zip(MAGIC).filter(|(a, b)| a == b).count();
+    if alike < 12 {
         return Ok(Seal::Absent);
     }
     f.seek(SeekFrom::Start(0)).map_err(fail)?;

@@ -18,6 +18,7 @@
 //! Written atomically (temporary file, then rename), so a checkpoint is
 //! always a whole file.
 
+use crate::continuation::RunState;
 use std::collections::BTreeSet;
 use std::path::Path;
 
@@ -36,8 +37,8 @@ pub struct SweepHeader {
     pub kind: String,
     /// `i/n` or `merged`.
     pub shard: String,
-    /// `running`, `interrupted` or `completed`.
-    pub stop_reason: String,
+    /// In progress (a checkpoint), interrupted, completed, or partial (a merge).
+    pub stop_reason: RunState,
     /// The swept keys.
     pub keys: Vec<String>,
     /// Their values.
@@ -87,7 +88,7 @@ pub fn write_sweep(
             ("problem", &header.problem),
             ("kind", &header.kind),
             ("shard", &header.shard),
-            ("stop_reason", &header.stop_reason),
+            ("stop_reason", &header.stop_reason.name().to_string()),
             (
                 "generator",
                 &concat!("cosserat ", env!("CARGO_PKG_VERSION")).to_string(),
@@ -224,7 +225,12 @@ pub fn read_sweep(path: &Path) -> hdf5::Result<(SweepHeader, Vec<Record>)> {
         problem: read_string(&f, "problem")?,
         kind: read_string(&f, "kind")?,
         shard: read_string(&f, "shard")?,
-        stop_reason: read_string(&f, "stop_reason")?,
+        stop_reason: {
+            let name = read_string(&f, "stop_reason")?;
+            RunState::from_name(&name).ok_or_else(|| {
+                hdf5::Error::from(format!("unknown stop_reason `{name}`").as_str())
+            })?
+        },
         keys,
         axes,
         members: f.attr("members")?.read_scalar::<u64>()? as usize,

@@ -110,7 +110,10 @@ impl argmin::core::CostFunction for &CurvatureCost<'_> {
 
     fn cost(&self, p: &Vec<f64>) -> Result<f64, argmin::core::Error> {
         if (self.stop)() {
-            return Err(argmin::core::Error::msg("interrupted"));
+            // Stopping: the worst cost, not an error — argmin's Nelder–Mead
+            // unwraps the costs of its first simplex (a panic), and the
+            // caller discards a polish that ran into a stop.
+            return Ok(f64::INFINITY);
         }
         let q = self.problem.project(p);
         let outside: f64 = p.iter().zip(&q).map(|(a, b)| (a - b).powi(2)).sum();

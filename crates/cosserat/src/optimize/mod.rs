@@ -527,7 +527,10 @@ impl CostFunction for &ReachCost<'_> {
 
     fn cost(&self, p: &Vec<f64>) -> Result<f64, ArgminError> {
         if (self.stop)() {
-            return Err(ArgminError::msg("interrupted"));
+            // Stopping: the worst cost, not an error — argmin's Nelder–Mead
+            // unwraps the costs of its first simplex (a panic), and the
+            // caller discards a polish that ran into a stop.
+            return Ok(f64::INFINITY);
         }
         self.calls.set(self.calls.get() + 1);
         let q = self.problem.project(p);

@@ -1,0 +1,137 @@
+//! Where a run stands and why a branch ended: values, not strings. They
+//! are written to result files as their names (`RunState::name`, the
+//! `Display` of `BranchEnd`) and read back by name, so that a resumed run
+//! writes the same text an uninterrupted one does.
+
+use std::fmt;
+
+/// How a whole run (a diagram, a sweep, an arm study) stands.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RunState {
+    /// Running: what a checkpoint records (resumable).
+    InProgress,
+    /// Every point asked for is computed.
+    Completed,
+    /// Stopped by a signal; the finished points are kept (resumable).
+    Interrupted,
+    /// A merge of shard files that does not hold every point.
+    Partial,
+}
+
+impl RunState {
+    /// The name in result files.
+    pub fn name(self) -> &'static str {
+        match self {
+            RunState::InProgress => "in progress",
+            RunState::Completed => "completed",
+            RunState::Interrupted => "interrupted",
+            RunState::Partial => "partial",
+        }
+    }
+
+    /// The state of a name; `running` is what sweep files of earlier
+    /// versions wrote for a checkpoint.
+    pub fn from_name(name: &str) -> Option<RunState> {
+        match name {
+            "in progress" | "running" => Some(RunState::InProgress),
+            "completed" => Some(RunState::Completed),
+            "interrupted" => Some(RunState::Interrupted),
+            "partial" => Some(RunState::Partial),
+            _ => None,
+        }
+    }
+
+    /// Whether `--resume` has something to do.
+    pub fn resumable(self) -> bool {
+        matches!(self, RunState::InProgress | RunState::Interrupted)
+    }
+}
+
+impl fmt::Display for RunState {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl PartialEq<&str> for RunState {
+    fn eq(&self, other: &&str) -> bool {
+        self.name() == *other
+    }
+}
+
+/// Why a branch ended.
+#[derive(Debug, Clone, PartialEq)]
+pub enum BranchEnd {
+    /// Still being followed (what a checkpoint records).
+    InProgress,
+    /// Stopped by a signal after its last point.
+    Interrupted,
+    /// A step left the parameter bounds (and could not land on them).
+    LeftBounds {
+        /// The parameter of the last point.
+        parameter: f64,
+        /// The bounds.
+        bounds: (f64, f64),
+    },
+    /// The branch landed exactly on a bound.
+    ReachedBound(f64),
+    /// The branch has the most points allowed.
+    MaxPoints(usize),
+    /// The tip turned by the angle limit (degrees).
+    TipAngle(f64),
+    /// The step fell below the smallest step: the corrector does not
+    /// converge there.
+    StepTooSmall(f64),
+    /// A point could not be evaluated.
+    Failed(String),
+    /// The branch's first point could not be evaluated.
+    StartFailed(String),
+    /// An ended branch read back from a file, by its text.
+    Recorded(String),
+}
+
+impl BranchEnd {
+    /// Whether the branch goes on when the run is resumed.
+    pub fn resumable(&self) -> bool {
+        matches!(self, BranchEnd::InProgress | BranchEnd::Interrupted)
+    }
+
+    /// The end of a branch from its text in a file.
+    pub fn from_text(text: &str) -> BranchEnd {
+        match text {
+            "in progress" => BranchEnd::InProgress,
+            "interrupted" => BranchEnd::Interrupted,
+            other => BranchEnd::Recorded(other.to_string()),
+        }
+    }
+}
+
+impl fmt::Display for BranchEnd {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            BranchEnd::InProgress => f.write_str("in progress"),
+            BranchEnd::Interrupted => f.write_str("interrupted"),
+            BranchEnd::LeftBounds {
+                parameter,
+                bounds: (lo, hi),
+            } => write!(f, "parameter {parameter} left [{lo}, {hi}]"),
+            BranchEnd::ReachedBound(b) => write!(f, "reached the bound {b}"),
+            BranchEnd::MaxPoints(n) => write!(f, "{n} points"),
+            BranchEnd::TipAngle(deg) => write!(f, "tip angle {deg:.2}° reached"),
+            BranchEnd::StepTooSmall(min) => write!(
+                f,
+                "step size below {min:.1e}: the corrector does not converge"
+            ),
+            BranchEnd::Failed(e) => write!(f, "stopped: {e}"),
+            BranchEnd::StartFailed(e) => write!(f, "start point failed: {e}"),
+            BranchEnd::Recorded(text) => f.write_str(text),
+        }
+    }
+}
+
+impl PartialEq<&str> for BranchEnd {
+    fn eq(&self, other: &&str) -> bool {
+        let text = self.to_string();
+        text.as_str() == *other
+    }
+}
