@@ -1,0 +1,554 @@
+//! The collocation equations on one mesh and the condensed Newton step.
+//!
+//! Unknowns x = [u | y_1 … y_N | Y_0 … Y_{N−1}] (y_0 = y(0; u)); per
+//! interval i of width h the residual is
+//!
+//!   Y_ij − y_i − h Σ_l a_jl f(s_i + c_l h, Y_il),   j = 1 … m,
+//!   y_{i+1} − y_i − h Σ_j b_j f(s_i + c_j h, Y_ij),
+//!
+//! then the tip conditions g(y_N), all scaled by the state scales.
+//!
+//! The Newton matrix is condensed interval by interval (AMR §7.2.1): with
+//! the stage matrix W = I − h (A ⊗ I) diag(J_j), J_j = ∂f/∂y at stage j,
+//! the stage corrections are δY = v + Z δy_i with W Z = E (stacked
+//! identities), which leaves δy_{i+1} − Γ_i δy_i = c_i with
+//! Γ_i = I + h Σ_j b_j J_j Z_j. These node rows, δy_0 = S δu and the tip
+//! rows form a banded system factored by [`BandLu`], so a Newton step
+//! costs O(N). Also the starting unknowns (warm, IVP or straight rod) and
+//! the conversion of converged unknowns into a [`CollocationSolution`].
+
+use nalgebra::DMatrix;
+
+use super::iteration::{Linearization, NewtonOutcome};
+use super::lu::{dense_lu, dense_solve, BandLu};
+use super::{CollocationSolution, Tableau};
+use crate::equations::{RodEquations, RodSample};
+use crate::numerics::integrator::{Dop853, Tolerances};
+
+/// The collocation equations on one mesh. Unknown vector layout:
+/// [u (p) | y_1 … y_N (n each) | Y_0 … Y_{N−1} (m·n each)].
+pub(super) struct Grid<'a> {
+    pub(super) eq: &'a dyn RodEquations,
+    pub(super) tab: Tableau,
+    pub(super) mesh: Vec<f64>,
+    pub(super) n: usize,
+    pub(super) p: usize,
+    /// 1 / state scale, per component.
+    pub(super) w: Vec<f64>,
+    /// ∂y_0/∂u.
+    pub(super) sens: DMatrix<f64>,
+    /// The n × n identity, column-major: the tangent vectors that make
+    /// `rhs_linearized` return the Jacobian ∂f/∂y (one call per point).
+    pub(super) ident: Vec<f64>,
+}
+
+/// Buffers of one interval's stage computations, reused across intervals
+/// and iterations (no allocation per interval).
+pub(super) struct Scratch {
+    /// f at the m stages (m·n).
+    pub(super) f: Vec<f64>,
+    /// ∂f/∂y at the m stages, each n × n column-major.
+    pub(super) jac: Vec<f64>,
+    /// The stage matrix W (mn × mn, row-major), factored in place.
+    pub(super) w: Vec<f64>,
+    pub(super) piv: Vec<usize>,
+    /// A stage-sized right-hand side (m·n).
+    pub(super) g: Vec<f64>,
+}
+
+impl Scratch {
+    pub(super) fn new(n: usize, m: usize) -> Self {
+        let mn = m * n;
+        Scratch {
+            f: vec![0.0; mn],
+            jac: vec![0.0; m * n * n],
+            w: vec![0.0; mn * mn],
+            piv: vec![0; mn],
+            g: vec![0.0; mn],
+        }
+    }
+}
+
+impl<'a> Grid<'a> {
+    pub(super) fn new(eq: &'a dyn RodEquations, tab: Tableau, mesh: Vec<f64>) -> Self {
+        let n = eq.dim();
+        Grid {
+            eq,
+            tab,
+            mesh,
+            n,
+            p: eq.unknowns(),
+            w: eq.state_scales().iter().map(|v| 1.0 / v).collect(),
+            sens: eq.initial_sensitivity(),
+            ident: DMatrix::<f64>::identity(n, n).as_slice().to_vec(),
+        }
+    }
+
+    pub(super) fn intervals(&self) -> usize {
+        self.mesh.len() - 1
+    }
+
+    pub(super) fn size(&self) -> usize {
+        let (n, m, k) = (self.n, self.tab.m, self.intervals());
+        self.p + n * k + m * n * k
+    }
+
+    /// Offset of the stage values of interval i.
+    pub(super) fn stage_offset(&self, i: usize) -> usize {
+        self.p + self.n * self.intervals() + i * self.tab.m * self.n
+    }
+
+    /// The node state y_i (y_0 from u).
+    pub(super) fn node(&self, x: &[f64], i: usize) -> Vec<f64> {
+        let (n, p) = (self.n, self.p);
+        if i == 0 {
+            let mut y0 = vec![0.0; n];
+            self.eq.initial_state(&x[..p], &mut y0);
+            y0
+        } else {
+            x[p + n * (i - 1)..p + n * i].to_vec()
+        }
+    }
+
+    /// The node state y_i for i ≥ 1, or `y0` (y_0 computed by the caller).
+    pub(super) fn node_ref<'x>(&self, x: &'x [f64], y0: &'x [f64], i: usize) -> &'x [f64] {
+        let (n, p) = (self.n, self.p);
+        if i == 0 {
+            y0
+        } else {
+            &x[p + n * (i - 1)..p + n * i]
+        }
+    }
+
+    pub(super) fn stages<'x>(&self, x: &'x [f64], i: usize) -> &'x [f64] {
+        let o = self.stage_offset(i);
+        &x[o..o + self.tab.m * self.n]
+    }
+
+    /// (s_i, h_i).
+    pub(super) fn span(&self, i: usize) -> (f64, f64) {
+        (self.mesh[i], self.mesh[i + 1] - self.mesh[i])
+    }
+
+    /// The starting unknowns: interpolated from a warm start, or else a
+    /// cold start from the guessed clamp curvature u: the initial value
+    /// problem from u integrated with DOP853 (tolerance 1e-8) through the
+    /// nodes and stage points — for an unloaded rod that is its intrinsic
+    /// shape, however much it spirals — with the straight rod beyond a
+    /// blow-up; or, with `straight`, the straight rod.
+    pub(super) fn start_from(
+        &self,
+        warm: Option<&CollocationSolution>,
+        guess: Option<&[f64]>,
+        straight: bool,
+    ) -> Vec<f64> {
+        let u = match warm {
+            Some(w) => self.eq.unknowns_of(&w.states[0]),
+            None => guess.map_or_else(|| self.eq.initial_guess(), <[f64]>::to_vec),
+        };
+        // Points in order: per interval its stage points, then its right node.
+        let k = self.intervals();
+        let mut points = Vec::with_capacity(k * (self.tab.m + 1));
+        for i in 0..k {
+            let (s, h) = self.span(i);
+            points.extend(self.tab.c.iter().map(|c| s + c * h));
+            points.push(self.mesh[i + 1]);
+        }
+        let (n, m) = (self.n, self.tab.m);
+        let mut x = u;
+        x.reserve(self.size());
+        if let Some(w) = warm {
+            // Interpolated straight into x: the nodes, then the stages.
+            let (p, o) = (x.len(), x.len() + n * k);
+            x.resize(self.size(), 0.0);
+            for i in 0..k {
+                for (j, &s) in points[i * (m + 1)..(i + 1) * (m + 1)].iter().enumerate() {
+                    let r = if j == m {
+                        p + n * i..p + n * (i + 1)
+                    } else {
+                        o + (i * m + j) * n..o + (i * m + j + 1) * n
+                    };
+                    w.interpolate_into(s, &mut x[r]);
+                }
+            }
+            return x;
+        }
+        let states: Vec<Vec<f64>> = if straight {
+            points.iter().map(|&s| self.eq.straight_state(s)).collect()
+        } else {
+            self.integrate_guess(&x, &points)
+        };
+        for i in 0..k {
+            x.extend_from_slice(&states[i * (m + 1) + m]);
+        }
+        for i in 0..k {
+            for j in 0..m {
+                x.extend_from_slice(&states[i * (m + 1) + j]);
+            }
+        }
+        debug_assert!(states.iter().all(|y| y.len() == n));
+        debug_assert_eq!(x.len(), self.size());
+        x
+    }
+
+    /// y(s; u) of the initial value problem at sorted `points`.
+    pub(super) fn integrate_guess(&self, u: &[f64], points: &[f64]) -> Vec<Vec<f64>> {
+        let n = self.n;
+        let mut y = vec![0.0; n];
+        self.eq.initial_state(u, &mut y);
+        let tol = Tolerances {
+            rtol: 1e-8,
+            atol: 1e-8,
+            max_steps: 100_000,
+        };
+        let eq = self.eq;
+        let mut out = Vec::with_capacity(points.len());
+        let _ = Dop853::new(n).integrate(
+            |s, y: &[f64], d: &mut [f64]| eq.rhs(s, y, d),
+            0.0,
+            eq.length(),
+            &mut y,
+            n,
+            &tol,
+            points,
+            |_, y| out.push(y.to_vec()),
+            |y| eq.project(y),
+        );
+        let usable = out.len().min(points.len());
+        out.truncate(usable);
+        let finite = out
+            .iter()
+            .position(|y| y.iter().any(|v| !v.is_finite()))
+            .unwrap_or(usable);
+        out.truncate(finite);
+        out.extend(points[finite..].iter().map(|&s| eq.straight_state(s)));
+        out
+    }
+
+    /// f at the m stages `st` of the step of width h from s, into `f`.
+    pub(super) fn stage_rates(&self, s: f64, h: f64, st: &[f64], f: &mut [f64]) {
+        let n = self.n;
+        for (j, c) in self.tab.c.iter().enumerate() {
+            let r = j * n..(j + 1) * n;
+            self.eq.rhs(s + c * h, &st[r.clone()], &mut f[r]);
+        }
+    }
+
+    /// f and ∂f/∂y at the m stages `st` (one `rhs_linearized` call each),
+    /// into `f` and `jac` (n × n column-major per stage).
+    pub(super) fn stage_jacobians(
+        &self,
+        s: f64,
+        h: f64,
+        st: &[f64],
+        f: &mut [f64],
+        jac: &mut [f64],
+    ) {
+        let n = self.n;
+        for (j, c) in self.tab.c.iter().enumerate() {
+            let r = j * n..(j + 1) * n;
+            self.eq.rhs_linearized(
+                s + c * h,
+                &st[r.clone()],
+                n,
+                &self.ident,
+                &mut f[r],
+                &mut jac[j * n * n..(j + 1) * n * n],
+            );
+        }
+    }
+
+    /// W = I − h (A ⊗ I) diag(J_l) (row-major, into `w`): the stage block of
+    /// the Jacobian.
+    pub(super) fn stage_matrix(&self, h: f64, jac: &[f64], w: &mut [f64]) {
+        let (n, m) = (self.n, self.tab.m);
+        let mn = m * n;
+        for j in 0..m {
+            for l in 0..m {
+                let coef = h * self.tab.a(j, l);
+                let jl = &jac[l * n * n..(l + 1) * n * n];
+                for r in 0..n {
+                    let row = &mut w[(j * n + r) * mn + l * n..(j * n + r) * mn + (l + 1) * n];
+                    for (c, v) in row.iter_mut().enumerate() {
+                        let id = if j == l && r == c { 1.0 } else { 0.0 };
+                        *v = id - jl[c * n + r] * coef;
+                    }
+                }
+            }
+        }
+    }
+
+    /// The scaled residual: per interval the m·n stage equations and the n
+    /// node equations, then the p tip conditions.
+    pub(super) fn residual(&self, x: &[f64]) -> Vec<f64> {
+        let (n, m, p) = (self.n, self.tab.m, self.p);
+        let mut r = Vec::with_capacity(self.size());
+        let mut y0 = vec![0.0; n];
+        self.eq.initial_state(&x[..p], &mut y0);
+        let mut f = vec![0.0; m * n];
+        for i in 0..self.intervals() {
+            let (s, h) = self.span(i);
+            let st = self.stages(x, i);
+            self.stage_rates(s, h, st, &mut f);
+            let y = self.node_ref(x, &y0, i);
+            for j in 0..m {
+                for k in 0..n {
+                    let acc: f64 = (0..m).map(|l| self.tab.a(j, l) * f[l * n + k]).sum();
+                    r.push((st[j * n + k] - y[k] - h * acc) * self.w[k]);
+                }
+            }
+            let next = self.node_ref(x, &y0, i + 1);
+            for k in 0..n {
+                let acc: f64 = (0..m).map(|j| self.tab.b[j] * f[j * n + k]).sum();
+                r.push((next[k] - y[k] - h * acc) * self.w[k]);
+            }
+        }
+        let mut g = vec![0.0; p];
+        self.eq
+            .tip_residual(self.node_ref(x, &y0, self.intervals()), &mut g);
+        r.extend_from_slice(&g);
+        r
+    }
+
+    /// Storage for the Newton matrix of this mesh.
+    pub(super) fn new_linearization(&self) -> Linearization {
+        let (n, m, p, k) = (self.n, self.tab.m, self.p, self.intervals());
+        let mn = m * n;
+        Linearization {
+            lu: vec![0.0; k * mn * mn],
+            piv: vec![0; k * mn],
+            z: vec![0.0; k * mn * n],
+            hbj: vec![0.0; k * m * n * n],
+            band: BandLu::zeros(p + n * k, 2 * n - 1 - p, n + p - 1),
+            valid: false,
+        }
+    }
+
+    /// The Newton matrix at x, condensed and factored into `lin` (reusing
+    /// its storage); false if singular.
+    pub(super) fn linearize(&self, x: &[f64], lin: &mut Linearization, ws: &mut Scratch) -> bool {
+        lin.valid = false;
+        let (n, p, k) = (self.n, self.p, self.intervals());
+        lin.band.clear();
+        let mut gamma = vec![0.0; n * n];
+        let mut gamma0 = vec![0.0; n * p];
+        for i in 0..k {
+            if !self.condense(i, self.stages(x, i), lin, ws, &mut gamma) {
+                return false;
+            }
+            let (g, cols): (&[f64], usize) = if i == 0 {
+                // Γ_0 S (n × p, row-major).
+                for r in 0..n {
+                    for c in 0..p {
+                        gamma0[r * p + c] =
+                            (0..n).map(|q| gamma[r * n + q] * self.sens[(q, c)]).sum();
+                    }
+                }
+                (&gamma0, p)
+            } else {
+                (&gamma, n)
+            };
+            let col = if i == 0 { 0 } else { p + n * (i - 1) };
+            for r in 0..n {
+                for c in 0..cols {
+                    lin.band
+                        .add(n * i + r, col + c, -g[r * cols + c] * self.w[r]);
+                }
+                lin.band.add(n * i + r, p + n * i + r, self.w[r]);
+            }
+        }
+        let y_tip = self.node(x, k);
+        let gt = self.eq.tip_residual_jacobian(&y_tip);
+        for r in 0..p {
+            for c in 0..n {
+                lin.band.add(n * k + r, p + n * (k - 1) + c, gt[(r, c)]);
+            }
+        }
+        lin.valid = lin.band.factor().is_ok();
+        lin.valid
+    }
+
+    /// Condensation of interval i into `lin`: δY = v + Z δy_i with W Z = E
+    /// (stacked identities), and Γ = I + h Σ_j b_j J_j Z_j (AMR §7.2.1),
+    /// into `gamma` (n × n, row-major); false if W is singular.
+    pub(super) fn condense(
+        &self,
+        i: usize,
+        st: &[f64],
+        lin: &mut Linearization,
+        ws: &mut Scratch,
+        gamma: &mut [f64],
+    ) -> bool {
+        let (n, m, (s, h)) = (self.n, self.tab.m, self.span(i));
+        let (mn, nn) = (m * n, n * n);
+        self.stage_jacobians(s, h, st, &mut ws.f, &mut ws.jac);
+        let lu = &mut lin.lu[i * mn * mn..(i + 1) * mn * mn];
+        let piv = &mut lin.piv[i * mn..(i + 1) * mn];
+        self.stage_matrix(h, &ws.jac, lu);
+        if !dense_lu(lu, mn, piv) {
+            return false;
+        }
+        let z = &mut lin.z[i * mn * n..(i + 1) * mn * n];
+        for c in 0..n {
+            let col = &mut z[c * mn..(c + 1) * mn];
+            col.iter_mut()
+                .enumerate()
+                .for_each(|(r, v)| *v = if r % n == c { 1.0 } else { 0.0 });
+            dense_solve(lu, mn, piv, col);
+        }
+        if !z.iter().all(|v| v.is_finite()) {
+            return false;
+        }
+        let hbj = &mut lin.hbj[i * m * nn..(i + 1) * m * nn];
+        for j in 0..m {
+            let hb = h * self.tab.b[j];
+            hbj[j * nn..(j + 1) * nn]
+                .iter_mut()
+                .zip(&ws.jac[j * nn..(j + 1) * nn])
+                .for_each(|(a, b)| *a = b * hb);
+        }
+        for r in 0..n {
+            for c in 0..n {
+                gamma[r * n + c] = if r == c { 1.0 } else { 0.0 };
+            }
+        }
+        for j in 0..m {
+            let hb = &hbj[j * nn..(j + 1) * nn];
+            for r in 0..n {
+                for c in 0..n {
+                    let zc = &z[c * mn + j * n..c * mn + (j + 1) * n];
+                    let t: f64 = (0..n).map(|q| hb[q * n + r] * zc[q]).sum();
+                    gamma[r * n + c] += t;
+                }
+            }
+        }
+        true
+    }
+
+    /// −J⁻¹F for a scaled residual F, in the unknowns' layout.
+    pub(super) fn newton_correction(&self, lin: &Linearization, f: &[f64]) -> Vec<f64> {
+        let (n, m, p, k) = (self.n, self.tab.m, self.p, self.intervals());
+        let (mn, nn) = (m * n, n * n);
+        let mut dx = vec![0.0; self.size()];
+        let (head, stages) = dx.split_at_mut(p + n * k);
+        for i in 0..k {
+            let base = i * (m + 1) * n;
+            let v = &mut stages[i * mn..(i + 1) * mn];
+            v.iter_mut()
+                .enumerate()
+                .for_each(|(r, a)| *a = -f[base + r] / self.w[r % n]);
+            dense_solve(
+                &lin.lu[i * mn * mn..(i + 1) * mn * mn],
+                mn,
+                &lin.piv[i * mn..(i + 1) * mn],
+                v,
+            );
+            let hbj = &lin.hbj[i * m * nn..(i + 1) * m * nn];
+            for r in 0..n {
+                let mut acc = -f[base + mn + r] / self.w[r];
+                for j in 0..m {
+                    let hb = &hbj[j * nn..(j + 1) * nn];
+                    let vj = &v[j * n..(j + 1) * n];
+                    acc += (0..n).map(|q| hb[q * n + r] * vj[q]).sum::<f64>();
+                }
+                head[n * i + r] = acc * self.w[r];
+            }
+        }
+        for q in 0..p {
+            head[n * k + q] = -f[k * (m + 1) * n + q];
+        }
+        lin.band.solve(head);
+        let mut dy0 = vec![0.0; n];
+        for (r, d) in dy0.iter_mut().enumerate() {
+            *d = (0..p).map(|c| self.sens[(r, c)] * head[c]).sum();
+        }
+        for i in 0..k {
+            let dyi = if i == 0 {
+                &dy0[..]
+            } else {
+                &head[p + n * (i - 1)..p + n * i]
+            };
+            let z = &lin.z[i * mn * n..(i + 1) * mn * n];
+            let v = &mut stages[i * mn..(i + 1) * mn];
+            for (r, a) in v.iter_mut().enumerate() {
+                let t: f64 = (0..n).map(|c| z[c * mn + r] * dyi[c]).sum();
+                *a += t;
+            }
+        }
+        dx
+    }
+
+    /// A weighted Euclidean norm of a correction (δy_0 = S δu, nodes and
+    /// stages, each component divided by its scale).
+    /// The typical magnitude of each unknown: the free initial values in
+    /// the scale of the state component they set, node states in the
+    /// state scales.
+    pub(super) fn unknown_scales(&self) -> Vec<f64> {
+        let (n, p) = (self.n, self.p);
+        let total = p + n * self.intervals();
+        (0..total)
+            .map(|q| {
+                let row = if q < p {
+                    (0..n).find(|&r| self.sens[(r, q)] != 0.0).unwrap_or(0)
+                } else {
+                    (q - p) % n
+                };
+                1.0 / self.w[row]
+            })
+            .collect()
+    }
+
+    pub(super) fn step_norm(&self, dx: &[f64]) -> f64 {
+        let (n, p) = (self.n, self.p);
+        let head: f64 = (0..n)
+            .map(|r| {
+                let d: f64 = (0..p).map(|c| self.sens[(r, c)] * dx[c]).sum();
+                (d * self.w[r]).powi(2)
+            })
+            .sum();
+        let rest: f64 = dx[p..]
+            .iter()
+            .enumerate()
+            .map(|(q, d)| (d * self.w[q % n]).powi(2))
+            .sum();
+        (head + rest).sqrt()
+    }
+
+    /// Node states and stage values of x, with empty statistics.
+    pub(super) fn solution_parts(&self, x: &[f64]) -> CollocationSolution {
+        CollocationSolution {
+            mesh: self.mesh.clone(),
+            states: (0..=self.intervals()).map(|i| self.node(x, i)).collect(),
+            iterations: 0,
+            residual: f64::NAN,
+            residual_history: Vec::new(),
+            newton_steps: 0,
+            damped_steps: 0,
+            contraction: 0.0,
+            error_estimate: f64::NAN,
+            director_drift: 0.0,
+            stage_values: (0..self.intervals())
+                .map(|i| self.stages(x, i).to_vec())
+                .collect(),
+            stage_count: self.tab.m,
+        }
+    }
+
+    /// The solution with Newton's statistics, the error estimate and the
+    /// director drift.
+    pub(super) fn solution(&self, out: &NewtonOutcome, errors: &[f64]) -> CollocationSolution {
+        let mut sol = self.solution_parts(&out.x);
+        sol.iterations = out.iterations;
+        sol.residual = *out.history.last().unwrap_or(&f64::NAN);
+        sol.residual_history = out.history.clone();
+        sol.error_estimate = errors.iter().sum();
+        if self.n == 12 {
+            sol.director_drift = sol
+                .samples(self.eq)
+                .iter()
+                .map(RodSample::director_drift)
+                .fold(0.0, f64::max);
+        }
+        sol
+    }
+}

@@ -1,0 +1,289 @@
+//! The small dense and the banded LU factorizations of collocation.
+//!
+//! Dense LU with row partial pivoting of the mn × mn stage matrices
+//! (compiled for the planar and spatial sizes), and the banded LU of the
+//! condensed node system in LAPACK's `gbtrf` layout: Gaussian elimination
+//! with row partial pivoting, stable where the forward recursion of
+//! compactification is not (AMR §7.2.2).
+
+/// In-place LU with row partial pivoting (as nalgebra's `LU`) of the d × d
+/// row-major matrix `a`, interchanges in `piv`; false at a zero or
+/// non-finite pivot. The stage sizes m·n of the planar (n = 4) and spatial
+/// (n = 12) models are compiled for their size.
+pub(super) fn dense_lu(a: &mut [f64], d: usize, piv: &mut [usize]) -> bool {
+    match d {
+        4 => lu_sized::<4>(a, piv),
+        8 => lu_sized::<8>(a, piv),
+        12 => lu_sized::<12>(a, piv),
+        24 => lu_sized::<24>(a, piv),
+        36 => lu_sized::<36>(a, piv),
+        _ => lu_any(a, d, piv),
+    }
+}
+
+/// Solves A x = b in place with the factors of [`dense_lu`].
+pub(super) fn dense_solve(a: &[f64], d: usize, piv: &[usize], b: &mut [f64]) {
+    match d {
+        4 => solve_sized::<4>(a, piv, b),
+        8 => solve_sized::<8>(a, piv, b),
+        12 => solve_sized::<12>(a, piv, b),
+        24 => solve_sized::<24>(a, piv, b),
+        36 => solve_sized::<36>(a, piv, b),
+        _ => solve_any(a, d, piv, b),
+    }
+}
+
+/// [`dense_lu`] for a dimension known at compile time (unrolled loops).
+fn lu_sized<const D: usize>(a: &mut [f64], piv: &mut [usize]) -> bool {
+    // Inlined with a constant dimension, so the loops unroll.
+    lu_any(&mut a[..D * D], D, &mut piv[..D])
+}
+
+/// [`dense_solve`] for a dimension known at compile time.
+fn solve_sized<const D: usize>(a: &[f64], piv: &[usize], b: &mut [f64]) {
+    solve_any(&a[..D * D], D, &piv[..D], &mut b[..D])
+}
+
+/// [`dense_lu`] for any dimension.
+#[inline(always)]
+fn lu_any(a: &mut [f64], d: usize, piv: &mut [usize]) -> bool {
+    for k in 0..d {
+        let (mut p, mut best) = (k, a[k * d + k].abs());
+        for i in k + 1..d {
+            let v = a[i * d + k].abs();
+            if v > best {
+                (p, best) = (i, v);
+            }
+        }
+        piv[k] = p;
+        if best == 0.0 || !best.is_finite() {
+            return false;
+        }
+        if p != k {
+            for c in 0..d {
+                a.swap(k * d + c, p * d + c);
+            }
+        }
+        let (upper, lower) = a.split_at_mut((k + 1) * d);
+        let row_k = &upper[k * d..];
+        let pivot = row_k[k];
+        for row in lower.chunks_exact_mut(d) {
+            let l = row[k] / pivot;
+            row[k] = l;
+            if l != 0.0 {
+                row[k + 1..]
+                    .iter_mut()
+                    .zip(&row_k[k + 1..])
+                    .for_each(|(v, u)| *v -= l * u);
+            }
+        }
+    }
+    true
+}
+
+/// [`dense_solve`] for any dimension.
+#[inline(always)]
+fn solve_any(a: &[f64], d: usize, piv: &[usize], b: &mut [f64]) {
+    for (k, &p) in piv.iter().enumerate() {
+        b.swap(k, p);
+    }
+    for i in 1..d {
+        let row = &a[i * d..i * d + i];
+        let acc: f64 = row.iter().zip(&b[..i]).map(|(l, v)| l * v).sum();
+        b[i] -= acc;
+    }
+    for i in (0..d).rev() {
+        let row = &a[i * d..(i + 1) * d];
+        let acc: f64 = row[i + 1..]
+            .iter()
+            .zip(&b[i + 1..])
+            .map(|(u, v)| u * v)
+            .sum();
+        b[i] = (b[i] - acc) / row[i];
+    }
+}
+
+/// A banded matrix factored by Gaussian elimination with row partial
+/// pivoting in LAPACK's `gbtrf` layout: column-major band storage with kl
+/// extra rows above for the fill-in of row interchanges. Work
+/// O(size · kl · (kl + ku)), storage O(size · (2kl + ku + 1)).
+pub(super) struct BandLu {
+    size: usize,
+    kl: usize,
+    ku: usize,
+    ld: usize,
+    data: Vec<f64>,
+    piv: Vec<usize>,
+}
+
+impl BandLu {
+    pub(super) fn zeros(size: usize, kl: usize, ku: usize) -> Self {
+        let ld = 2 * kl + ku + 1;
+        BandLu {
+            size,
+            kl,
+            ku,
+            ld,
+            data: vec![0.0; ld * size],
+            piv: vec![0; size],
+        }
+    }
+
+    /// Storage index of (i, j), for j − i ≤ kl + ku and i − j ≤ kl.
+    fn idx(&self, i: usize, j: usize) -> usize {
+        debug_assert!(
+            i <= j + self.kl && j <= i + self.kl + self.ku,
+            "({i}, {j}) outside the band"
+        );
+        j * self.ld + self.kl + self.ku + i - j
+    }
+
+    /// Zeros the matrix for a new factorization.
+    pub(super) fn clear(&mut self) {
+        self.data.fill(0.0);
+    }
+
+    pub(super) fn add(&mut self, i: usize, j: usize, v: f64) {
+        let k = self.idx(i, j);
+        self.data[k] += v;
+    }
+
+    fn get(&self, i: usize, j: usize) -> f64 {
+        self.data[self.idx(i, j)]
+    }
+
+    /// In-place LU with partial pivoting; Err(column) at a zero pivot.
+    pub(super) fn factor(&mut self) -> Result<(), usize> {
+        let (kl, ku) = (self.kl, self.ku);
+        for k in 0..self.size {
+            let last = (k + kl).min(self.size - 1);
+            let right = (k + kl + ku).min(self.size - 1);
+            let p = (k..=last).fold(k, |b, i| {
+                if self.get(i, k).abs() > self.get(b, k).abs() {
+                    i
+                } else {
+                    b
+                }
+            });
+            let pivot = self.get(p, k);
+            if pivot == 0.0 || !pivot.is_finite() {
+                return Err(k);
+            }
+            self.piv[k] = p;
+            if p != k {
+                for c in k..=right {
+                    let (a, b) = (self.idx(k, c), self.idx(p, c));
+                    self.data.swap(a, b);
+                }
+            }
+            // Multipliers below the pivot, then the rank-one update column
+            // by column (contiguous in the column-major band storage),
+            // skipping the zero columns of the pivot row.
+            let (lo, hi) = (self.idx(k + 1, k), self.idx(last, k) + 1);
+            for v in &mut self.data[lo..hi] {
+                *v /= pivot;
+            }
+            for c in k + 1..=right {
+                let v = self.get(k, c);
+                if v == 0.0 {
+                    continue;
+                }
+                let start = self.idx(k + 1, c);
+                for (off, i) in (k + 1..=last).enumerate() {
+                    let l = self.data[lo + i - (k + 1)];
+                    self.data[start + off] -= l * v;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Solves A x = b in place with the factors.
+    pub(super) fn solve(&self, b: &mut [f64]) {
+        let (kl, ku, n) = (self.kl, self.ku, self.size);
+        for k in 0..n {
+            b.swap(k, self.piv[k]);
+            for i in k + 1..=(k + kl).min(n - 1) {
+                b[i] -= self.get(i, k) * b[k];
+            }
+        }
+        for k in (0..n).rev() {
+            let right = (k + kl + ku).min(n - 1);
+            let acc: f64 = (k + 1..=right).map(|c| self.get(k, c) * b[c]).sum();
+            b[k] = (b[k] - acc) / self.get(k, k);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{DMatrix, DVector};
+
+    /// The band LU against nalgebra's dense LU on a random banded matrix
+    /// that needs pivoting (zero diagonal).
+    #[test]
+    fn band_lu_matches_dense_lu() {
+        let (size, kl, ku) = (23, 4, 3);
+        let mut seed = 12345u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        };
+        let mut dense = DMatrix::zeros(size, size);
+        let mut band = BandLu::zeros(size, kl, ku);
+        for i in 0..size {
+            for j in i.saturating_sub(kl)..=(i + ku).min(size - 1) {
+                let v = if i == j { 0.0 } else { rnd() };
+                dense[(i, j)] = v;
+                band.add(i, j, v);
+            }
+        }
+        let b: Vec<f64> = (0..size).map(|_| rnd()).collect();
+        let exact = dense
+            .clone()
+            .lu()
+            .solve(&DVector::from_column_slice(&b))
+            .unwrap();
+        band.factor().unwrap();
+        let mut x = b.clone();
+        band.solve(&mut x);
+        let err = x
+            .iter()
+            .zip(exact.iter())
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(err < 1e-10, "{err}");
+    }
+
+    /// The dense LU (compiled sizes and the general one) against nalgebra's.
+    #[test]
+    fn dense_lu_matches_nalgebra() {
+        let mut seed = 987u64;
+        let mut rnd = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64) - 0.5
+        };
+        for d in [7, 12, 36] {
+            let a: Vec<f64> = (0..d * d).map(|_| rnd()).collect();
+            let b: Vec<f64> = (0..d).map(|_| rnd()).collect();
+            let exact = DMatrix::from_row_slice(d, d, &a)
+                .lu()
+                .solve(&DVector::from_column_slice(&b))
+                .unwrap();
+            let (mut f, mut piv, mut x) = (a.clone(), vec![0; d], b.clone());
+            assert!(dense_lu(&mut f, d, &mut piv));
+            dense_solve(&f, d, &piv, &mut x);
+            let err = x
+                .iter()
+                .zip(exact.iter())
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            assert!(err < 1e-10, "d {d}: {err}");
+        }
+    }
+}

@@ -1,0 +1,234 @@
+//! Problem files: a TOML description of a rod scene and how to solve it.
+//!
+//! Every table rejects unknown keys; syntax errors carry line and column;
+//! physical validation names the offending field. `--set key=value`
+//! overrides are applied to the parsed document before it is read, so they
+//! go through exactly the same checks. The reference of every key is in
+//! docs/problem-files.md.
+//!
+//! Submodules: `sections` (the serde structs of the tables as written),
+//! `overrides` (`--set`), `checks` (finite numbers, magnitudes, ranges),
+//! `rod` (the checked rod, energy, clamp and model level) and `options`
+//! (solver, continuation, fixed shape and stability settings); this module
+//! reads the file and assembles the checked [`Problem`].
+
+mod checks;
+mod options;
+mod overrides;
+mod rod;
+mod sections;
+
+use std::path::Path;
+
+use crate::bvp::SolverOptions;
+use crate::continuation::{ContinuationOptions, Family};
+use crate::io::strict;
+use crate::io::sweep_section::{Sweep, SweepSection};
+use crate::model::{EnergyCatalog, ModelChoice, ModelLevel, Rod};
+use crate::optimize::{ArmProblem, ArmScene, SearchOptions};
+use crate::stability::{FixedShape, StabilityOptions};
+pub(crate) use checks::{within, NEWTON_TOLERANCE};
+use options::{build_continuation, build_options, build_shape, build_stability, eigenvalue_count};
+use overrides::apply_overrides;
+use rod::{build_rod, choose_model};
+pub use sections::{ProblemFile, ProfileSpec};
+
+/// Why a problem could not be read.
+#[derive(Debug, thiserror::Error)]
+pub enum ProblemError {
+    /// The file could not be read.
+    #[error("cannot read {path}: {source}")]
+    Read {
+        /// The problem file.
+        path: String,
+        /// The error of the read.
+        source: std::io::Error,
+    },
+    /// TOML syntax, an unknown or missing key, or a wrong type.
+    #[error("{0}")]
+    Parse(String),
+    /// A `--set` override that cannot be applied.
+    #[error("--set {assignment}: {message}")]
+    Override {
+        /// The `KEY=VALUE` as given.
+        assignment: String,
+        /// Why it cannot be applied.
+        message: String,
+    },
+    /// A value that is well-formed but not physical or not consistent.
+    #[error("{field}: {message}")]
+    Invalid {
+        /// The dotted key of the offending value (e.g. `rod.length`).
+        field: String,
+        /// What is wrong with it.
+        message: String,
+    },
+}
+
+pub(crate) fn invalid(field: impl Into<String>, message: impl Into<String>) -> ProblemError {
+    ProblemError::Invalid {
+        field: field.into(),
+        message: message.into(),
+    }
+}
+
+/// A problem ready to solve.
+#[derive(Debug, Clone)]
+pub struct Problem {
+    /// The rod.
+    pub rod: Rod,
+    /// The model level and why.
+    pub model: ModelChoice,
+    /// The solver settings.
+    pub options: SolverOptions,
+    /// The effective problem text (with overrides applied), stored with
+    /// results.
+    pub text: String,
+    /// The fixed loaded shape of a fixed-shape scene.
+    pub shape: Option<FixedShape>,
+    /// The discretization of the second variation.
+    pub stability: StabilityOptions,
+    /// The continued family and how to continue it.
+    pub continuation: Option<(Family, ContinuationOptions)>,
+    /// The arm optimization, its search, and whether to compute R̂0.
+    pub arm: Option<(ArmProblem, SearchOptions, bool)>,
+    /// The arm's loads and actuator limit, and the size of its reach map.
+    pub arm_scene: Option<(ArmScene, usize)>,
+    /// The grid of a `[sweep]` table.
+    pub sweep: Option<Sweep>,
+}
+
+impl Problem {
+    /// Reads a problem file and applies `key=value` overrides.
+    pub fn from_path(path: &Path, overrides: &[String]) -> Result<Problem, ProblemError> {
+        Problem::from_path_in(path, overrides, &EnergyCatalog::standard())
+    }
+
+    /// [`Problem::from_path`] with the energies of `catalog` (a program's
+    /// own energies by name: examples/custom_energy.rs).
+    pub fn from_path_in(
+        path: &Path,
+        overrides: &[String],
+        catalog: &EnergyCatalog,
+    ) -> Result<Problem, ProblemError> {
+        let text = read_problem_file(path)?;
+        Problem::from_str_in(&text, overrides, catalog)
+    }
+
+    /// Reads a problem from TOML text and applies `key=value` overrides.
+    pub fn from_str_with(text: &str, overrides: &[String]) -> Result<Problem, ProblemError> {
+        Problem::from_str_in(text, overrides, &EnergyCatalog::standard())
+    }
+
+    /// [`Problem::from_str_with`] with the energies of `catalog`.
+    pub fn from_str_in(
+        text: &str,
+        overrides: &[String],
+        catalog: &EnergyCatalog,
+    ) -> Result<Problem, ProblemError> {
+        if text.len() > MAX_PROBLEM_BYTES as usize {
+            return Err(ProblemError::Parse(format!(
+                "the problem text is {} bytes, more than the {MAX_PROBLEM_BYTES} a problem file \
+                 may have; a problem file describes a rod, not data",
+                text.len()
+            )));
+        }
+        let text = apply_overrides(text, overrides)?;
+        let file: ProblemFile = strict::parse(&text)?;
+        let rod = build_rod(&file, catalog)?;
+        let model = choose_model(&rod, &file.solver.model, file.energy.shear.is_some())?;
+        if rod.clamp.hinge && model.level != ModelLevel::Planar {
+            return Err(invalid(
+                "clamp.hinge",
+                format!(
+                    "a hinged base needs the planar model, but the scene runs {}",
+                    model.reason
+                ),
+            ));
+        }
+        let options = build_options(&file.solver)?;
+        let shape = build_shape(&file)?;
+        let stability = build_stability(&file.stability)?;
+        eigenvalue_count("stability", &stability, &rod)?;
+        let continuation = build_continuation(&file, &rod, &model, &options, shape.as_ref())?;
+        let arm = file.arm.as_ref().map(|a| a.build(&rod)).transpose()?;
+        let arm_scene = file
+            .arm
+            .as_ref()
+            .map(|a| a.scene(&rod).map(|s| (s, a.map_samples)))
+            .transpose()?;
+        let sweep = file.sweep.as_ref().map(SweepSection::build).transpose()?;
+        let problem = Problem {
+            rod,
+            model,
+            options,
+            text,
+            shape,
+            stability,
+            continuation,
+            arm,
+            arm_scene,
+            sweep,
+        };
+        // Before any command allocates: what the sizes ask for must fit.
+        super::memory::check(&problem)?;
+        Ok(problem)
+    }
+}
+
+/// The largest problem file read: 1 MiB (the shipped ones are under 3 KiB).
+pub const MAX_PROBLEM_BYTES: u64 = 1 << 20;
+
+/// The text of a problem file, refusing before reading anything what is not
+/// a regular file (a directory; a device such as /dev/zero or a FIFO would
+/// be read without end, or block) or is larger than [`MAX_PROBLEM_BYTES`];
+/// at most that many bytes are read even if the file grows meanwhile.
+fn read_problem_file(path: &Path) -> Result<String, ProblemError> {
+    use std::io::Read;
+    let fail = |message: String| ProblemError::Read {
+        path: path.display().to_string(),
+        source: std::io::Error::new(std::io::ErrorKind::InvalidInput, message),
+    };
+    let io = |source: std::io::Error| ProblemError::Read {
+        path: path.display().to_string(),
+        source,
+    };
+    let meta = std::fs::metadata(path).map_err(io)?;
+    if meta.is_dir() {
+        return Err(fail(
+            "is a directory; give a problem file (TOML), e.g. problems/cantilever_tip_load.toml"
+                .into(),
+        ));
+    }
+    if !meta.is_file() {
+        return Err(fail(
+            "is not a regular file (a device, FIFO or socket would be read without end); give a \
+             problem file (TOML)"
+                .into(),
+        ));
+    }
+    if meta.len() > MAX_PROBLEM_BYTES {
+        return Err(fail(format!(
+            "is {} bytes, more than the {MAX_PROBLEM_BYTES} (1 MiB) a problem file may have; is \
+             it the right file?",
+            meta.len()
+        )));
+    }
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)
+        .map_err(io)?
+        .take(MAX_PROBLEM_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    if bytes.len() as u64 > MAX_PROBLEM_BYTES {
+        return Err(fail(format!(
+            "grew beyond {MAX_PROBLEM_BYTES} bytes (1 MiB) while being read"
+        )));
+    }
+    String::from_utf8(bytes).map_err(|e| {
+        fail(format!(
+            "is not UTF-8 text (byte {}); a problem file is TOML text",
+            e.utf8_error().valid_up_to()
+        ))
+    })
+}

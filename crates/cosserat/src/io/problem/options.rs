@@ -1,0 +1,276 @@
+//! The checked settings of the analyses: the solver (method, Newton,
+//! integrator, collocation), the `[continuation]` family, the fixed shape
+//! of a fixed-shape scene and the discretization of the second variation
+//! (with enough unknowns per block for the eigenvalues asked).
+
+use super::checks::{
+    vector, within, COLLOCATION_TOLERANCE, INTEGRATION_TOLERANCE, NEWTON_TOLERANCE,
+};
+use super::rod::profile;
+use super::sections::{ProblemFile, ProfileSpec, SolverSection, StabilitySection};
+use super::{invalid, ProblemError};
+use crate::bvp::newton::NewtonOptions;
+use crate::bvp::{Method, SolverOptions, Strategy};
+use crate::continuation::{ContinuationOptions, Family, Parameter};
+use crate::model::{ModelChoice, Profile, Rod};
+use crate::numerics::integrator::Tolerances;
+use crate::stability::{FixedShape, StabilityOptions};
+
+/// The family of a `[continuation]` table, discretized by the solver's
+/// shooting method at the scene's model level.
+pub(super) fn build_continuation(
+    file: &ProblemFile,
+    rod: &Rod,
+    model: &ModelChoice,
+    options: &SolverOptions,
+    shape: Option<&FixedShape>,
+) -> Result<Option<(Family, ContinuationOptions)>, ProblemError> {
+    let Some(section) = &file.continuation else {
+        return Ok(None);
+    };
+    let (parameter, opts) = section.build()?;
+    eigenvalue_count("continuation", &opts.stability, rod)?;
+    let (segments, stages) = match options.method {
+        Method::Shooting => (1, None),
+        Method::MultipleShooting { segments } => (segments, None),
+        Method::Collocation { stages } => {
+            if !(1..=10_000).contains(&section.intervals) {
+                return Err(invalid(
+                    "continuation.intervals",
+                    format!("must be between 1 and 10000, got {}", section.intervals),
+                ));
+            }
+            (section.intervals, Some(stages))
+        }
+    };
+    if let Some(shape) = shape {
+        // A fixed shape's κ⁰ follows from the load; continuation needs a
+        // rod with one κ⁰: only shapes on which the loads make no moment
+        // (κ⁰ = φ', e.g. a straight column under an axial load) qualify.
+        let fe_points: Vec<f64> = (0..=64).map(|i| rod.length * i as f64 / 64.0).collect();
+        let moment = shape
+            .samples(rod, &fe_points)
+            .map_err(|e| invalid("shape", e.to_string()))?
+            .iter()
+            .map(|p| p.moment.norm())
+            .fold(0.0, f64::max);
+        if moment > 1e-12 * rod.moment_scale()
+            || !matches!(shape.turning_angle, Profile::Constant(_))
+        {
+            return Err(invalid(
+                "shape",
+                "continuation from a fixed shape needs a straight shape on which the loads make no moment",
+            ));
+        }
+    }
+    let mut base = rod.clone();
+    if parameter == Parameter::ClampAngle {
+        // The parameter is the absolute angle: start from the unturned frame.
+        base.clamp.frame = rod.clamp.turned_frame(-file.clamp.angle);
+    }
+    let family = match stages {
+        None => Family::new(base, parameter, model.level, segments, options.integration),
+        Some(m) => Family::collocation(
+            base,
+            parameter,
+            model.level,
+            segments,
+            m,
+            options.integration,
+        ),
+    };
+    // A parameter the energy cannot vary (a varying profile, an energy
+    // without that profile) is refused here, not at the first point.
+    family
+        .rod_at(opts.start)
+        .map_err(|e| invalid("continuation.parameter", e.to_string()))?;
+    Ok(Some((family, opts)))
+}
+
+pub(super) fn build_shape(file: &ProblemFile) -> Result<Option<FixedShape>, ProblemError> {
+    let Some(shape) = &file.shape else {
+        return Ok(None);
+    };
+    let turning_angle = profile("shape.turning_angle", &shape.turning_angle)?;
+    if file.energy.kind != "linear" {
+        return Err(invalid(
+            "shape",
+            "a fixed-shape scene needs energy.kind = \"linear\" (K is then linear in the load)",
+        ));
+    }
+    if file
+        .energy
+        .intrinsic_curvature
+        .iter()
+        .any(|p| *p != ProfileSpec::Constant(0.0))
+    {
+        return Err(invalid(
+            "energy.intrinsic_curvature",
+            "a fixed-shape scene derives κ⁰ from the shape and the load (paper (43)); remove it",
+        ));
+    }
+    if file.loads.tip_couple != [0.0; 3] {
+        return Err(invalid(
+            "loads.tip_couple",
+            "a fixed-shape scene takes forces only",
+        ));
+    }
+    Ok(Some(FixedShape { turning_angle }))
+}
+
+/// The fewest unknowns a block of the second variation can have: the
+/// in-plane block has one rotation per node but the clamped one
+/// (elements × order), and a tip support removes up to six more
+/// (three held translations, three held rotations).
+pub(crate) fn fewest_block_unknowns(opts: &StabilityOptions, rod: &Rod) -> usize {
+    let nodes = opts.elements.saturating_mul(opts.order);
+    if rod.support.is_some() {
+        nodes.saturating_sub(6)
+    } else {
+        nodes
+    }
+}
+
+/// The eigenvalues asked per block exist on the mesh (a count beyond the
+/// block's unknowns made the continuation tracker index past its columns).
+pub(super) fn eigenvalue_count(
+    table: &str,
+    opts: &StabilityOptions,
+    rod: &Rod,
+) -> Result<(), ProblemError> {
+    let most = fewest_block_unknowns(opts, rod);
+    if opts.eigenvalues > most {
+        return Err(invalid(
+            format!("{table}.eigenvalues"),
+            format!(
+                "{} eigenvalues per block, but the smallest block of {} elements of order {} \
+                 has {most} unknowns{}: lower {table}.eigenvalues to at most {most} or raise \
+                 {table}.elements",
+                opts.eigenvalues,
+                opts.elements,
+                opts.order,
+                if rod.support.is_some() {
+                    " (elements × order, less six held by the support)"
+                } else {
+                    " (elements × order)"
+                },
+            ),
+        ));
+    }
+    Ok(())
+}
+
+pub(super) fn build_stability(s: &StabilitySection) -> Result<StabilityOptions, ProblemError> {
+    if s.elements < 1 {
+        return Err(invalid("stability.elements", "must be at least 1"));
+    }
+    if !(1..=3).contains(&s.order) {
+        return Err(invalid(
+            "stability.order",
+            format!("must be 1, 2 or 3, got {}", s.order),
+        ));
+    }
+    if s.eigenvalues < 1 {
+        return Err(invalid("stability.eigenvalues", "must be at least 1"));
+    }
+    Ok(StabilityOptions {
+        elements: s.elements,
+        order: s.order,
+        eigenvalues: s.eigenvalues,
+    })
+}
+
+pub(super) fn build_options(s: &SolverSection) -> Result<SolverOptions, ProblemError> {
+    let method = match s.method.as_str() {
+        "shooting" => Method::Shooting,
+        "multiple-shooting" => {
+            if s.segments < 1 {
+                return Err(invalid("solver.segments", "must be at least 1"));
+            }
+            Method::MultipleShooting {
+                segments: s.segments,
+            }
+        }
+        "collocation" => {
+            if !(1..=3).contains(&s.stages) {
+                return Err(invalid("solver.stages", "must be 1, 2 or 3"));
+            }
+            Method::Collocation { stages: s.stages }
+        }
+        other => {
+            return Err(invalid(
+                "solver.method",
+                format!(
+                    "unknown method `{other}`; expected \"shooting\", \"multiple-shooting\" \
+                     or \"collocation\""
+                ),
+            ))
+        }
+    };
+    let defaults = crate::bvp::CollocationOptions::default();
+    if s.max_intervals < defaults.intervals {
+        return Err(invalid(
+            "solver.max_intervals",
+            format!("must be at least {}", defaults.intervals),
+        ));
+    }
+    let collocation = crate::bvp::CollocationOptions {
+        stages: s.stages,
+        tolerance: within(
+            "solver.collocation_tolerance",
+            s.collocation_tolerance,
+            COLLOCATION_TOLERANCE,
+        )?,
+        max_intervals: s.max_intervals,
+        ..defaults
+    };
+    let strategy = match s.strategy.as_str() {
+        "auto" => Strategy::Auto,
+        "direct" => Strategy::Direct,
+        "ramp" => Strategy::Ramp,
+        other => {
+            return Err(invalid(
+                "solver.strategy",
+                format!("unknown strategy `{other}`; expected \"auto\", \"direct\" or \"ramp\""),
+            ))
+        }
+    };
+    let tol = within(
+        "solver.integration_tolerance",
+        s.integration_tolerance,
+        INTEGRATION_TOLERANCE,
+    )?;
+    if s.max_steps < 1 {
+        return Err(invalid(
+            "solver.max_steps",
+            "must be at least 1 (the step budget of one integration; e.g. 100000)",
+        ));
+    }
+    if s.output_points < 2 {
+        return Err(invalid("solver.output_points", "must be at least 2"));
+    }
+    if s.max_iterations < 1 {
+        return Err(invalid("solver.max_iterations", "must be at least 1"));
+    }
+    let initial_guess = match s.initial_curvature {
+        Some(k) => Some(vector("solver.initial_curvature", k)?.as_slice().to_vec()),
+        None => None,
+    };
+    Ok(SolverOptions {
+        method,
+        newton: NewtonOptions {
+            tolerance: within("solver.tolerance", s.tolerance, NEWTON_TOLERANCE)?,
+            max_iterations: s.max_iterations,
+            ..Default::default()
+        },
+        integration: Tolerances {
+            rtol: tol,
+            atol: tol,
+            max_steps: s.max_steps,
+        },
+        collocation,
+        output_points: s.output_points,
+        initial_guess,
+        strategy,
+    })
+}

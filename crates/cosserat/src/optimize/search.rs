@@ -1,0 +1,290 @@
+//! The search for the farthest-reaching design: Owen-scrambled Sobol'
+//! samples of the box of c2..cM (the global stage), then Nelder–Mead
+//! (argmin) from the best few (the polish) on the cost −R̂, points outside
+//! the box projected into it and charged their squared distance; with the
+//! progress kept so that an interrupted search can be resumed.
+
+use argmin::core::{CostFunction, Error as ArgminError, Executor, State};
+use argmin::solver::neldermead::NelderMead;
+
+use crate::model::Profile;
+use crate::stability::{critical_load, FixedShape};
+
+use super::design::{intrinsic_shape, least_squares_polynomial};
+use super::{
+    derivative, polynomial, ArmDesign, ArmOptimum, ArmProblem, ArmScene, SearchOptions,
+    SearchProgress, REACH_TOLERANCE,
+};
+
+impl ArmProblem {
+    /// Clamps a point into the bounds.
+    pub(super) fn project(&self, p: &[f64]) -> Vec<f64> {
+        p.iter()
+            .zip(&self.bounds)
+            .map(|(v, (lo, hi))| v.clamp(*lo, *hi))
+            .collect()
+    }
+
+    /// The best design: scrambled Sobol' samples of the box, then
+    /// Nelder–Mead from the best few.
+    pub fn optimize(&self, opts: &SearchOptions) -> Option<ArmOptimum> {
+        self.optimize_until(opts, &|| false).map(|(o, _)| o)
+    }
+
+    /// As [`Self::optimize`], stopping early when `stop()` turns true (an
+    /// interrupt): then the best design found so far is returned, flagged.
+    pub fn optimize_until(
+        &self,
+        opts: &SearchOptions,
+        stop: &dyn Fn() -> bool,
+    ) -> Option<(ArmOptimum, bool)> {
+        let (optimum, _, interrupted) = self.search(
+            &ArmScene::default(),
+            opts,
+            SearchProgress::default(),
+            stop,
+            &mut |_| {},
+        );
+        Some((optimum?, interrupted))
+    }
+
+    /// The search in a scene, going on from `progress` (a fresh one, or
+    /// what an interrupted run kept): Sobol' samples of the box, then
+    /// Nelder–Mead from the best `starts`. Returns the optimum (the best
+    /// so far when interrupted), the progress to resume from, and whether
+    /// `stop()` interrupted it. Resuming gives the same optimum as an
+    /// uninterrupted run: the samples are a fixed sequence and a polish
+    /// cut short is redone from its start. `checkpoint` sees the progress
+    /// after every sample and every polish (to save it against a kill).
+    ///
+    /// The optimum is then checked on finer meshes ([`Self::resolve`]):
+    /// where the search's mesh does not resolve it, the search is redone on
+    /// a finer one, and the optimum reported is that search's, with its
+    /// discretization error.
+    pub fn search(
+        &self,
+        scene: &ArmScene,
+        opts: &SearchOptions,
+        progress: SearchProgress,
+        stop: &dyn Fn() -> bool,
+        checkpoint: &mut dyn FnMut(&SearchProgress),
+    ) -> (Option<ArmOptimum>, SearchProgress, bool) {
+        let (optimum, progress, interrupted) =
+            self.search_on_mesh(scene, opts, progress, stop, checkpoint);
+        if interrupted {
+            return (optimum, progress, true);
+        }
+        let optimum = optimum.map(|o| self.resolve(scene, o, opts, REACH_TOLERANCE, stop));
+        (optimum, progress, stop())
+    }
+
+    /// The search on this problem's mesh alone, without the mesh check.
+    pub(super) fn search_on_mesh(
+        &self,
+        scene: &ArmScene,
+        opts: &SearchOptions,
+        mut progress: SearchProgress,
+        stop: &dyn Fn() -> bool,
+        checkpoint: &mut dyn FnMut(&SearchProgress),
+    ) -> (Option<ArmOptimum>, SearchProgress, bool) {
+        let keep = opts.starts.max(1);
+        while progress.samples_done < opts.samples && !stop() {
+            let i = progress.samples_done + 1;
+            let p = self.sample_point(i);
+            progress.evaluations += 1;
+            if let Some(d) = self.design_in(scene, &p) {
+                let at = progress.leaders.partition_point(|(r, _)| *r >= d.reach);
+                progress.leaders.insert(at, (d.reach, p));
+                progress.leaders.truncate(keep);
+            }
+            progress.samples_done = i;
+            checkpoint(&progress);
+        }
+        if self.bounds.is_empty() {
+            let optimum = self
+                .design_in(scene, &[])
+                .and_then(|d| self.finish(scene, d, progress.evaluations));
+            return (optimum, progress, stop());
+        }
+        if progress.polishes_done == 0 {
+            progress.best = progress
+                .leaders
+                .first()
+                .and_then(|(_, p)| self.design_in(scene, p));
+        }
+        let starts = opts.starts.min(progress.leaders.len());
+        while progress.polishes_done < starts && !stop() {
+            let start = progress.leaders[progress.polishes_done].1.clone();
+            let (design, used) = self.polish(scene, &start, opts.iterations, stop);
+            if stop() {
+                break;
+            }
+            progress.evaluations += used;
+            if let Some(d) = design {
+                if progress.best.as_ref().is_none_or(|b| d.reach > b.reach) {
+                    progress.best = Some(d);
+                }
+            }
+            progress.polishes_done += 1;
+            checkpoint(&progress);
+        }
+        let optimum = self.best_so_far(scene, &progress);
+        (optimum, progress, stop())
+    }
+
+    /// The best design of a search so far with its shapes: the best polish,
+    /// or the best sample while the global stage runs.
+    pub fn best_so_far(&self, scene: &ArmScene, progress: &SearchProgress) -> Option<ArmOptimum> {
+        let best = match &progress.best {
+            Some(b) if progress.polishes_done > 0 || progress.leaders.is_empty() => b.clone(),
+            _ => {
+                let (_, p) = progress.leaders.first()?;
+                self.design_in(scene, p)?
+            }
+        };
+        self.finish(scene, best, progress.evaluations)
+    }
+
+    /// The starting simplex around `start`: steps of 5 % of each bound's
+    /// width, inwards at the upper bound.
+    pub(super) fn simplex(&self, start: &[f64]) -> Vec<Vec<f64>> {
+        self.simplex_sized(start, 0.05)
+    }
+
+    /// The simplex with steps of `fraction` of each bound's width.
+    pub(super) fn simplex_sized(&self, start: &[f64], fraction: f64) -> Vec<Vec<f64>> {
+        std::iter::once(start.to_vec())
+            .chain((0..start.len()).map(|d| {
+                let mut p = start.to_vec();
+                let (lo, hi) = self.bounds[d];
+                let step = fraction * (hi - lo);
+                p[d] = if p[d] + step <= hi {
+                    p[d] + step
+                } else {
+                    p[d] - step
+                };
+                p
+            }))
+            .collect()
+    }
+
+    /// Nelder–Mead from `start` on −R̂ (projected into the bounds).
+    pub(super) fn polish(
+        &self,
+        scene: &ArmScene,
+        start: &[f64],
+        iterations: u64,
+        stop: &dyn Fn() -> bool,
+    ) -> (Option<ArmDesign>, usize) {
+        self.nelder_mead(scene, self.simplex(start), iterations, stop)
+    }
+
+    /// Nelder–Mead on −R̂ from a simplex; the polished design and the
+    /// evaluations used.
+    pub(super) fn nelder_mead(
+        &self,
+        scene: &ArmScene,
+        simplex: Vec<Vec<f64>>,
+        iterations: u64,
+        stop: &dyn Fn() -> bool,
+    ) -> (Option<ArmDesign>, usize) {
+        let cost = ReachCost {
+            problem: self,
+            scene,
+            stop,
+            calls: std::cell::Cell::new(0),
+        };
+        let Ok(solver) = NelderMead::new(simplex).with_sd_tolerance(1e-12) else {
+            return (None, 0);
+        };
+        let result = Executor::new(&cost, solver)
+            .configure(|state| state.max_iters(iterations))
+            .run();
+        let calls = cost.calls.get();
+        let design = result.ok().and_then(|r| {
+            let p = r.state().get_best_param()?.clone();
+            self.design_in(scene, &self.project(&p))
+        });
+        (design, calls)
+    }
+
+    /// The optimum with its shapes, intrinsic curvature (43) and its
+    /// Taylor fit (59), and the critical load of its shape.
+    pub(super) fn finish(
+        &self,
+        scene: &ArmScene,
+        design: ArmDesign,
+        evaluations: usize,
+    ) -> Option<ArmOptimum> {
+        let rod = self.rod_in(scene);
+        let shape = FixedShape {
+            turning_angle: Profile::Polynomial(design.shape_coefficients.clone()),
+        };
+        let critical = critical_load(&rod, &shape, &self.stability)
+            .ok()?
+            .load_factor?;
+        let n = 101;
+        let points: Vec<f64> = (0..n).map(|i| i as f64 / (n - 1) as f64).collect();
+        let samples = shape.samples(&rod, &points).ok()?;
+        let c = &design.shape_coefficients;
+        let dphi = derivative(c);
+        let kappa0: Vec<f64> = samples
+            .iter()
+            .map(|p| polynomial(&dphi, p.s) - design.gamma * p.moment[1])
+            .collect();
+        let scale = scene.length(design.gamma);
+        let loaded = samples
+            .iter()
+            .map(|p| {
+                [
+                    p.position[0] * scale,
+                    p.position[1] * scale,
+                    p.position[2] * scale,
+                ]
+            })
+            .collect();
+        let unloaded = intrinsic_shape(c[0], &points, &kappa0, scale);
+        Some(ArmOptimum {
+            curvature_coefficients: least_squares_polynomial(&points, &kappa0, c.len()),
+            design,
+            loaded_shape: loaded,
+            unloaded_shape: unloaded,
+            intrinsic_curvature: kappa0,
+            evaluations,
+            critical_load: critical,
+            scene: *scene,
+            resolution: None,
+        })
+    }
+}
+
+/// −R̂ for Nelder–Mead; points outside the box are projected into it and
+/// charged their squared distance.
+struct ReachCost<'a> {
+    problem: &'a ArmProblem,
+    scene: &'a ArmScene,
+    stop: &'a dyn Fn() -> bool,
+    calls: std::cell::Cell<usize>,
+}
+
+impl CostFunction for &ReachCost<'_> {
+    type Param = Vec<f64>;
+    type Output = f64;
+
+    fn cost(&self, p: &Vec<f64>) -> Result<f64, ArgminError> {
+        if (self.stop)() {
+            // Stopping: the worst cost, not an error — argmin's Nelder–Mead
+            // unwraps the costs of its first simplex (a panic), and the
+            // caller discards a polish that ran into a stop.
+            return Ok(f64::INFINITY);
+        }
+        self.calls.set(self.calls.get() + 1);
+        let q = self.problem.project(p);
+        let outside: f64 = p.iter().zip(&q).map(|(a, b)| (a - b).powi(2)).sum();
+        let reach = self
+            .problem
+            .design_in(self.scene, &q)
+            .map_or(0.0, |d| d.reach);
+        Ok(-reach + outside)
+    }
+}
