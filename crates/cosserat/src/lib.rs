@@ -18,7 +18,7 @@
 //!
 //! | stage | module | takes | gives |
 //! |---|---|---|---|
-//! | problem file | [`io`] (`io/problem.rs`) | TOML text, `--set` overrides | [`io::Problem`]: a [`model::Rod`], a [`model::ModelChoice`], [`bvp::SolverOptions`], and optionally a [`stability::FixedShape`], [`stability::StabilityOptions`], a [`continuation::Family`] with [`continuation::ContinuationOptions`], an [`optimize::ArmProblem`], a [`io::Sweep`] |
+//! | problem file | [`io`] (`io/problem/`) | TOML text, `--set` overrides | [`io::Problem`]: a [`model::Rod`], a [`model::ModelChoice`], [`bvp::SolverOptions`], and optionally a [`stability::FixedShape`], [`stability::StabilityOptions`], a [`continuation::Family`] with [`continuation::ContinuationOptions`], an [`optimize::ArmProblem`], a [`io::Sweep`] |
 //! | model | [`model`] | lengths, stiffnesses, loads | [`model::Rod`]: length, `Arc<dyn` [`model::StoredEnergy`]`>`, clamp, [`model::DeadLoads`], an optional [`model::TipSupport`]; n(s) = P + R + ∫_s^L f is known up to the tip reaction R |
 //! | equations | [`equations`] | a rod and its [`model::ModelLevel`] | a [`equations::RodEquations`]: the first-order ODEs (planar 4, Kirchhoff 9, Cosserat 9 with ν = e3 + S⁻¹N), their linearization, clamp and tip residuals |
 //! | equilibrium | [`bvp`] | the equations | [`bvp::solve`] by shooting, multiple shooting or Gauss–Legendre collocation with damped Newton → [`bvp::Equilibrium`]: samples (s, r, d1, d2, d3, κ, M, n), unknowns, Jacobian |
@@ -28,7 +28,10 @@
 //! | sweep | [`sweep`] | a problem with a `[sweep]` grid | [`sweep::run`]: lines of the grid in parallel (rayon) with warm starts down each line, an arm or solve job per point → one [`sweep::Record`] per point |
 //! | output | [`io`] (feature `hdf5`) | results | HDF5 files (`io::write_equilibrium`, `io::write_stability`, `io::write_diagram`, `io::write_arm_study`, `io::write_sweep`), written atomically to outputs claimed by [`io::target`] |
 //!
-//! Beside the stages, [`references`] holds the closed forms (elliptic
+//! Below the stages, [`numerics`] holds the numerical building blocks with
+//! nothing of rods in them (Gauss–Legendre tables, scalar root finding and
+//! maximization, the banded LDLᵀ with inertia, the DOP853 integrator).
+//! Beside them, [`references`] holds the closed forms (elliptic
 //! integrals, Bessel zeros) that validation and tests compare against. The
 //! `cosserat` command, its charts, the bench and the validation runner live
 //! in the separate crate `cosserat-cli`.
