@@ -102,6 +102,10 @@ pub fn run_continue(
     let mut last_save = Instant::now();
     let mut checkpoint_error = None;
     let mut monitor = |progress: Progress, diagram: &Diagram| {
+        // From the first point on there is work to keep: a signal stops at
+        // the next point. Before it (the start solve, a resumed run's
+        // replay) it stops at once, losing nothing.
+        signals::set_mode(signals::Mode::NextPoint);
         bar.set_message(format!(
             "{} points, branch {}, parameter {:.6}",
             progress.points, progress.branch, progress.parameter
@@ -123,7 +127,6 @@ pub fn run_continue(
             output.display()
         );
     }
-    signals::set_mode(signals::Mode::NextPoint);
     let outcome = match &saved {
         Some(saved) => cosserat::continuation::resume(family, opts, saved, &mut monitor),
         None => continuation(family, opts, &mut monitor),

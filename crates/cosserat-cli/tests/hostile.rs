@@ -488,6 +488,19 @@ fn regressions() -> Vec<(Verb, &'static str, Vec<&'static str>)> {
             "euler_column.toml",
             vec!["--set", "continuation.max_points=1000000000"],
         ),
+        // Found by the long form: a start solve of minutes ignored SIGTERM
+        // (it now stops at once until the first point exists) ...
+        (
+            Verb::Continue,
+            "guided_column.toml",
+            vec!["--set", "loads.tip_force=[1e6, 0.0, -1.0]"],
+        ),
+        // ... and a stop inside a Nelder–Mead polish panicked in argmin.
+        (
+            Verb::Optimize,
+            "longest_arm_fig7.toml",
+            vec!["--set", "energy.stiffness[1]=1000000"],
+        ),
     ]
 }
 
