@@ -14,7 +14,7 @@ use std::path::Path;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use cosserat::optimize::{ArmOptimum, ClosestStraight, ReachMap, StraightArm};
+use cosserat::study::arm::{ArmOptimum, ClosestStraight, ReachMap, StraightArm};
 
 /// What the chart shows.
 #[derive(Debug, Clone, Copy)]

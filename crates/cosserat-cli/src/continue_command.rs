@@ -8,8 +8,9 @@ use std::time::{Duration, Instant};
 
 use crate::plot::{draw, read_diagram};
 use cosserat::continuation::{continuation, Diagram, Progress, RunState};
-use cosserat::io::target::replace_atomically;
-use cosserat::io::{read_saved, write_diagram, Problem, MEASURES};
+use cosserat::input::{Problem, MEASURES};
+use cosserat::output::target::replace_atomically;
+use cosserat::output::{read_saved, write_diagram};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::exit::{fail, BAD_INPUT, INTERRUPTED, NO_RESULT, OUTPUT};

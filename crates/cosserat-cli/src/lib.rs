@@ -11,16 +11,16 @@
 //!
 //! | command | module | library stages it drives | writes |
 //! |---|---|---|---|
-//! | `solve`, `stability` | [`solve_command`] | `io::Problem` → `bvp::solve` → `stability::analyze` or `stability::critical_load` | an equilibrium or a stability report (HDF5) |
-//! | `continue`, `plot` | [`continue_command`] | `io::Problem`'s `Family` → `continuation::continuation` (or `resume`) | a `Diagram` (HDF5), its chart by [`plot`] |
-//! | `optimize` | [`optimize_command`] | `optimize::ArmProblem` → `ArmOptimum`, its reach map and loading / control paths | the study (HDF5), its chart by [`arm_chart`] (Fig. 5) |
-//! | `sweep`, `merge` | [`sweep_command`] | `io::Sweep` → `sweep::run` over `ArmJob` or `SolveJob` | checkpointed records (HDF5), merged shards, charts by [`sweep_figure`] and [`sweep_chart`] (Figs. 6, 7) |
+//! | `solve`, `stability` | [`solve_command`] | `input::Problem` → `bvp::solve` → `stability::analyze` or `stability::critical_load` | an equilibrium or a stability report (HDF5) |
+//! | `continue`, `plot` | [`continue_command`] | `input::Problem`'s `Family` → `continuation::continuation` (or `resume`) | a `Diagram` (HDF5), its chart by [`plot`] |
+//! | `optimize` | [`optimize_command`] | `study::arm::ArmProblem` → `ArmOptimum`, its reach map and loading / control paths | the study (HDF5), its chart by [`arm_chart`] (Fig. 5) |
+//! | `sweep`, `merge` | [`sweep_command`] | `study::sweep::Sweep` → `study::sweep::run` over `ArmJob` or `SolveJob` | checkpointed records (HDF5), merged shards, charts by [`sweep_figure`] and [`sweep_chart`] (Figs. 6, 7) |
 //! | `validate` | [`validate`] | every case of validation/*.toml with every method, against `cosserat::references` | a Markdown report |
 //! | `bench` | [`mod@bench`] | `bvp::solve` for every method and order | a work-precision chart and CSV |
 //!
-//! Every command first reads its problem (`cosserat::io::Problem`, the only
+//! Every command first reads its problem (`cosserat::input::Problem`, the only
 //! reader of problem files) and claims its outputs
-//! (`cosserat::io::target::claim`: never an input, never a non-regular
+//! (`cosserat::output::target::claim`: never an input, never a non-regular
 //! file, locked), then computes, then writes atomically. Failures map to
 //! the exit codes of [`exit`] (0, 1 output, 2 bad input, 3 no result, 130
 //! interrupted); [`signals`] turns SIGINT, SIGTERM and SIGHUP into a stop

@@ -8,9 +8,10 @@ use std::time::Instant;
 
 use crate::arm_chart::{draw_arm, ArmChart};
 use cosserat::continuation::RunState;
-use cosserat::io::target::{replace_atomically, Claim};
-use cosserat::io::{read_search, write_arm_study, ArmStudy, Problem};
-use cosserat::optimize::{
+use cosserat::input::Problem;
+use cosserat::output::target::{replace_atomically, Claim};
+use cosserat::output::{read_search, write_arm_study, ArmStudy};
+use cosserat::study::arm::{
     ArmOptimum, ArmProblem, ArmScene, ArmWeight, ClosestStraight, ReachMap, SearchOptions,
     SearchProgress, StraightArm,
 };
@@ -439,24 +440,27 @@ fn report_mesh(opt: &ArmOptimum) {
             "warning: R* = {coarse:.6} on {n} elements but {fine:.6} on {}: the mesh does not \
              resolve the optimum (tolerance {:.0e}); searched again on {} elements",
             4 * n,
-            cosserat::optimize::REACH_TOLERANCE,
+            cosserat::study::arm::REACH_TOLERANCE,
             4 * n
         );
     }
-    if r.verdict == cosserat::optimize::Verdict::Unresolved {
+    if r.verdict == cosserat::study::arm::Verdict::Unresolved {
         eprintln!(
             "warning: R* = {:.6} on {} elements is not resolved to {:.0e} ({:.6} on {}); \
              it carries the error above",
             s.reach[0],
             s.elements[0],
-            cosserat::optimize::REACH_TOLERANCE,
+            cosserat::study::arm::REACH_TOLERANCE,
             s.reach[2],
             s.elements[2]
         );
     }
 }
 
-fn straight_optimum(arm: &ArmProblem, opt: &ArmOptimum) -> Option<cosserat::optimize::StraightArm> {
+fn straight_optimum(
+    arm: &ArmProblem,
+    opt: &ArmOptimum,
+) -> Option<cosserat::study::arm::StraightArm> {
     let t = Instant::now();
     let s = arm.straight_until(&signals::requested);
     match &s {
@@ -472,7 +476,7 @@ fn straight_optimum(arm: &ArmProblem, opt: &ArmOptimum) -> Option<cosserat::opti
     }
     if let Some(s) = s
         .as_ref()
-        .filter(|s| s.limit != cosserat::optimize::StraightLimit::StabilityLoss)
+        .filter(|s| s.limit != cosserat::study::arm::StraightLimit::StabilityLoss)
     {
         eprintln!(
             "warning: R0 = {:.6} is a lower bound: the level family ended without losing \
@@ -519,9 +523,9 @@ fn write_path(
     let t = Instant::now();
     let stop = &signals::requested;
     let diagram = match kind.name {
-        "loading" => cosserat::optimize::loading_path_until(arm, scene, &opt.design, 2001, stop),
-        "control" => cosserat::optimize::control_path_until(arm, scene, &opt.design, 2001, stop),
-        _ => cosserat::optimize::shape_holding_path_until(arm, scene, &opt.design, 2001, stop),
+        "loading" => cosserat::study::arm::loading_path_until(arm, scene, &opt.design, 2001, stop),
+        "control" => cosserat::study::arm::control_path_until(arm, scene, &opt.design, 2001, stop),
+        _ => cosserat::study::arm::shape_holding_path_until(arm, scene, &opt.design, 2001, stop),
     };
     let diagram = match diagram {
         Ok(d) => d,
@@ -556,7 +560,7 @@ fn write_path(
             s.block.name()
         );
     }
-    if let Err(e) = cosserat::io::write_diagram(out, &problem.text, kind.axis, &diagram, true) {
+    if let Err(e) = cosserat::output::write_diagram(out, &problem.text, kind.axis, &diagram, true) {
         return fail(OUTPUT, e);
     }
     let chart = out.with_extension("png");

@@ -62,7 +62,7 @@ fn rows3(v: Vec<f64>) -> hdf5::Result<Vec<[f64; 3]>> {
 
 /// Reads a diagram written by `cosserat continue`.
 pub fn read_diagram(path: &Path) -> hdf5::Result<DiagramData> {
-    let f = cosserat::io::seal::open(path)?;
+    let f = cosserat::output::seal::open(path)?;
     let parameter_name = f
         .attr("parameter_name")?
         .read_scalar::<hdf5::types::VarLenUnicode>()?

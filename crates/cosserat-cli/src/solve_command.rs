@@ -5,8 +5,9 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use cosserat::bvp::{solve, Equilibrium};
-use cosserat::io::target::{claim, Claim};
-use cosserat::io::{write_equilibrium, write_stability, Problem, StabilityResult};
+use cosserat::input::Problem;
+use cosserat::output::target::{claim, Claim};
+use cosserat::output::{write_equilibrium, write_stability, StabilityResult};
 use cosserat::stability::{analyze, critical_load, CriticalLoad, Stability};
 
 use crate::exit::{fail, BAD_INPUT, NO_RESULT, OUTPUT};
@@ -68,7 +69,7 @@ pub fn claim_outputs(
     inputs: &[&std::path::Path],
     replace: bool,
 ) -> Result<Vec<Claim>, ExitCode> {
-    cosserat::io::target::claim_all(outputs, inputs, replace)
+    cosserat::output::target::claim_all(outputs, inputs, replace)
         .map(|claims| claims.into_iter().map(hold).collect())
         .map_err(|e| fail(BAD_INPUT, e))
 }

@@ -13,7 +13,7 @@ use std::path::Path;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
-use cosserat::sweep::contour::{GridField, PowerFit};
+use cosserat::study::sweep::contour::{GridField, PowerFit};
 
 type Chart = Result<(), Box<dyn std::error::Error>>;
 

@@ -10,9 +10,11 @@ use std::time::{Duration, Instant};
 
 use crate::sweep_figure as figure;
 use cosserat::continuation::RunState;
-use cosserat::io::target::{replace_atomically, Claim};
-use cosserat::io::{read_sweep, write_sweep, Problem, Sweep, SweepHeader};
-use cosserat::sweep::{run, ArmJob, Job, Record, Shard, SolveJob, SweepPlan};
+use cosserat::input::Problem;
+use cosserat::output::target::{replace_atomically, Claim};
+use cosserat::output::{read_sweep, write_sweep, SweepHeader};
+use cosserat::study::sweep::Sweep;
+use cosserat::study::sweep::{run, ArmJob, Job, Record, Shard, SolveJob, SweepPlan};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::exit::{fail, BAD_INPUT, INTERRUPTED, OUTPUT};
@@ -78,19 +80,7 @@ fn prepare(args: &SweepArgs) -> Result<Option<Setup>, ExitCode> {
         Some(s) => Shard::parse(s).map_err(|e| fail(BAD_INPUT, format!("--shard: {e}")))?,
         None => Shard::ALL,
     };
-    let plan = SweepPlan {
-        text: &problem.text,
-        sweep: &sweep,
-        shard,
-    };
-    for i in plan.members() {
-        plan.problem(i).map_err(|e| {
-            at(&format!(
-                "sweep point {i} ({}): {e}",
-                sweep.overrides(i).join(", ")
-            ))
-        })?;
-    }
+    check_points(&problem.text, &sweep, shard).map_err(|e| at(&e))?;
     let job: Box<dyn Job> = match &problem.arm {
         Some(_) => Box::new(ArmJob {
             families: sweep.families,
@@ -142,6 +132,31 @@ fn threads(asked: Option<u16>) -> Result<usize, ExitCode> {
     }
 }
 
+/// Reads the problem at every point of this shard, so that a bad point is
+/// refused before any point is computed.
+fn check_points(text: &str, sweep: &Sweep, shard: Shard) -> Result<(), String> {
+    let points = point_problems(text, sweep);
+    let plan = SweepPlan {
+        problem_at: &points,
+        sweep,
+        shard,
+    };
+    for i in plan.members() {
+        plan.problem(i)
+            .map_err(|e| format!("sweep point {i} ({}): {e}", sweep.overrides(i).join(", ")))?;
+    }
+    Ok(())
+}
+
+/// The problem at each grid point: the base problem's text read with the
+/// point's `--set` overrides.
+fn point_problems<'a>(
+    text: &'a str,
+    sweep: &'a Sweep,
+) -> impl Fn(usize) -> Result<Problem, String> + Sync + 'a {
+    move |i| Problem::from_str_with(text, &sweep.overrides(i)).map_err(|e| e.to_string())
+}
+
 fn header(
     problem: &Problem,
     sweep: &Sweep,
@@ -149,8 +164,9 @@ fn header(
     kind: &str,
     reason: RunState,
 ) -> SweepHeader {
+    let points = point_problems(&problem.text, sweep);
     let plan = SweepPlan {
-        text: &problem.text,
+        problem_at: &points,
         sweep,
         shard,
     };
@@ -231,8 +247,9 @@ fn announce(args: &SweepArgs, setup: &Setup, members: usize) {
 
 /// Runs the points, checkpointing every second; writes the final file.
 fn execute(args: &SweepArgs, setup: Setup) -> ExitCode {
+    let points = point_problems(&setup.problem.text, &setup.sweep);
     let plan = SweepPlan {
-        text: &setup.problem.text,
+        problem_at: &points,
         sweep: &setup.sweep,
         shard: setup.shard,
     };

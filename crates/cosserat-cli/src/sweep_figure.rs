@@ -9,9 +9,9 @@
 use std::path::Path;
 
 use crate::sweep_chart::{contour_maps, envelopes, Envelope, MapPanel};
-use cosserat::io::SweepHeader;
-use cosserat::sweep::contour::{fit_power_law, GridField, PowerFit};
-use cosserat::sweep::Record;
+use cosserat::output::SweepHeader;
+use cosserat::study::sweep::contour::{fit_power_law, GridField, PowerFit};
+use cosserat::study::sweep::Record;
 
 /// The key of the reach direction (degrees).
 const ALPHA: &str = "arm.alpha";
@@ -149,7 +149,7 @@ fn curves(header: &SweepHeader, records: &[Record], a: usize, column: &str) -> V
 
 fn multi_index(axes: &[Vec<f64>], i: usize) -> Vec<usize> {
     let shape: Vec<usize> = axes.iter().map(Vec::len).collect();
-    cosserat::io::grid_index(&shape, i)
+    cosserat::study::sweep::grid_index(&shape, i)
 }
 
 fn envelope_chart(

@@ -2,8 +2,8 @@
 #[path = "../../cosserat/tests/support/mod.rs"]
 mod support;
 
-use cosserat::optimize::{ArmProblem, SearchOptions};
 use cosserat::stability::StabilityOptions;
+use cosserat::study::arm::{ArmProblem, SearchOptions};
 
 fn problem(b1: f64, b3: f64, bounds: Vec<(f64, f64)>) -> ArmProblem {
     ArmProblem {
@@ -45,7 +45,7 @@ fn section_4_4_reach_from_the_problem_file() {
         "{}/problems/longest_arm.toml",
         concat!(env!("CARGO_MANIFEST_DIR"), "/../..")
     );
-    let p = cosserat::io::Problem::from_path(std::path::Path::new(&path), &[]).unwrap();
+    let p = cosserat::input::Problem::from_path(std::path::Path::new(&path), &[]).unwrap();
     let (arm, search, _) = p.arm.unwrap();
     let o = arm.optimize(&search).unwrap();
     let r = o.design.reach;
@@ -96,7 +96,7 @@ fn curvature_beats_the_straight_arm() {
 fn circular_arm_loading_path_arrives_at_the_design() {
     let p = problem(1.0, 2.0 / 3.0, vec![(-4.0, 4.0), (-2.0, 2.0), (-0.5, 0.5)]);
     let o = p.optimize(&SearchOptions::default()).unwrap();
-    let d = cosserat::optimize::loading_path(&p, &o.design, 2001).unwrap();
+    let d = cosserat::study::arm::loading_path(&p, &o.design, 2001).unwrap();
     let last = d.branches[0].points.last().unwrap();
     assert_eq!(last.parameter, 1.0);
     let designed = o
@@ -156,7 +156,7 @@ fn interrupted_optimization_keeps_its_best_design() {
         .unwrap();
     assert_eq!(reason.as_str(), "interrupted");
     let (reach, c, _) = read_reach(&out);
-    let p = cosserat::io::Problem::from_path(std::path::Path::new(&file), &[]).unwrap();
+    let p = cosserat::input::Problem::from_path(std::path::Path::new(&file), &[]).unwrap();
     let (arm, _, _) = p.arm.unwrap();
     let again = arm.design(&c[1..]).unwrap();
     assert!(
@@ -202,8 +202,8 @@ fn circular_fig5() -> ArmProblem {
 fn circular_arm_control_path_arrives_stably() {
     let p = circular_fig5();
     let o = p.optimize(&SearchOptions::default()).unwrap();
-    let scene = cosserat::optimize::ArmScene::default();
-    let d = cosserat::optimize::control_path(&p, &scene, &o.design, 2001).unwrap();
+    let scene = cosserat::study::arm::ArmScene::default();
+    let d = cosserat::study::arm::control_path(&p, &scene, &o.design, 2001).unwrap();
     let points = &d.branches[0].points;
     let last = points.last().unwrap();
     assert_eq!(last.parameter, 1.0);
@@ -236,17 +236,17 @@ fn section_4_4_arm_reaches_its_design_only_holding_its_shape() {
         "{}/problems/longest_arm.toml",
         concat!(env!("CARGO_MANIFEST_DIR"), "/../..")
     );
-    let p = cosserat::io::Problem::from_path(std::path::Path::new(&path), &[]).unwrap();
+    let p = cosserat::input::Problem::from_path(std::path::Path::new(&path), &[]).unwrap();
     let (arm, search, _) = p.arm.unwrap();
     let o = arm.optimize(&search).unwrap();
     let (x, z) = designed_tip(&o.design.shape_coefficients);
     assert!(x.abs() < 1e-6, "the design's tip is level: {x}");
-    let scene = cosserat::optimize::ArmScene::default();
+    let scene = cosserat::study::arm::ArmScene::default();
     let miss =
         |q: &cosserat::continuation::Point| (q.tip.position[0] - x).hypot(q.tip.position[2] - z);
     for d in [
-        cosserat::optimize::loading_path(&arm, &o.design, 2001).unwrap(),
-        cosserat::optimize::control_path(&arm, &scene, &o.design, 2001).unwrap(),
+        cosserat::study::arm::loading_path(&arm, &o.design, 2001).unwrap(),
+        cosserat::study::arm::control_path(&arm, &scene, &o.design, 2001).unwrap(),
     ] {
         let last = d.branches[0].points.last().unwrap();
         assert_eq!(last.parameter, 1.0);
@@ -258,7 +258,7 @@ fn section_4_4_arm_reaches_its_design_only_holding_its_shape() {
             last.tip.position
         );
     }
-    let d = cosserat::optimize::shape_holding_path(&arm, &scene, &o.design, 2001).unwrap();
+    let d = cosserat::study::arm::shape_holding_path(&arm, &scene, &o.design, 2001).unwrap();
     let points = &d.branches[0].points;
     assert_eq!(points.last().unwrap().parameter, 1.0);
     for q in points {
@@ -285,8 +285,8 @@ fn straight_rod(b: [f64; 3], phi: f64) -> (cosserat::model::Rod, cosserat::stabi
         b3: b[2],
         ..problem(1.0, 1.0, vec![])
     }
-    .rod_in(&cosserat::optimize::ArmScene {
-        weight: cosserat::optimize::ArmWeight::Alone,
+    .rod_in(&cosserat::study::arm::ArmScene {
+        weight: cosserat::study::arm::ArmWeight::Alone,
         max_curvature: None,
     });
     rod.energy = std::sync::Arc::new(cosserat::model::LinearElastic::uniform(b, [0.0; 3]));
@@ -353,8 +353,8 @@ fn fixed_shape_lateral_torsional_buckling_under_own_weight() {
 fn straight_arm_under_own_weight_reaches_the_closed_form() {
     let j = support::bessel::first_zero(-1.0 / 6.0, 1.0, 3.0);
     let p = problem(1.0, 2.0 / 3.0, vec![]);
-    let scene = cosserat::optimize::ArmScene {
-        weight: cosserat::optimize::ArmWeight::Alone,
+    let scene = cosserat::study::arm::ArmScene {
+        weight: cosserat::study::arm::ArmWeight::Alone,
         max_curvature: None,
     };
     let d = p.design_in(&scene, &[]).unwrap();
@@ -375,8 +375,8 @@ fn straight_arm_under_own_weight_reaches_the_closed_form() {
 fn actuator_limit_constrains_the_optimum() {
     let p = circular_fig5();
     let free = p.optimize(&SearchOptions::default()).unwrap();
-    let length = |o: &cosserat::optimize::ArmOptimum| o.scene.length(o.design.gamma);
-    let peak = |o: &cosserat::optimize::ArmOptimum| {
+    let length = |o: &cosserat::study::arm::ArmOptimum| o.scene.length(o.design.gamma);
+    let peak = |o: &cosserat::study::arm::ArmOptimum| {
         o.intrinsic_curvature
             .iter()
             .fold(0.0f64, |a, k| a.max(k.abs()))
@@ -386,7 +386,7 @@ fn actuator_limit_constrains_the_optimum() {
     let mut last = f64::INFINITY;
     for factor in [1.5, 0.8, 0.5, 0.25] {
         let limit = factor * free_peak;
-        let scene = cosserat::optimize::ArmScene {
+        let scene = cosserat::study::arm::ArmScene {
             max_curvature: Some(limit),
             ..Default::default()
         };

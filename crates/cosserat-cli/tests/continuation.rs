@@ -15,7 +15,7 @@ use std::sync::OnceLock;
 use cosserat::bvp::integrator::Tolerances;
 use cosserat::bvp::{equations, newton::NonlinearSystem, ShootingSystem};
 use cosserat::continuation::{continuation, Diagram, Family, SpecialKind};
-use cosserat::io::Problem;
+use cosserat::input::Problem;
 use cosserat::model::ModelLevel;
 use cosserat::stability::Block;
 use nalgebra::{DMatrix, DVector};

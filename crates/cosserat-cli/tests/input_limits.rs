@@ -4,7 +4,7 @@
 //! what to do. Where a bad count could reach a computation, the
 //! computation returns an error instead of panicking.
 
-use cosserat::io::Problem;
+use cosserat::input::Problem;
 #[path = "../../cosserat/tests/support/mod.rs"]
 mod support;
 use support::references::cantilever_tip;
@@ -548,7 +548,7 @@ fn sizes_beyond_the_memory_budget_are_refused_with_the_estimate() {
     for entry in std::fs::read_dir(dir).unwrap() {
         let path = entry.unwrap().path();
         let p = Problem::from_path(&path, &[]).unwrap();
-        let total = cosserat::io::memory::estimate(&p).total();
+        let total = cosserat::input::memory::estimate(&p).total();
         assert!(total < 1e9, "{}: {total:e}", path.display());
     }
 }

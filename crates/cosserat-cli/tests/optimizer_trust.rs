@@ -6,11 +6,12 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use cosserat::io::{read_sweep, Problem};
-use cosserat::optimize::{
+use cosserat::input::Problem;
+use cosserat::output::read_sweep;
+use cosserat::stability::StabilityOptions;
+use cosserat::study::arm::{
     ArmProblem, ArmScene, SearchOptions, StraightLimit, Verdict, REACH_TOLERANCE,
 };
-use cosserat::stability::StabilityOptions;
 
 const BIN: &str = env!("CARGO_BIN_EXE_cosserat");
 
@@ -374,7 +375,7 @@ fn actuator_line(values: &str, warm: bool) -> String {
     )
 }
 
-fn sweep_records(dir: &Path, name: &str, text: &str) -> Vec<cosserat::sweep::Record> {
+fn sweep_records(dir: &Path, name: &str, text: &str) -> Vec<cosserat::study::sweep::Record> {
     let problem = dir.join(format!("{name}.toml"));
     std::fs::write(&problem, text).unwrap();
     let out = dir.join(format!("{name}.h5"));
@@ -400,14 +401,14 @@ fn warm_sweep_line_recovers_after_a_failed_point() {
     let dir = scratch("warm");
     let warm = sweep_records(&dir, "warm", &actuator_line("0.5, 0.05, 0.2, 0.3", true));
     let cold = sweep_records(&dir, "cold", &actuator_line("0.5, 0.05, 0.2, 0.3", false));
-    let status = |r: &cosserat::sweep::Record| r.labels["family_0/status"].clone();
+    let status = |r: &cosserat::study::sweep::Record| r.labels["family_0/status"].clone();
     assert_eq!(status(&warm[1]), "no_critical_load");
     for r in [&warm[0], &warm[2], &warm[3]] {
         assert_eq!(status(r), "optimum", "point {}", r.index);
     }
     assert_eq!(warm[2].labels["family_0/start"], "cold_after_failure");
     assert_eq!(warm[3].labels["family_0/start"], "warm");
-    let reach = |r: &cosserat::sweep::Record| r.number("family_0/reach").unwrap();
+    let reach = |r: &cosserat::study::sweep::Record| r.number("family_0/reach").unwrap();
     assert_eq!(reach(&warm[2]).to_bits(), reach(&cold[2]).to_bits());
     assert_eq!(
         warm[2].numbers["family_0/shape_coefficients"],
@@ -482,9 +483,9 @@ fn long_computations_stop_when_asked() {
         })
         .unwrap();
     for path in [
-        cosserat::optimize::loading_path_until,
-        cosserat::optimize::control_path_until,
-        cosserat::optimize::shape_holding_path_until,
+        cosserat::study::arm::loading_path_until,
+        cosserat::study::arm::control_path_until,
+        cosserat::study::arm::shape_holding_path_until,
     ] {
         let d = path(&arm, &scene, &o.design, 201, &stop_after(5)).unwrap();
         assert_eq!(d.stop_reason, "interrupted");
@@ -508,7 +509,7 @@ fn search_stops_inside_a_polish() {
         let (_, progress, interrupted) = arm.search(
             &scene,
             &opts,
-            cosserat::optimize::SearchProgress::default(),
+            cosserat::study::arm::SearchProgress::default(),
             &stop_after(calls),
             &mut |_| {},
         );

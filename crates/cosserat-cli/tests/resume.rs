@@ -8,7 +8,8 @@
 use std::path::Path;
 
 use cosserat::continuation::{continuation, resume, Diagram};
-use cosserat::io::{read_saved, write_diagram, Problem};
+use cosserat::input::Problem;
+use cosserat::output::{read_saved, write_diagram};
 
 fn problem(name: &str, set: &[&str]) -> Problem {
     let path = format!(

@@ -7,9 +7,10 @@ mod support;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
-use cosserat::io::{read_sweep, Problem};
-use cosserat::sweep::contour::{fit_power_law, GridField};
-use cosserat::sweep::Record;
+use cosserat::input::Problem;
+use cosserat::output::read_sweep;
+use cosserat::study::sweep::contour::{fit_power_law, GridField};
+use cosserat::study::sweep::Record;
 
 const BIN: &str = env!("CARGO_BIN_EXE_cosserat");
 

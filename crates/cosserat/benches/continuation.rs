@@ -10,7 +10,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use cosserat::continuation::continuation;
-use cosserat::io::Problem;
+use cosserat::input::Problem;
 
 fn main() {
     for (name, overrides) in [

@@ -12,7 +12,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use cosserat::bvp::{solve, Method, SolverOptions};
-use cosserat::io::Problem;
+use cosserat::input::Problem;
 use cosserat::model::{
     Clamp, DeadLoads, LinearElastic, ModelChoice, ModelLevel, Rod, Shearable, StoredEnergy,
 };

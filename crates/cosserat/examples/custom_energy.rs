@@ -16,7 +16,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use cosserat::bvp::solve;
-use cosserat::io::Problem;
+use cosserat::input::Problem;
 use cosserat::model::{EnergyCatalog, EnergySpecError, LinearElastic, StoredEnergy};
 use nalgebra::{Matrix3, Vector3};
 

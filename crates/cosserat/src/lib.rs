@@ -18,20 +18,22 @@
 //!
 //! | stage | module | takes | gives |
 //! |---|---|---|---|
-//! | problem file | [`io`] (`io/problem/`) | TOML text, `--set` overrides | [`io::Problem`]: a [`model::Rod`], a [`model::ModelChoice`], [`bvp::SolverOptions`], and optionally a [`stability::FixedShape`], [`stability::StabilityOptions`], a [`continuation::Family`] with [`continuation::ContinuationOptions`], an [`optimize::ArmProblem`], a [`io::Sweep`] |
+//! | numerics | [`numerics`] | numbers | damped Newton's convergence test, Gauss–Legendre tables, scalar root finding and maximization, the banded LDLᵀ with inertia, the DOP853 integrator — nothing of rods |
 //! | model | [`model`] | lengths, stiffnesses, loads | [`model::Rod`]: length, `Arc<dyn` [`model::StoredEnergy`]`>`, clamp, [`model::DeadLoads`], an optional [`model::TipSupport`]; n(s) = P + R + ∫_s^L f is known up to the tip reaction R |
 //! | equations | [`equations`] | a rod and its [`model::ModelLevel`] | a [`equations::RodEquations`]: the first-order ODEs (planar 4, Kirchhoff 9, Cosserat 9 with ν = e3 + S⁻¹N), their linearization, clamp and tip residuals |
 //! | equilibrium | [`bvp`] | the equations | [`bvp::solve`] by shooting, multiple shooting or Gauss–Legendre collocation with damped Newton → [`bvp::Equilibrium`]: samples (s, r, d1, d2, d3, κ, M, n), unknowns, Jacobian |
 //! | stability | [`stability`] | an equilibrium | [`stability::analyze`]: per quadrature point the [`stability::FormCoefficients`] (A = H, B, C) of δ²V, finite elements, banded K and G, LDLᵀ inertia and Lanczos → [`stability::Stability`] (spectra, Morse index); [`stability::critical_load`] of a fixed shape |
 //! | continuation | [`continuation`] | a [`continuation::Family`] F(x, p) = 0 | [`continuation::continuation`]: predictor–corrector, eigenvalue tracking, folds and branch points → [`continuation::Diagram`] |
-//! | arm study | [`optimize`] | an [`optimize::ArmProblem`] | fixed-shape critical loads over the shape coefficients, Sobol' + Nelder–Mead → [`optimize::ArmOptimum`]; its loading and control paths as diagrams |
-//! | sweep | [`sweep`] | a problem with a `[sweep]` grid | [`sweep::run`]: lines of the grid in parallel (rayon) with warm starts down each line, an arm or solve job per point → one [`sweep::Record`] per point |
-//! | output | [`io`] (feature `hdf5`) | results | HDF5 files (`io::write_equilibrium`, `io::write_stability`, `io::write_diagram`, `io::write_arm_study`, `io::write_sweep`), written atomically to outputs claimed by [`io::target`] |
+//! | study | [`study`] | a [`study::Problem`] | [`study::arm`]: fixed-shape critical loads over the shape coefficients, Sobol' + Nelder–Mead → [`study::arm::ArmOptimum`]; [`study::sweep`]: a job at every point of a grid in parallel → one [`study::sweep::Record`] per point |
 //!
-//! Below the stages, [`numerics`] holds the numerical building blocks with
-//! nothing of rods in them (Gauss–Legendre tables, scalar root finding and
-//! maximization, the banded LDLᵀ with inertia, the DOP853 integrator).
-//! Beside them, [`references`] holds the closed forms (elliptic
+//! Beside the stages, and imported by none of them:
+//!
+//! | module | takes | gives |
+//! |---|---|---|
+//! | [`input`] | TOML text, `--set` overrides | a checked [`study::Problem`] (the only code that reads problem files) |
+//! | [`output`] | results | HDF5 files (feature `hdf5`: `output::write_equilibrium`, `write_stability`, `write_diagram`, `write_arm_study`, `write_sweep`), written atomically to outputs claimed by [`output::target`] and sealed by [`output::seal`] |
+//!
+//! [`references`] holds the closed forms (elliptic
 //! integrals, Bessel zeros) that validation and tests compare against. The
 //! `cosserat` command, its charts, the bench and the validation runner live
 //! in the separate crate `cosserat-cli`.
@@ -47,13 +49,13 @@
 pub mod bvp;
 pub mod continuation;
 pub mod equations;
-pub mod io;
+pub mod input;
 pub mod model;
 pub mod numerics;
-pub mod optimize;
+pub mod output;
 pub mod references;
 pub mod stability;
-pub mod sweep;
+pub mod study;
 
 /// The code blocks of the repository's README, compiled and run as
 /// doctests so that its library example cannot go stale.

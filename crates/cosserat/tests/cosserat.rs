@@ -10,7 +10,7 @@ use std::f64::consts::PI;
 use std::sync::Arc;
 
 use cosserat::bvp::{solve, Equilibrium, Method, SolverOptions};
-use cosserat::io::Problem;
+use cosserat::input::Problem;
 use cosserat::model::{
     Clamp, DeadLoads, LinearElastic, ModelChoice, ModelLevel, Rod, Shearable, StoredEnergy,
 };

@@ -10,7 +10,7 @@ mod custom_energy;
 use std::path::Path;
 
 use cosserat::bvp::{solve, Method, SolverOptions};
-use cosserat::io::Problem;
+use cosserat::input::Problem;
 use cosserat::model::{LinearElastic, Profile, StoredEnergy};
 use custom_energy::{catalog, HyperbolicStiffening};
 use nalgebra::Vector3;

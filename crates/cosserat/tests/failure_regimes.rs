@@ -317,7 +317,7 @@ fn interval_budget_too_small_is_an_error() {
 #[test]
 fn continuation_recovers_on_multiple_shooting_for_a_long_rod() {
     use cosserat::continuation::continuation;
-    use cosserat::io::Problem;
+    use cosserat::input::Problem;
     let text = |method: &str| {
         format!(
             "[rod]\nlength = 16.0\n[energy]\nstiffness = [10.0, 1.0, 10.0]\n\

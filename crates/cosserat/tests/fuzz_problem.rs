@@ -8,7 +8,7 @@
 //! their rejection must name (`# expect: …` on the first line), so that a
 //! class of bad input once covered stays covered.
 
-use cosserat::io::Problem;
+use cosserat::input::Problem;
 use proptest::prelude::*;
 mod support;
 use support::fuzz::runner;

@@ -9,7 +9,7 @@ use std::f64::consts::PI;
 use std::sync::Arc;
 
 use cosserat::bvp::{solve, Equilibrium, SolverOptions, Strategy};
-use cosserat::io::Problem;
+use cosserat::input::Problem;
 use cosserat::model::{
     Clamp, DeadLoads, LinearElastic, ModelChoice, ModelLevel, Profile, QuarticStiffening, Rod,
     StoredEnergy,

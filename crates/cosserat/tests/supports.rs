@@ -8,7 +8,7 @@ mod support;
 use std::f64::consts::PI;
 
 use cosserat::bvp::{solve, Equilibrium, Method, SolverOptions};
-use cosserat::io::Problem;
+use cosserat::input::Problem;
 use cosserat::model::ModelLevel;
 use cosserat::stability::{analyze, StabilityOptions};
 use support::columns::{clamped_pinned, greenhill_clamped};

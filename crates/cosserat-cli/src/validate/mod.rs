@@ -100,7 +100,7 @@ pub fn run_cli(args: ValidateArgs) -> ExitCode {
         }
         let report = markdown(&cases, &rows, &opts);
         if let Err(e) =
-            cosserat::io::target::replace_atomically(out, |tmp| std::fs::write(tmp, &report))
+            cosserat::output::target::replace_atomically(out, |tmp| std::fs::write(tmp, &report))
         {
             eprintln!("error: {e}");
             return ExitCode::from(1);

@@ -14,7 +14,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use cosserat::bvp::{solve, Equilibrium};
-use cosserat::io::Problem;
+use cosserat::input::Problem;
 use cosserat::stability::critical_load;
 
 use super::case::{Case, CaseFile, Check, InputError, Point, Scan};

@@ -5,7 +5,7 @@
 //! `[energy.parameters]`) into a [`StoredEnergy`]. The standard catalog
 //! holds "linear" and "quartic"; a program adds its own energy with
 //! [`EnergyCatalog::register`] and reads problem files through
-//! `io::Problem::from_path_in` — see examples/custom_energy.rs.
+//! `input::Problem::from_path_in` — see examples/custom_energy.rs.
 
 use std::collections::BTreeMap;
 use std::sync::Arc;

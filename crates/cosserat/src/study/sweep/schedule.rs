@@ -9,8 +9,9 @@ use std::sync::Mutex;
 
 use rayon::prelude::*;
 
+use super::Sweep;
 use super::{Job, Record};
-use crate::io::{Problem, ProblemError, Sweep};
+use crate::study::Problem;
 
 /// Shard `index` of `count` (0 ≤ index < count): the lines whose number
 /// modulo `count` is `index`.
@@ -45,11 +46,17 @@ impl std::fmt::Display for Shard {
     }
 }
 
+/// The problem at a flat grid point, or why there is none (the message is
+/// kept as the point's `error` label). The caller builds it, typically by
+/// reading the base problem text with the point's overrides
+/// ([`Sweep::overrides`]); the sweep itself never reads problem files.
+pub type PointProblem<'a> = dyn Fn(usize) -> Result<Problem, String> + Sync + 'a;
+
 /// A sweep of a base problem.
-#[derive(Debug, Clone)]
+#[derive(Clone)]
 pub struct SweepPlan<'a> {
-    /// The base problem's text (with its `--set` overrides applied).
-    pub text: &'a str,
+    /// The problem at each grid point.
+    pub problem_at: &'a PointProblem<'a>,
     /// The grid.
     pub sweep: &'a Sweep,
     /// The part of the grid this run computes.
@@ -82,8 +89,8 @@ impl SweepPlan<'_> {
     }
 
     /// The problem at grid point `i`.
-    pub fn problem(&self, i: usize) -> Result<Problem, ProblemError> {
-        Problem::from_str_with(self.text, &self.sweep.overrides(i))
+    pub fn problem(&self, i: usize) -> Result<Problem, String> {
+        (self.problem_at)(i)
     }
 }
 
@@ -122,7 +129,7 @@ pub fn run(
                     Ok(problem) => job.run(i, &problem, previous.as_ref(), &stopped),
                     Err(e) => {
                         let mut r = Record::new(i);
-                        r.label("error", &e.to_string());
+                        r.label("error", &e);
                         r
                     }
                 };

@@ -4,7 +4,7 @@
 
 use super::{Job, Record};
 use crate::bvp::solve;
-use crate::io::Problem;
+use crate::study::Problem;
 
 /// The solve job.
 #[derive(Debug, Clone, Copy, Default)]

@@ -12,7 +12,7 @@
 //! moment of the unit tip load on the shape.
 //!
 //! The search is deterministic: an Owen-scrambled Sobol' set over the box
-//! of c2..cM (the global stage, the private `optimize/sampling.rs`), then Nelder–Mead (argmin)
+//! of c2..cM (the global stage, the private `study/arm/sampling.rs`), then Nelder–Mead (argmin)
 //! from the best few (the polish).
 //!
 //! Submodules: `design` (a design's reach), `search` (the sampled search

@@ -4,7 +4,7 @@
 //! optimum needs a small simplex, a cold start the search's 5 %), and the
 //! finished optimum of a design (curvature fit (59), shapes).
 //!
-//! A child module of `optimize`, so that it uses the search's private
+//! A child module of `study::arm`, so that it uses the search's private
 //! pieces instead of copying them.
 
 use super::{sampling, ArmDesign, ArmOptimum, ArmProblem, ArmScene};
@@ -12,7 +12,7 @@ use super::{sampling, ArmDesign, ArmOptimum, ArmProblem, ArmScene};
 impl ArmProblem {
     /// The i-th sample (i ≥ 1) of the box of c2..cM — the samples of the
     /// global stage of [`ArmProblem::optimize`]: point i − 1 of the
-    /// scrambled Sobol' sequence (`optimize/sampling.rs`) mapped onto the bounds.
+    /// scrambled Sobol' sequence (`study/arm/sampling.rs`) mapped onto the bounds.
     pub fn sample_point(&self, i: usize) -> Vec<f64> {
         assert!(i >= 1, "samples are numbered from 1");
         sampling::unit_point(i - 1, self.bounds.len())

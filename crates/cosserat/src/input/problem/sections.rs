@@ -10,11 +10,11 @@ use std::collections::BTreeMap;
 use serde::de::{self, MapAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize};
 
-use crate::io::arm_section::ArmSection;
-use crate::io::continuation_section::ContinuationSection;
-use crate::io::strict;
-use crate::io::sweep_section::SweepSection;
-use crate::io::SupportSection;
+use crate::input::arm_section::ArmSection;
+use crate::input::continuation_section::ContinuationSection;
+use crate::input::strict;
+use crate::input::support_section::SupportSection;
+use crate::input::sweep_section::SweepSection;
 
 /// A problem file as written.
 #[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]

@@ -6,8 +6,8 @@ use serde::{Deserialize, Serialize};
 
 use super::problem::{invalid, ProblemError};
 use crate::model::Rod;
-use crate::optimize::{ArmProblem, ArmScene, ArmWeight, SearchOptions};
 use crate::stability::StabilityOptions;
+use crate::study::arm::{ArmProblem, ArmScene, ArmWeight, SearchOptions};
 
 /// `[arm]`.
 #[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]

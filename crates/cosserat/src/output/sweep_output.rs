@@ -25,8 +25,8 @@ use std::path::Path;
 use hdf5::types::VarLenUnicode;
 
 use super::hdf5_output::{array, string_attr, text, write_atomically, OutputError};
-use super::sweep_section::grid_index;
-use crate::sweep::Record;
+use crate::study::sweep::grid_index;
+use crate::study::sweep::Record;
 
 /// What a sweep file says about itself.
 #[derive(Debug, Clone, PartialEq)]

@@ -1,5 +1,5 @@
 //! Sweeps: a problem's analysis at every point of a grid over problem-file
-//! keys (the `[sweep]` table, [`crate::io::Sweep`]), in parallel, with
+//! keys (the `[sweep]` table, [`Sweep`]), in parallel, with
 //! results that do not depend on the number of threads.
 //!
 //! A grid point is the base problem with the point's `--set` overrides.
@@ -18,16 +18,18 @@
 
 mod arm_job;
 pub mod contour;
+mod grid;
 mod schedule;
 mod solve_job;
 
 pub use arm_job::{distinct_optima, shape_distance, ArmJob};
-pub use schedule::{run, Shard, SweepPlan};
+pub use grid::{grid_index, Sweep, SweepAxis, MAX_POINTS};
+pub use schedule::{run, PointProblem, Shard, SweepPlan};
 pub use solve_job::SolveJob;
 
 use std::collections::BTreeMap;
 
-use crate::io::Problem;
+use crate::study::Problem;
 
 /// One grid point's results: numeric columns (a fixed-width row each, NaN
 /// where a value does not exist) and text labels (statuses).

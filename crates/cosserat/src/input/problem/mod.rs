@@ -20,13 +20,10 @@ mod sections;
 
 use std::path::Path;
 
-use crate::bvp::SolverOptions;
-use crate::continuation::{ContinuationOptions, Family};
-use crate::io::strict;
-use crate::io::sweep_section::{Sweep, SweepSection};
-use crate::model::{EnergyCatalog, ModelChoice, ModelLevel, Rod};
-use crate::optimize::{ArmProblem, ArmScene, SearchOptions};
-use crate::stability::{FixedShape, StabilityOptions};
+use crate::input::strict;
+use crate::input::sweep_section::SweepSection;
+use crate::model::{EnergyCatalog, ModelLevel};
+pub use crate::study::Problem;
 pub(crate) use checks::{within, NEWTON_TOLERANCE};
 use options::{build_continuation, build_options, build_shape, build_stability, eigenvalue_count};
 use overrides::apply_overrides;
@@ -70,32 +67,6 @@ pub(crate) fn invalid(field: impl Into<String>, message: impl Into<String>) -> P
         field: field.into(),
         message: message.into(),
     }
-}
-
-/// A problem ready to solve.
-#[derive(Debug, Clone)]
-pub struct Problem {
-    /// The rod.
-    pub rod: Rod,
-    /// The model level and why.
-    pub model: ModelChoice,
-    /// The solver settings.
-    pub options: SolverOptions,
-    /// The effective problem text (with overrides applied), stored with
-    /// results.
-    pub text: String,
-    /// The fixed loaded shape of a fixed-shape scene.
-    pub shape: Option<FixedShape>,
-    /// The discretization of the second variation.
-    pub stability: StabilityOptions,
-    /// The continued family and how to continue it.
-    pub continuation: Option<(Family, ContinuationOptions)>,
-    /// The arm optimization, its search, and whether to compute R̂0.
-    pub arm: Option<(ArmProblem, SearchOptions, bool)>,
-    /// The arm's loads and actuator limit, and the size of its reach map.
-    pub arm_scene: Option<(ArmScene, usize)>,
-    /// The grid of a `[sweep]` table.
-    pub sweep: Option<Sweep>,
 }
 
 impl Problem {

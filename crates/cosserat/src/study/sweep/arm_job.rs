@@ -18,10 +18,10 @@
 //! better of the two at each point (they swap labels where they cross).
 
 use super::{Job, Record};
-use crate::io::Problem;
-use crate::optimize::{
+use crate::study::arm::{
     ArmDesign, ArmOptimum, ArmProblem, ArmScene, SearchOptions, Verdict, REACH_TOLERANCE,
 };
+use crate::study::Problem;
 
 /// Loaded shapes closer than this (root-mean-square difference of the
 /// turning angle φ(s̄) over [0, 1], rad) are one local optimum: the reach
@@ -202,7 +202,7 @@ impl ArmJob {
         let optimum = outcome.optimum.as_ref();
         let value = |g: fn(&ArmOptimum) -> f64| optimum.map_or(f64::NAN, g);
         let check = optimum.and_then(|o| o.resolution.as_ref());
-        let study = |g: fn(&crate::optimize::Resolution) -> f64| check.map_or(f64::NAN, g);
+        let study = |g: fn(&crate::study::arm::Resolution) -> f64| check.map_or(f64::NAN, g);
         record.set(&key("reach"), vec![value(|o| o.design.reach)]);
         record.set(&key("gamma_crit"), vec![value(|o| o.design.gamma)]);
         record.set(
@@ -344,7 +344,7 @@ impl Job for ArmJob {
 
 /// Says on stderr when a family's optimum was not resolved by the search's
 /// mesh (the reported one is then the finer mesh's, or carries its error).
-fn warn_mesh(index: usize, f: usize, r: &crate::optimize::Resolution) {
+fn warn_mesh(index: usize, f: usize, r: &crate::study::arm::Resolution) {
     let Some(&(n, coarse, fine)) = r.rejected.first() else {
         if r.verdict == Verdict::Unresolved {
             eprintln!(
@@ -374,7 +374,7 @@ fn warn_mesh(index: usize, f: usize, r: &crate::optimize::Resolution) {
 /// farthest stable equilibrium).
 fn write_straight(arm: &ArmProblem, record: &mut Record) {
     let s = arm.straight();
-    let v = |f: fn(&crate::optimize::StraightArm) -> f64| s.as_ref().map_or(f64::NAN, f);
+    let v = |f: fn(&crate::study::arm::StraightArm) -> f64| s.as_ref().map_or(f64::NAN, f);
     record.set("straight/reach", vec![v(|s| s.reach)]);
     record.set("straight/gamma_crit", vec![v(|s| s.gamma)]);
     record.set("straight/clamp_angle", vec![v(|s| s.clamp_angle)]);

@@ -3,7 +3,7 @@
 //!
 //! `solver.segments = 1e6` asked for a dense Jacobian of 9e6² numbers and
 //! `continuation.intervals = 10000` for 24 GB before the process was
-//! killed. The reader ([`super::Problem`]) now refuses a problem whose
+//! killed. The reader ([`super::Problem`], built by `input`) now refuses a problem whose
 //! estimate exceeds the budget, naming the key that drives the largest item
 //! and the estimate, so every command gets the check.
 //!

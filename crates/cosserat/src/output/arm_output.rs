@@ -45,7 +45,7 @@ use crate::continuation::RunState;
 use std::path::Path;
 
 use super::hdf5_output::{array, string_attr, write_atomically, OutputError};
-use crate::optimize::{
+use crate::study::arm::{
     ArmOptimum, ClosestStraight, ReachMap, Resolution, SearchProgress, StraightArm,
 };
 

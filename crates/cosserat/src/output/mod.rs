@@ -1,0 +1,28 @@
+//! Results out: HDF5 files of equilibria, stability, bifurcation diagrams,
+//! arm studies and sweeps (feature `hdf5`: the HDF5 C library through
+//! hdf5-metno), written atomically to outputs claimed by [`target`] and
+//! sealed with a checksum ([`seal`]) that is verified before a file is read
+//! back. Writers read results; they never build or compute them. No stage
+//! imports this module.
+
+#[cfg(feature = "hdf5")]
+mod arm_output;
+#[cfg(feature = "hdf5")]
+mod diagram;
+#[cfg(feature = "hdf5")]
+mod hdf5_output;
+pub mod seal;
+#[cfg(feature = "hdf5")]
+mod sweep_output;
+pub mod target;
+
+#[cfg(feature = "hdf5")]
+pub use arm_output::{read_search, write_arm, write_arm_study, ArmStudy, SavedSearch};
+#[cfg(feature = "hdf5")]
+pub use diagram::{read_saved, write_diagram};
+#[cfg(feature = "hdf5")]
+pub use hdf5_output::{
+    check_target, write_equilibrium, write_stability, OutputError, StabilityResult,
+};
+#[cfg(feature = "hdf5")]
+pub use sweep_output::{read_sweep, write_sweep, SweepHeader};
