@@ -4,9 +4,9 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::mesh::MeshKeys;
 use super::problem::{invalid, ProblemError};
 use crate::model::Rod;
-use crate::stability::StabilityOptions;
 use crate::study::arm::{ArmProblem, ArmScene, ArmWeight, SearchOptions};
 
 /// `[arm]`.
@@ -30,12 +30,13 @@ pub struct ArmSection {
     /// Iterations per polish.
     #[serde(default = "default_iterations")]
     pub iterations: u64,
-    /// Finite elements of the second variation.
-    #[serde(default = "default_elements")]
-    pub elements: usize,
+    /// Finite elements of the second variation (default:
+    /// [`crate::stability::StabilityOptions::default`], as in every table).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub elements: Option<usize>,
     /// Their Lagrange order.
-    #[serde(default = "default_order")]
-    pub order: usize,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub order: Option<usize>,
     /// Also compute R̂0 of the intrinsically straight arm.
     #[serde(default = "default_true")]
     pub straight: bool,
@@ -56,12 +57,6 @@ fn default_starts() -> usize {
 }
 fn default_iterations() -> u64 {
     400
-}
-fn default_elements() -> usize {
-    100
-}
-fn default_order() -> usize {
-    1
 }
 fn default_true() -> bool {
     true
@@ -198,18 +193,15 @@ impl ArmSection {
                 ));
             }
         }
-        if !(1..=3).contains(&self.order) {
-            return Err(invalid(
-                "arm.order",
-                format!("must be 1, 2 or 3, got {}", self.order),
-            ));
+        // The arm's critical load is the lowest eigenvalue of the pencil.
+        let stability = MeshKeys {
+            table: "arm",
+            elements: self.elements,
+            order: self.order,
+            eigenvalues: Some(1),
+            min_elements: 2,
         }
-        if self.elements < 2 {
-            return Err(invalid(
-                "arm.elements",
-                format!("must be at least 2, got {}", self.elements),
-            ));
-        }
+        .build()?;
         if self.samples < 1 {
             return Err(invalid(
                 "arm.samples",
@@ -228,7 +220,7 @@ impl ArmSection {
                 "must be at least 1 (Nelder–Mead polishes and their iterations; e.g. 4 and 400)",
             ));
         }
-        reach_direction(self.alpha, self.elements)?;
+        reach_direction(self.alpha, stability.elements)?;
         let b2 = h[(1, 1)];
         Ok((
             ArmProblem {
@@ -236,11 +228,7 @@ impl ArmSection {
                 b3: h[(2, 2)] / b2,
                 alpha: self.alpha.to_radians(),
                 bounds: self.bounds.iter().map(|[a, b]| (*a, *b)).collect(),
-                stability: StabilityOptions {
-                    elements: self.elements,
-                    order: self.order,
-                    eigenvalues: 1,
-                },
+                stability,
             },
             SearchOptions {
                 samples: self.samples,

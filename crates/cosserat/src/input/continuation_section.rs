@@ -3,9 +3,9 @@
 
 use serde::{Deserialize, Serialize};
 
+use super::mesh::MeshKeys;
 use super::problem::{invalid, within, ProblemError, NEWTON_TOLERANCE};
 use crate::continuation::{ContinuationOptions, Parameter};
-use crate::stability::StabilityOptions;
 
 /// `[continuation]`.
 #[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
@@ -41,15 +41,16 @@ pub struct ContinuationSection {
     /// Stop a branch when the tip tangent has turned this far (degrees).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tip_angle_limit: Option<f64>,
-    /// Finite elements of the tracked second variation.
-    #[serde(default = "default_elements")]
-    pub elements: usize,
+    /// Finite elements of the tracked second variation (default:
+    /// [`crate::stability::StabilityOptions::default`], as in every table).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub elements: Option<usize>,
     /// Their Lagrange order.
-    #[serde(default = "default_order")]
-    pub order: usize,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub order: Option<usize>,
     /// Eigenvalues tracked per block.
-    #[serde(default = "default_eigenvalues")]
-    pub eigenvalues: usize,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eigenvalues: Option<usize>,
     /// Corrector tolerance (scaled residual).
     #[serde(default = "default_tolerance")]
     pub tolerance: f64,
@@ -79,17 +80,8 @@ fn default_max_points() -> usize {
 fn default_depth() -> usize {
     1
 }
-fn default_elements() -> usize {
-    40
-}
-fn default_order() -> usize {
-    2
-}
 fn default_intervals() -> usize {
     32
-}
-fn default_eigenvalues() -> usize {
-    4
 }
 fn default_tolerance() -> f64 {
     1e-11
@@ -148,17 +140,16 @@ impl ContinuationSection {
                 "need min_step ≤ step ≤ max_step",
             ));
         }
-        if !(1..=3).contains(&self.order) {
-            return Err(invalid(
-                "continuation.order",
-                format!("must be 1, 2 or 3, got {}", self.order),
-            ));
+        let stability = MeshKeys {
+            table: "continuation",
+            elements: self.elements,
+            order: self.order,
+            eigenvalues: self.eigenvalues,
+            min_elements: 2,
         }
-        if self.elements < 2 || self.eigenvalues < 1 || self.max_points < 1 {
-            return Err(invalid(
-                "continuation",
-                "elements ≥ 2, eigenvalues ≥ 1 and max_points ≥ 1 are needed",
-            ));
+        .build()?;
+        if self.max_points < 1 {
+            return Err(invalid("continuation.max_points", "must be at least 1"));
         }
         let tip_angle_limit = match self.tip_angle_limit {
             // The tip angle is measured in [0°, 180°] (the angle between
@@ -198,11 +189,7 @@ impl ContinuationSection {
                 both_directions: self.both_directions,
                 switch_depth: self.switch_depth,
                 tip_angle_limit,
-                stability: StabilityOptions {
-                    elements: self.elements,
-                    order: self.order,
-                    eigenvalues: self.eigenvalues,
-                },
+                stability,
                 tolerance: within("continuation.tolerance", self.tolerance, NEWTON_TOLERANCE)?,
                 event_tolerance: 1e-11,
             },

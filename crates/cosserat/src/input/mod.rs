@@ -9,6 +9,7 @@
 mod arm_section;
 mod continuation_section;
 pub mod memory;
+mod mesh;
 mod problem;
 mod strict;
 mod support_section;

@@ -12,6 +12,7 @@ use super::{invalid, ProblemError};
 use crate::bvp::newton::NewtonOptions;
 use crate::bvp::{Method, SolverOptions, Strategy};
 use crate::continuation::{ContinuationOptions, Family, Parameter};
+use crate::input::mesh::MeshKeys;
 use crate::model::{ModelChoice, Profile, Rod};
 use crate::numerics::integrator::Tolerances;
 use crate::stability::{FixedShape, StabilityOptions};
@@ -161,23 +162,14 @@ pub(super) fn eigenvalue_count(
 }
 
 pub(super) fn build_stability(s: &StabilitySection) -> Result<StabilityOptions, ProblemError> {
-    if s.elements < 1 {
-        return Err(invalid("stability.elements", "must be at least 1"));
-    }
-    if !(1..=3).contains(&s.order) {
-        return Err(invalid(
-            "stability.order",
-            format!("must be 1, 2 or 3, got {}", s.order),
-        ));
-    }
-    if s.eigenvalues < 1 {
-        return Err(invalid("stability.eigenvalues", "must be at least 1"));
-    }
-    Ok(StabilityOptions {
+    MeshKeys {
+        table: "stability",
         elements: s.elements,
         order: s.order,
         eigenvalues: s.eigenvalues,
-    })
+        min_elements: 1,
+    }
+    .build()
 }
 
 pub(super) fn build_options(s: &SolverSection) -> Result<SolverOptions, ProblemError> {

@@ -66,25 +66,15 @@ pub struct ShapeSection {
 #[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct StabilitySection {
-    /// Finite elements.
-    #[serde(default = "default_elements")]
-    pub elements: usize,
+    /// Finite elements (default: [`crate::stability::StabilityOptions::default`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub elements: Option<usize>,
     /// Lagrange order (1 to 3).
-    #[serde(default = "default_order")]
-    pub order: usize,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub order: Option<usize>,
     /// Lowest eigenvalues reported per block.
-    #[serde(default = "default_eigenvalues")]
-    pub eigenvalues: usize,
-}
-
-fn default_elements() -> usize {
-    100
-}
-fn default_order() -> usize {
-    2
-}
-fn default_eigenvalues() -> usize {
-    4
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eigenvalues: Option<usize>,
 }
 
 impl Default for StabilitySection {
