@@ -191,6 +191,7 @@ impl Tracker {
             );
             block_morse.push(
                 count_below_constrained(k, g, constraints, 0.0)
+                    .below()
                     .ok_or_else(|| {
                         PointError::Eigen(format!(
                             "the Morse index of the {} block cannot be counted (K singular to working precision)",

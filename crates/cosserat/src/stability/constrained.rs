@@ -20,7 +20,8 @@ use nalgebra::{DMatrix, DVector};
 
 use super::eigen::{
     count_below, dense_pencil, diagonal_ratio, lowest_eigenpairs_near, shift_below,
-    shift_invert_lanczos, verify_with, EigenError, Eigenpairs, DENSE_LIMIT,
+    shift_invert_lanczos, verify_with, EigenError, Eigenpairs, Inertia, UndecidedInertia,
+    DENSE_LIMIT,
 };
 use crate::numerics::banded::{BandedLdlt, SymmetricBanded};
 
@@ -99,16 +100,19 @@ impl Bordered {
         })
     }
 
-    /// neg(A) + pos(S) − m, or None when round-off made it negative (the
+    /// neg(A) + pos(S) − m, undecided when round-off made it negative (the
     /// count cannot be trusted; it used to saturate to 0, "stable").
-    fn count_below(&self) -> Option<usize> {
+    fn count_below(&self) -> Inertia {
         let pos = self
             .s
             .symmetric_eigenvalues()
             .iter()
             .filter(|&&v| v > 0.0)
             .count();
-        (self.a.negative_pivots() + pos).checked_sub(self.s.nrows())
+        (self.a.negative_pivots() + pos)
+            .checked_sub(self.s.nrows())
+            .ok_or(UndecidedInertia::RoundOff)
+            .into()
     }
 
     /// y = (A⁻¹ − Z S⁻¹ Zᵀ) b.
@@ -120,28 +124,29 @@ impl Bordered {
     }
 }
 
-/// The number of eigenvalues below σ of (K, G) on null C, or None when it
-/// cannot be decided (K − σG has zero pivots at σ and at every nudge):
-/// undecided, never a default count.
+/// The number of eigenvalues below σ of (K, G) on null C, or
+/// [`Inertia::Undecided`] when it cannot be counted (K − σG has zero pivots
+/// at σ and at every nudge, or round-off spoilt the count), never a default
+/// count.
 pub fn count_below_constrained(
     k: &SymmetricBanded,
     g: &SymmetricBanded,
     c: &Constraints,
     sigma: f64,
-) -> Option<usize> {
+) -> Inertia {
     if c.count() == 0 {
         return count_below(k, g, sigma);
     }
     try_count_below_constrained(k, g, c, sigma)
 }
 
-/// The count, or None when it cannot be decided (persistent zero pivots).
+/// The count, or undecided (persistent zero pivots, round-off).
 fn try_count_below_constrained(
     k: &SymmetricBanded,
     g: &SymmetricBanded,
     c: &Constraints,
     sigma: f64,
-) -> Option<usize> {
+) -> Inertia {
     let nudge = 1e-10 * diagonal_ratio(k, g);
     let mut s = sigma;
     for _ in 0..8 {
@@ -150,7 +155,7 @@ fn try_count_below_constrained(
         }
         s += nudge;
     }
-    None
+    Inertia::Undecided(UndecidedInertia::ZeroPivots { size: k.size() })
 }
 
 /// The `count` lowest eigenpairs of (K, G) on null C; `previous` as in
@@ -190,7 +195,7 @@ pub fn lowest_eigenpairs_constrained(
 /// constrained Sturm count.
 fn shift_below_constrained(k: &SymmetricBanded, g: &SymmetricBanded, c: &Constraints) -> f64 {
     shift_below(diagonal_ratio(k, g), |s| {
-        try_count_below_constrained(k, g, c, s)
+        try_count_below_constrained(k, g, c, s).below()
     })
 }
 
@@ -292,7 +297,10 @@ mod tests {
             assert!(c.apply(v).norm() < 1e-10);
         }
         let sigma = 0.5 * (dense.values[2] + dense.values[3]);
-        assert_eq!(count_below_constrained(&k, &g, &c, sigma), Some(3));
+        assert_eq!(
+            count_below_constrained(&k, &g, &c, sigma),
+            Inertia::Below(3)
+        );
         // The constraints raise the spectrum (interlacing).
         let free = lowest_eigenpairs_near(&k, &g, 1, None).unwrap();
         assert!(sparse.values[0] > free.values[0]);

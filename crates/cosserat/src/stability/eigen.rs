@@ -47,46 +47,99 @@ pub enum EigenError {
 /// Size up to which the dense solver is used.
 pub const DENSE_LIMIT: usize = 48;
 
+/// How many eigenvalues of a pencil (K, G) lie below a shift σ — or why
+/// that could not be counted. A count that fails is never a number (it
+/// used to become 0, "stable").
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Inertia {
+    /// The number of eigenvalues below σ.
+    Below(usize),
+    /// Not counted, and why.
+    Undecided(UndecidedInertia),
+}
+
+/// Why an inertia count could not be made.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum UndecidedInertia {
+    /// K − σG broke down (a zero pivot) at σ and at every nudge, and has
+    /// more than [`DENSE_INERTIA_LIMIT`] unknowns to recount densely.
+    #[error("K − σG has zero pivots at the shift and every nudge, and {size} unknowns are too many to recount densely")]
+    ZeroPivots {
+        /// Unknowns of the pencil.
+        size: usize,
+    },
+    /// An eigenvalue of the dense K − σG lies within the nudge of zero (σ
+    /// sits on an eigenvalue of the pencil) or is not finite.
+    #[error(
+        "an eigenvalue of K − σG is zero to working precision (the shift sits on an eigenvalue)"
+    )]
+    OnEigenvalue,
+    /// The count of the constraint-bordered system came out negative:
+    /// round-off has spoilt it.
+    #[error("the constrained count came out negative (round-off)")]
+    RoundOff,
+}
+
+impl Inertia {
+    /// The count, or None when undecided.
+    pub fn below(self) -> Option<usize> {
+        match self {
+            Inertia::Below(n) => Some(n),
+            Inertia::Undecided(_) => None,
+        }
+    }
+}
+
+impl From<Result<usize, UndecidedInertia>> for Inertia {
+    fn from(r: Result<usize, UndecidedInertia>) -> Self {
+        match r {
+            Ok(n) => Inertia::Below(n),
+            Err(why) => Inertia::Undecided(why),
+        }
+    }
+}
+
 /// The number of eigenvalues of (K, G) below σ, from the inertia of K − σG
 /// (Sylvester's law: K − σG ≅ D of its LDLᵀ factors). A zero pivot nudges σ
 /// up by a relative 1e-10 of the spectrum's scale; should every nudge break
 /// down too, a problem of at most [`DENSE_INERTIA_LIMIT`] unknowns counts the
 /// eigenvalues of the dense K − σG (congruent to the pencil's shifted
-/// spectrum), and a larger one is None: undecided, never a default count.
-pub fn count_below(k: &SymmetricBanded, g: &SymmetricBanded, sigma: f64) -> Option<usize> {
+/// spectrum), and a larger one is [`Inertia::Undecided`], never a default
+/// count.
+pub fn count_below(k: &SymmetricBanded, g: &SymmetricBanded, sigma: f64) -> Inertia {
     let nudge = 1e-10 * diagonal_ratio(k, g);
     let mut s = sigma;
     for _ in 0..8 {
         match k.combine(1.0, g, -s).ldlt() {
-            Ok(f) => return Some(f.negative_pivots()),
+            Ok(f) => return Inertia::Below(f.negative_pivots()),
             Err(PivotBreakdown { .. }) => s += nudge,
         }
     }
-    dense_count_below(k, g, sigma, nudge)
+    dense_count_below(k, g, sigma, nudge).into()
 }
 
 /// Size up to which an undecidable LDLᵀ inertia is recounted densely.
 pub const DENSE_INERTIA_LIMIT: usize = 1500;
 
-/// The count from the eigenvalues of the dense K − σG, or None when one of
-/// them is within the nudge of zero (σ sits on an eigenvalue) or the
+/// The count from the eigenvalues of the dense K − σG, or why not: one of
+/// them is within the nudge of zero (σ sits on an eigenvalue), or the
 /// problem is too large to factor densely.
 fn dense_count_below(
     k: &SymmetricBanded,
     g: &SymmetricBanded,
     sigma: f64,
     nudge: f64,
-) -> Option<usize> {
+) -> Result<usize, UndecidedInertia> {
     if k.size() > DENSE_INERTIA_LIMIT {
-        return None;
+        return Err(UndecidedInertia::ZeroPivots { size: k.size() });
     }
     let shifted = k.to_dense() - g.to_dense() * sigma;
     let values = shifted.symmetric_eigenvalues();
     let gap = nudge * g.to_dense().diagonal().amax();
     if values.iter().any(|v| !v.is_finite() || v.abs() <= gap) {
-        return None;
+        return Err(UndecidedInertia::OnEigenvalue);
     }
-    Some(values.iter().filter(|v| **v < 0.0).count())
+    Ok(values.iter().filter(|v| **v < 0.0).count())
 }
 
 /// The `count` lowest eigenpairs of K v = λ G v.
@@ -190,7 +243,7 @@ pub(super) fn diagonal_ratio(k: &SymmetricBanded, g: &SymmetricBanded) -> f64 {
 }
 
 fn shift_below_spectrum(k: &SymmetricBanded, g: &SymmetricBanded) -> f64 {
-    shift_below(diagonal_ratio(k, g), |s| count_below(k, g, s))
+    shift_below(diagonal_ratio(k, g), |s| count_below(k, g, s).below())
 }
 
 /// A shift σ < λ_1 close to λ_1, from Sturm counts `count(σ)` (None when

@@ -20,7 +20,7 @@ use crate::bvp::{Equilibrium, SolveError, SolverOptions};
 use crate::equations::RodSample;
 use crate::model::{Freedom, ModelLevel, Rod};
 use constrained::{count_below_constrained, lowest_eigenpairs_constrained, Constraints};
-use eigen::EigenError;
+use eigen::{EigenError, Inertia, UndecidedInertia};
 
 /// How the second variation is discretized and how much of its spectrum is
 /// computed.
@@ -84,8 +84,8 @@ pub enum StabilityError {
     Unsupported(String),
     /// The inertia of K could not be decided (K has a zero pivot at every
     /// nudge of the shift and is too large to recount densely).
-    #[error("undecided: the inertia of the {0} block cannot be counted (K is singular to working precision: the equilibrium sits on a critical point)")]
-    Undecided(&'static str),
+    #[error("undecided: the inertia of the {0} block cannot be counted: {1} (K is singular to working precision: the equilibrium sits on a critical point)")]
+    Undecided(&'static str, UndecidedInertia),
 }
 
 /// The spectrum of one block of K.
@@ -153,8 +153,10 @@ pub fn block_spectrum(
             .iter()
             .map(|v| fe.nodal_rotations(block, v))
             .collect(),
-        morse_index: count_below_constrained(&k, &g, constraints, 0.0)
-            .ok_or(StabilityError::Undecided(block.name()))?,
+        morse_index: match count_below_constrained(&k, &g, constraints, 0.0) {
+            Inertia::Below(n) => n,
+            Inertia::Undecided(why) => return Err(StabilityError::Undecided(block.name(), why)),
+        },
     })
 }
 
@@ -297,10 +299,10 @@ pub fn decide(
     for _ in 0..=REFINEMENTS {
         let current = match analyze(rod, eq, solver, &opts) {
             Ok(st) => st,
-            Err(StabilityError::Undecided(block)) => {
+            Err(StabilityError::Undecided(block, why)) => {
                 return Ok(undecided(
                     format!(
-                        "the inertia of the {block} block cannot be counted on {} elements",
+                        "the inertia of the {block} block cannot be counted on {} elements: {why}",
                         opts.elements
                     ),
                     previous,
