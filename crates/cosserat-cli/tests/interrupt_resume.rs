@@ -1,25 +1,19 @@
 //! SIGINT, SIGTERM or SIGHUP at random moments of `optimize` and `sweep`,
 //! then `--resume` until the run completes: the file is the one an
 //! uninterrupted run writes, bit for bit in its datasets. (`continue` is
-//! checked the same way in tests/continuation.rs and, at every point of
+//! checked the same way in tests/continuation_cli.rs and, at every point of
 //! the shipped diagrams, in tests/resume.rs.)
+#[path = "common/problems.rs"]
+mod problems;
+use problems::shipped;
 #[path = "common/h5.rs"]
 mod h5;
-#[path = "../../cosserat/tests/support/mod.rs"]
-mod support;
 
 use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::Duration;
 
 const BIN: &str = env!("CARGO_BIN_EXE_cosserat");
-
-fn shipped(name: &str) -> String {
-    format!(
-        "{}/problems/{name}.toml",
-        concat!(env!("CARGO_MANIFEST_DIR"), "/../..")
-    )
-}
 
 /// Runs `args` with `-o out` (and `--resume` after the first run),
 /// signalling each run after the given delays, then once more to the end.

@@ -14,9 +14,9 @@ use cosserat::input::Problem;
 use cosserat::model::{
     Clamp, DeadLoads, LinearElastic, ModelChoice, ModelLevel, Rod, Shearable, StoredEnergy,
 };
+use cosserat::references::CantileverTip;
 use cosserat::stability::{analyze, StabilityOptions};
 use nalgebra::Vector3;
-use support::references::cantilever_tip;
 
 /// L = 1, B = (b1, 1, b3), shear and extension stiffnesses S, paper clamp
 /// (d1 = e1, d3 = e3), tip force f.
@@ -135,7 +135,7 @@ fn shearable_column_buckles_at_haringx_load() {
 #[test]
 fn converges_to_kirchhoff_at_first_order() {
     let k = 3.0;
-    let reference = cantilever_tip(k);
+    let reference = CantileverTip::at(k);
     let stiffnesses = [1e3, 1e4, 1e5, 1e6];
     let errors: Vec<f64> = stiffnesses
         .iter()

@@ -2,25 +2,19 @@
 //! the small-deflection closed form of beam theory, and at large deflection
 //! a mesh-convergence study of fixed-mesh collocation whose measured order
 //! is the method's, with every method agreeing on the converged tip.
-
-use std::sync::Arc;
+mod support;
 
 use cosserat::bvp::{solve, CollocationOptions, Equilibrium, Method, SolverOptions};
-use cosserat::model::{Clamp, DeadLoads, LinearElastic, ModelChoice, Rod};
+use cosserat::model::{DeadLoads, ModelChoice, Rod};
 use nalgebra::Vector3;
 
 /// L = 1, B2 = 1, clamp tangent e3, weight q per length along e1.
 fn hanging(q: f64) -> Rod {
-    Rod {
-        length: 1.0,
-        energy: Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
-            distributed_force: Vector3::new(q, 0.0, 0.0),
-            ..Default::default()
-        },
-        support: None,
-    }
+    let loads = DeadLoads {
+        distributed_force: Vector3::new(q, 0.0, 0.0),
+        ..Default::default()
+    };
+    support::rods::uniform(1.0, [10.0, 1.0, 10.0], loads)
 }
 
 fn solve_with(rod: &Rod, opts: SolverOptions) -> Equilibrium {

@@ -10,8 +10,9 @@ use std::f64::consts::PI;
 use cosserat::bvp::{solve, Equilibrium, Method, SolverOptions};
 use cosserat::input::Problem;
 use cosserat::model::ModelLevel;
+use cosserat::references::greenhill_clamped;
 use cosserat::stability::{analyze, StabilityOptions};
-use support::columns::{clamped_pinned, greenhill_clamped};
+use support::columns::clamped_pinned;
 
 /// A unit column (B = 1, L = 1) along e3, clamped at the origin, with a tip
 /// support and loads given as overrides.
@@ -160,7 +161,7 @@ fn columns_buckle_at_their_classical_loads() {
 #[test]
 fn twisted_column_buckles_at_greenhill_load() {
     for torque in [2.0, 5.0] {
-        let reference = greenhill_clamped(torque, 1.0, 1.0);
+        let reference = greenhill_clamped(torque);
         let column = Column {
             overrides: vec![
                 "support.translation=\"axial\"".into(),
