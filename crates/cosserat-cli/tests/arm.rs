@@ -1,7 +1,6 @@
 //! The longest arm: limits with closed forms, and the paper's values (the
 //! `optimize` command itself: arm_cli.rs).
-#[path = "common/problems.rs"]
-mod problems;
+mod common;
 #[path = "../../cosserat/tests/support/mod.rs"]
 mod support;
 
@@ -26,7 +25,7 @@ fn problem(b1: f64, b3: f64, bounds: Vec<(f64, f64)>) -> ArmProblem {
 /// The arm of the paper's Sec. 4.4 (problems/longest_arm.toml) and its
 /// optimum.
 fn section_4_4_optimum() -> (ArmProblem, ArmOptimum) {
-    let (arm, search, _) = problems::load("longest_arm").arm.unwrap();
+    let (arm, search, _) = common::problems::load("longest_arm").arm.unwrap();
     let o = arm.optimize(&search).unwrap();
     (arm, o)
 }

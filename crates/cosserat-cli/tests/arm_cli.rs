@@ -1,16 +1,11 @@
 //! The longest arm from the command line: `cosserat optimize` interrupted
 //! (keeping its best design), resumed where it stopped, and the Fig. 5 file
 //! and chart.
-#[path = "common/run.rs"]
-mod common_run;
-#[path = "common/h5.rs"]
-mod h5;
-#[path = "common/problems.rs"]
-mod problems;
+mod common;
 
-use common_run::{scratch, signal, stderr, BIN};
-use h5::stop_reason;
-use problems::{load, shipped};
+use common::h5::stop_reason;
+use common::problems::{load, shipped};
+use common::run::{scratch, signal, stderr, BIN};
 
 /// Ctrl-C during `cosserat optimize` keeps the best design found so far in
 /// a valid file marked interrupted, and that design is what it claims.

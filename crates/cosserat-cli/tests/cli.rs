@@ -1,17 +1,14 @@
 //! The `cosserat solve` command: the HDF5 contract, overrides, and every
 //! class of bad input (exit code 2, a message naming the field, no output).
-#[path = "common/problems.rs"]
-mod problems;
-use problems::shipped;
+mod common;
+use common::problems::shipped;
 
 use std::path::{Path, PathBuf};
 
-#[path = "common/run.rs"]
-mod common_run;
-use common_run::{entries, run, stderr};
+use common::run::{entries, run, stderr};
 
 fn scratch(name: &str) -> PathBuf {
-    common_run::scratch("cli", name)
+    common::run::scratch("cli", name)
 }
 const CANTILEVER: &str = include_str!("../../../problems/cantilever_tip_load.toml");
 
@@ -296,14 +293,15 @@ fn impossible_tolerance_is_an_error_not_a_result() {
 #[test]
 fn unstable_result_is_flagged() {
     let file = shipped("cantilever_tip_load");
-    let o = run(&[
+    let long = [
         "solve",
         &file,
         "--set",
         "rod.length=12",
         "--set",
         "loads.tip_force=[1,0,0]",
-    ]);
+    ];
+    let o = run(&long);
     let out = String::from_utf8_lossy(&o.stdout);
     let err = stderr(&o);
     assert!(
@@ -311,17 +309,15 @@ fn unstable_result_is_flagged() {
         "{out}\n{err}"
     );
     let o = run(&[
-        "solve",
-        &file,
-        "--set",
-        "rod.length=12",
-        "--set",
-        "loads.tip_force=[1,0,0]",
-        "--method",
-        "multiple-shooting",
-        "--set",
-        "solver.segments=16",
-    ]);
+        &long[..],
+        &[
+            "--method",
+            "multiple-shooting",
+            "--set",
+            "solver.segments=16",
+        ],
+    ]
+    .concat());
     assert!(String::from_utf8_lossy(&o.stdout).contains("stability stable"));
 }
 

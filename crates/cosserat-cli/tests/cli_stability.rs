@@ -1,10 +1,9 @@
 //! `cosserat stability`: the printed report and the HDF5 contract.
-#[path = "common/problems.rs"]
-mod problems;
+mod common;
 
 use std::path::{Path, PathBuf};
 
-use problems::shipped;
+use common::problems::shipped;
 use std::process::Command;
 
 const BIN: &str = env!("CARGO_BIN_EXE_cosserat");

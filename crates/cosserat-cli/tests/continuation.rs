@@ -4,8 +4,7 @@
 //! stepping cannot pass, branch switching onto new branches, and the
 //! collocation discretization's order (the `continue` command itself, its
 //! file and interrupted runs: continuation_cli.rs).
-#[path = "common/problems.rs"]
-mod problems;
+mod common;
 
 use std::f64::consts::PI;
 use std::path::Path;
@@ -27,7 +26,7 @@ const FILES: [&str; 4] = [
     "guided_column",
 ];
 
-use problems::{load as problem, shipped};
+use common::problems::{load as problem, shipped};
 
 /// Each shipped diagram, computed once.
 fn diagram(name: &str) -> &'static (Problem, Diagram) {

@@ -1,18 +1,13 @@
 //! `cosserat continue` from the command line: the HDF5 diagram contract and
 //! a plot, interrupted and killed runs keeping their points, and a run
 //! interrupted and resumed giving the file of an uninterrupted one.
-#[path = "common/run.rs"]
-mod common_run;
-#[path = "common/h5.rs"]
-mod h5;
-#[path = "common/problems.rs"]
-mod problems;
+mod common;
 
 use std::path::Path;
 
-use common_run::{entries, interrupt_after, scratch, signal, BIN};
-use h5::{read_f64, stop_reason};
-use problems::shipped;
+use common::h5::{read_f64, stop_reason};
+use common::problems::shipped;
+use common::run::{entries, interrupt_after, scratch, signal, BIN};
 
 #[test]
 fn cli_writes_the_diagram_contract_and_a_plot() {
@@ -64,6 +59,11 @@ fn cli_writes_the_diagram_contract_and_a_plot() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
+/// The parameter at the points of a diagram's first branch.
+fn first_branch(f: &hdf5::File) -> Vec<f64> {
+    read_f64(&f.group("branches/0").unwrap(), "parameter")
+}
+
 /// `cosserat continue` on the Euler column with the arclength step fixed
 /// at `step`, so that the run lasts long enough to be interrupted.
 fn slow_euler(out: &Path, step: &str, extra: &[&str]) -> std::process::Command {
@@ -88,7 +88,7 @@ fn interrupted_run_keeps_its_points() {
     assert_eq!(status.code(), Some(130), "interrupted runs exit with 130");
     let f = hdf5::File::open(&out).unwrap();
     assert_eq!(stop_reason(&f), "interrupted");
-    let points = read_f64(&f.group("branches/0").unwrap(), "parameter");
+    let points = first_branch(&f);
     assert!(points.len() > 5, "{} points kept", points.len());
     // No temporary files left behind.
     let left = entries(&dir);
@@ -107,7 +107,7 @@ fn killed_run_leaves_its_last_checkpoint() {
     child.kill().unwrap();
     let _ = child.wait();
     let f = hdf5::File::open(&out).expect("the checkpoint is a valid HDF5 file");
-    let points = read_f64(&f.group("branches/0").unwrap(), "parameter");
+    let points = first_branch(&f);
     assert!(points.len() > 5, "{} points kept", points.len());
     assert!(points.windows(2).all(|w| w[1] > w[0]), "points in order");
     assert_eq!(
@@ -122,7 +122,7 @@ fn killed_run_leaves_its_last_checkpoint() {
     let status = interrupt_after(&mut child, 3000);
     assert_eq!(status.code(), Some(130));
     let f = hdf5::File::open(&out).unwrap();
-    let more = read_f64(&f.group("branches/0").unwrap(), "parameter");
+    let more = first_branch(&f);
     assert!(
         more.len() > points.len(),
         "{} → {}",
@@ -162,7 +162,7 @@ fn interrupted_run_resumes_to_the_same_diagram() {
     for f in [&partial, &full] {
         assert_eq!(stop_reason(&hdf5::File::open(f).unwrap()), "completed");
     }
-    h5::assert_same_datasets(&partial, &full);
+    common::h5::assert_same_datasets(&partial, &full);
     let left = entries(&dir);
     assert_eq!(left.len(), 2, "no lock or temporary file left: {left:?}");
     std::fs::remove_dir_all(dir).unwrap();

@@ -42,8 +42,11 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
-const BIN: &str = env!("CARGO_BIN_EXE_cosserat");
-const ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../..");
+mod common;
+
+use common::problems::ROOT;
+use common::run::BIN;
+
 /// The documented exit codes (README, "Exit codes").
 const CODES: [i32; 5] = [0, 1, 2, 3, 130];
 /// The memory limit of every run, in KiB (`ulimit -v`).

@@ -5,11 +5,10 @@
 //! a bad count reaches a computation from a library caller, the
 //! computation returns an error instead of panicking.
 
-#[path = "common/problems.rs"]
-mod problems;
+mod common;
 
+use common::problems::{accepted, refusal, shipped_text, CANTILEVER};
 use cosserat::input::Problem;
-use problems::{accepted, refusal, shipped_text, CANTILEVER};
 
 /// Crashes: `continuation.eigenvalues = 100` on 16 elements of order 2
 /// indexed past the tracker's columns. Refused at input with the block's

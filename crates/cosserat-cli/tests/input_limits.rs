@@ -4,11 +4,10 @@
 //! what to do. Counts and sizes that could reach a computation are in
 //! input_budgets.rs.
 
-#[path = "common/problems.rs"]
-mod problems;
+mod common;
 
+use common::problems::{accepted, refusal, shipped_text, CANTILEVER};
 use cosserat::references::CantileverTip;
-use problems::{accepted, refusal, shipped_text, CANTILEVER};
 
 /// A problem with every optional table present, so that every
 /// fixed-length key can be overridden.

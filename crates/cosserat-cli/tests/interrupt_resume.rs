@@ -3,11 +3,8 @@
 //! uninterrupted run writes, bit for bit in its datasets. (`continue` is
 //! checked the same way in tests/continuation_cli.rs and, at every point of
 //! the shipped diagrams, in tests/resume.rs.)
-#[path = "common/problems.rs"]
-mod problems;
-use problems::shipped;
-#[path = "common/h5.rs"]
-mod h5;
+mod common;
+use common::problems::shipped;
 
 use std::path::Path;
 use std::process::{Command, Stdio};
@@ -90,7 +87,7 @@ fn optimize_resumes_to_the_uninterrupted_file() {
     for seed in 1..=3 {
         let part = dir.join(format!("part{seed}.h5"));
         interrupted_then_resumed(&args, &part, &delays(seed, 3, 900));
-        h5::assert_same_datasets(&part, &full);
+        common::h5::assert_same_datasets(&part, &full);
     }
     let left = std::fs::read_dir(&dir).unwrap().count();
     assert_eq!(left, 4, "no lock or temporary file left");
@@ -114,7 +111,7 @@ fn sweep_resumes_to_the_uninterrupted_file() {
     for seed in 1..=2 {
         let part = dir.join(format!("part{seed}.h5"));
         interrupted_then_resumed(&args, &part, &delays(seed, 3, 2500));
-        h5::assert_same_datasets(&part, &full);
+        common::h5::assert_same_datasets(&part, &full);
     }
     std::fs::remove_dir_all(dir).unwrap();
 }

@@ -1,9 +1,8 @@
 //! `cosserat sweep` and `cosserat merge`: values against closed forms,
 //! results independent of threads, shards and interruptions, and every
 //! class of bad input (exit 2, the field named, nothing written).
-#[path = "common/problems.rs"]
-mod problems;
-use problems::shipped;
+mod common;
+use common::problems::shipped;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
@@ -13,9 +12,7 @@ use cosserat::output::read_sweep;
 use cosserat::study::sweep::contour::{fit_power_law, GridField};
 use cosserat::study::sweep::Record;
 
-#[path = "common/run.rs"]
-mod common_run;
-use common_run::{interrupt_after, stderr, BIN};
+use common::run::{interrupt_after, stderr, BIN};
 
 /// A small arm (M = 3, a short search) over B̄1 × B̄3 with two families;
 /// `count` values of B̄3 per line.
@@ -49,7 +46,7 @@ axes = [
 }
 
 fn scratch(name: &str) -> PathBuf {
-    common_run::scratch("sweep", name)
+    common::run::scratch("sweep", name)
 }
 
 fn sweep(problem: &Path, out: &Path, extra: &[&str]) -> Command {

@@ -5,6 +5,7 @@
 //! the shear and extension stiffnesses grow, and the level chosen from a
 //! problem file.
 mod support;
+use support::methods::methods;
 
 use std::f64::consts::PI;
 use std::sync::Arc;
@@ -48,11 +49,7 @@ fn solve_cosserat(rod: &Rod, method: Method) -> Equilibrium {
     solve(rod, &choice, &opts).unwrap_or_else(|e| panic!("{method:?}: {e}"))
 }
 
-const METHODS: [Method; 3] = [
-    Method::Shooting,
-    Method::MultipleShooting { segments: 8 },
-    Method::Collocation { stages: 3 },
-];
+const METHODS: [Method; 3] = methods(8);
 
 /// Timoshenko beam theory: a tip force F across the rod deflects the tip by
 /// F L³/(3 B2) + F L/S1 (bending plus shear), up to O(F³).

@@ -3,6 +3,7 @@
 //! a mesh-convergence study of fixed-mesh collocation whose measured order
 //! is the method's, with every method agreeing on the converged tip.
 mod support;
+use support::methods::methods;
 
 use cosserat::bvp::{solve, CollocationOptions, Equilibrium, Method, SolverOptions};
 use cosserat::model::{DeadLoads, ModelChoice, Rod};
@@ -27,11 +28,7 @@ fn solve_with(rod: &Rod, opts: SolverOptions) -> Equilibrium {
 fn small_deflection_matches_beam_theory() {
     let q = 1e-4;
     let rod = hanging(q);
-    for method in [
-        Method::Shooting,
-        Method::MultipleShooting { segments: 4 },
-        Method::Collocation { stages: 3 },
-    ] {
+    for method in methods(4) {
         let opts = SolverOptions {
             method,
             ..Default::default()
@@ -78,11 +75,7 @@ fn large_deflection_converges_at_the_method_order() {
         assert!((order - 4.0).abs() < 0.15, "order {order}: {x:?}");
     }
     let converged = x[4];
-    for method in [
-        Method::Shooting,
-        Method::MultipleShooting { segments: 8 },
-        Method::Collocation { stages: 3 },
-    ] {
+    for method in methods(8) {
         let opts = SolverOptions {
             method,
             ..Default::default()

@@ -4,6 +4,7 @@
 //! constrained second variation and the BVP Jacobian, and Greenhill's
 //! twisted column with clamped ends.
 mod support;
+use support::methods::methods;
 
 use std::f64::consts::PI;
 
@@ -32,11 +33,7 @@ fn solve_with(p: &Problem, method: Method) -> Equilibrium {
     solve(&p.rod, &p.model, &opts).unwrap_or_else(|e| panic!("{method:?}: {e}"))
 }
 
-const METHODS: [Method; 3] = [
-    Method::Shooting,
-    Method::MultipleShooting { segments: 4 },
-    Method::Collocation { stages: 3 },
-];
+const METHODS: [Method; 3] = methods(4);
 
 /// A tip displaced across by δ: the guided clamp pushes back with 12Bδ/L³
 /// and bends the clamp with 6Bδ/L², the sliding pin with 3Bδ/L³ (linear

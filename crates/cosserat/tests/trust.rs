@@ -3,6 +3,7 @@
 //! to a turn by π. Each reference is independent of the code: the
 //! Bisshopp–Drucker elliptic integrals, and the straight rod.
 mod support;
+use support::methods::methods;
 
 use std::f64::consts::PI;
 use std::sync::Arc;
@@ -19,11 +20,7 @@ fn cantilever(b1: f64, b3: f64) -> Rod {
     uniform(1.0, [b1, 1.0, b3], tip_force(3.0, 0.0, 0.0))
 }
 
-const METHODS: [Method; 3] = [
-    Method::Shooting,
-    Method::MultipleShooting { segments: 8 },
-    Method::Collocation { stages: 3 },
-];
+const METHODS: [Method; 3] = methods(8);
 
 /// The tip of the planar cantilever does not depend on B1 or B3: exact to
 /// 1e-8 for every ratio from 1e-3 to 1e12 and every method. (A residual

@@ -237,7 +237,7 @@ pub(crate) fn fixtures(dir: &Path) -> Fixtures {
             String::from_utf8_lossy(&o.stderr)
         );
     };
-    let euler = format!("{ROOT}/problems/euler_column.toml");
+    let euler = common::problems::shipped("euler_column");
     run(&[
         "continue",
         &euler,
@@ -246,8 +246,7 @@ pub(crate) fn fixtures(dir: &Path) -> Fixtures {
         "--set",
         "continuation.tip_angle_limit=40",
     ]);
-    let cantilever =
-        std::fs::read_to_string(format!("{ROOT}/problems/cantilever_tip_load.toml")).unwrap();
+    let cantilever = common::problems::shipped_text("cantilever_tip_load");
     let sweep = format!(
         "{cantilever}\n[sweep]\naxes = [{{ key = \"loads.tip_force[0]\", values = [0.5, 1] }}, {{ key = \"energy.stiffness[1]\", values = [1, 2] }}]\n"
     );

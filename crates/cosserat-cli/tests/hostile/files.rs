@@ -30,9 +30,7 @@ pub(crate) fn replace_dataset<T: hdf5::H5Type>(path: &Path, name: &str, data: &[
 /// and `--resume`, never a panic or a silently truncated result.
 #[test]
 fn inconsistent_result_files_are_named_errors() {
-    let dir = std::env::temp_dir().join(format!("cosserat-hostile-files-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::run::scratch("hostile", "files");
     let fx = fixtures(&dir);
     type Damage = Box<dyn Fn(&Path)>;
     let cases: Vec<(&str, Damage, Vec<&str>)> = vec![
@@ -96,9 +94,7 @@ fn inconsistent_result_files_are_named_errors() {
 /// `merge`, an impossible allocation in `plot`).
 #[test]
 fn damaged_sealed_files_are_refused_before_hdf5_reads_them() {
-    let dir = std::env::temp_dir().join(format!("cosserat-hostile-seal-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = common::run::scratch("hostile", "seal");
     let fx = fixtures(&dir);
     for (k, (bytes, args)) in [
         (&fx.diagram, vec!["plot", "x.h5", "-o", "f.png"]),

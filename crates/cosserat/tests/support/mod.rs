@@ -5,5 +5,6 @@
 
 pub mod columns;
 pub mod fuzz;
+pub mod methods;
 pub mod quadrature;
 pub mod rods;
