@@ -1,9 +1,12 @@
-//! The longest arm: limits with closed forms, and the paper's values.
+//! The longest arm: limits with closed forms, and the paper's values (the
+//! `optimize` command itself: arm_cli.rs).
+mod common;
 #[path = "../../cosserat/tests/support/mod.rs"]
 mod support;
 
 use cosserat::stability::StabilityOptions;
-use cosserat::study::arm::{ArmProblem, SearchOptions};
+use cosserat::study::arm::{ArmOptimum, ArmProblem, SearchOptions};
+use support::quadrature::simpson;
 
 fn problem(b1: f64, b3: f64, bounds: Vec<(f64, f64)>) -> ArmProblem {
     ArmProblem {
@@ -19,13 +22,22 @@ fn problem(b1: f64, b3: f64, bounds: Vec<(f64, f64)>) -> ArmProblem {
     }
 }
 
+/// The arm of the paper's Sec. 4.4 (problems/longest_arm.toml) and its
+/// optimum.
+fn section_4_4_optimum() -> (ArmProblem, ArmOptimum) {
+    let (arm, search, _) = common::problems::load("longest_arm").arm.unwrap();
+    let o = arm.optimize(&search).unwrap();
+    (arm, o)
+}
+
 /// The straight horizontal arm is Timoshenko's cantilever: γ_crit =
 /// 2 j₋₁/₄,₁ √(B̄1 B̄3), so R̂ = √γ_crit.
 #[test]
 fn straight_arm_reaches_the_timoshenko_length() {
     let p = problem(1.0, 2.0 / 3.0, vec![]);
     let d = p.design(&[]).unwrap();
-    let gamma = 2.0 * support::bessel::first_zero(-0.25, 1.0, 3.0) * (2.0f64 / 3.0).sqrt();
+    let gamma =
+        2.0 * cosserat::references::bessel_first_zero(-0.25, 1.0, 3.0) * (2.0f64 / 3.0).sqrt();
     assert!(
         (d.reach - gamma.sqrt()).abs() < 1e-7,
         "{} vs {}",
@@ -41,13 +53,7 @@ fn straight_arm_reaches_the_timoshenko_length() {
 /// welcome) and not more than 2 % above it with these bounds.
 #[test]
 fn section_4_4_reach_from_the_problem_file() {
-    let path = format!(
-        "{}/problems/longest_arm.toml",
-        concat!(env!("CARGO_MANIFEST_DIR"), "/../..")
-    );
-    let p = cosserat::input::Problem::from_path(std::path::Path::new(&path), &[]).unwrap();
-    let (arm, search, _) = p.arm.unwrap();
-    let o = arm.optimize(&search).unwrap();
+    let (arm, o) = section_4_4_optimum();
     let r = o.design.reach;
     assert!((3.70 - 0.005..=3.70 * 1.02).contains(&r), "R* = {r}");
     // The design is what it claims: the tip is level (α = 0) and the
@@ -119,75 +125,15 @@ fn circular_arm_loading_path_arrives_at_the_design() {
     );
 }
 
-/// Ctrl-C during `cosserat optimize` keeps the best design found so far in
-/// a valid file marked interrupted, and that design is what it claims.
-#[test]
-fn interrupted_optimization_keeps_its_best_design() {
-    let dir = std::env::temp_dir().join(format!("cosserat-opt-int-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let out = dir.join("arm.h5");
-    let file = format!(
-        "{}/problems/longest_arm.toml",
-        concat!(env!("CARGO_MANIFEST_DIR"), "/../..")
-    );
-    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_cosserat"))
-        .args([
-            "optimize",
-            &file,
-            "-o",
-            out.to_str().unwrap(),
-            "--set",
-            "arm.samples=20000",
-        ])
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
-    std::thread::sleep(std::time::Duration::from_millis(1500));
-    let _ = std::process::Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status();
-    assert_eq!(child.wait().unwrap().code(), Some(130));
-    let f = hdf5::File::open(&out).unwrap();
-    let reason = f
-        .attr("stop_reason")
-        .unwrap()
-        .read_scalar::<hdf5::types::VarLenUnicode>()
-        .unwrap();
-    assert_eq!(reason.as_str(), "interrupted");
-    let (reach, c, _) = read_reach(&out);
-    let p = cosserat::input::Problem::from_path(std::path::Path::new(&file), &[]).unwrap();
-    let (arm, _, _) = p.arm.unwrap();
-    let again = arm.design(&c[1..]).unwrap();
-    assert!(
-        (again.reach - reach).abs() < 1e-12 && reach > 1.0,
-        "{reach} vs {}",
-        again.reach
-    );
-    std::fs::remove_dir_all(dir).unwrap();
-}
-
 /// The designed tip (x̄(1), z̄(1)) of a loaded shape φ(s̄) = Σ c_i s̄^{i−1},
 /// by composite Simpson quadrature of (sin φ, cos φ) — independent of the
 /// library's shape integrator.
 fn designed_tip(c: &[f64]) -> (f64, f64) {
     let phi = |s: f64| c.iter().rev().fold(0.0, |a, ci| a * s + ci);
-    let n = 2000;
-    let h = 1.0 / n as f64;
-    let (mut x, mut z) = (0.0, 0.0);
-    for i in 0..=n {
-        let w = if i == 0 || i == n {
-            1.0
-        } else if i % 2 == 1 {
-            4.0
-        } else {
-            2.0
-        };
-        let (sin, cos) = phi(i as f64 * h).sin_cos();
-        x += w * sin;
-        z += w * cos;
-    }
-    (x * h / 3.0, z * h / 3.0)
+    (
+        simpson(|s| phi(s).sin(), 0.0, 1.0),
+        simpson(|s| phi(s).cos(), 0.0, 1.0),
+    )
 }
 
 fn circular_fig5() -> ArmProblem {
@@ -232,13 +178,7 @@ fn circular_arm_control_path_arrives_stably() {
 /// marginal at λ = 1 (the design load is γ_crit).
 #[test]
 fn section_4_4_arm_reaches_its_design_only_holding_its_shape() {
-    let path = format!(
-        "{}/problems/longest_arm.toml",
-        concat!(env!("CARGO_MANIFEST_DIR"), "/../..")
-    );
-    let p = cosserat::input::Problem::from_path(std::path::Path::new(&path), &[]).unwrap();
-    let (arm, search, _) = p.arm.unwrap();
-    let o = arm.optimize(&search).unwrap();
+    let (arm, o) = section_4_4_optimum();
     let (x, z) = designed_tip(&o.design.shape_coefficients);
     assert!(x.abs() < 1e-6, "the design's tip is level: {x}");
     let scene = cosserat::study::arm::ArmScene::default();
@@ -309,7 +249,7 @@ fn fine() -> StabilityOptions {
 /// in the plane (B2) and out of it (B1), torsion not involved.
 #[test]
 fn fixed_shape_greenhill_column_under_own_weight() {
-    let j = support::bessel::first_zero(-1.0 / 3.0, 1.0, 3.0);
+    let j = cosserat::references::bessel_first_zero(-1.0 / 3.0, 1.0, 3.0);
     let greenhill = 2.25 * j * j;
     assert!((greenhill - 7.837).abs() < 5e-4, "{greenhill}");
     let (rod, shape) = straight_rod([2.0, 1.0, 0.7], -std::f64::consts::FRAC_PI_2);
@@ -332,7 +272,7 @@ fn fixed_shape_greenhill_column_under_own_weight() {
 /// Timoshenko & Gere, Theory of Elastic Stability (2nd ed., Sec. 6.3).
 #[test]
 fn fixed_shape_lateral_torsional_buckling_under_own_weight() {
-    let j = support::bessel::first_zero(-1.0 / 6.0, 1.0, 3.0);
+    let j = cosserat::references::bessel_first_zero(-1.0 / 6.0, 1.0, 3.0);
     assert!((6.0 * j - 12.85).abs() < 5e-3, "{}", 6.0 * j);
     for b in [[1.0, 1.0, 2.0 / 3.0], [0.5, 3.0, 0.4]] {
         let (rod, shape) = straight_rod(b, 0.0);
@@ -351,7 +291,7 @@ fn fixed_shape_lateral_torsional_buckling_under_own_weight() {
 /// λ_crit^{1/3} in units of (B2/q)^{1/3}, with λ_crit the closed form above.
 #[test]
 fn straight_arm_under_own_weight_reaches_the_closed_form() {
-    let j = support::bessel::first_zero(-1.0 / 6.0, 1.0, 3.0);
+    let j = cosserat::references::bessel_first_zero(-1.0 / 6.0, 1.0, 3.0);
     let p = problem(1.0, 2.0 / 3.0, vec![]);
     let scene = cosserat::study::arm::ArmScene {
         weight: cosserat::study::arm::ArmWeight::Alone,
@@ -417,192 +357,4 @@ fn actuator_limit_constrains_the_optimum() {
         }
         last = r;
     }
-}
-
-fn optimize(args: &[&str]) -> std::process::Output {
-    std::process::Command::new(env!("CARGO_BIN_EXE_cosserat"))
-        .arg("optimize")
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-fn read_reach(path: &std::path::Path) -> (f64, Vec<f64>, u64) {
-    let f = hdf5::File::open(path).unwrap();
-    let reach = f
-        .dataset("optimum/reach")
-        .unwrap()
-        .read_scalar::<f64>()
-        .unwrap();
-    let c = f
-        .dataset("optimum/shape_coefficients")
-        .unwrap()
-        .read_raw::<f64>()
-        .unwrap();
-    let evaluations = f
-        .group("optimum")
-        .unwrap()
-        .attr("evaluations")
-        .unwrap()
-        .read_scalar::<u64>()
-        .unwrap();
-    (reach, c, evaluations)
-}
-
-/// Starts `optimize` on `file` with `set`, sends `signal` after `wait`
-/// ms, and returns the exit code and the samples the file kept.
-fn interrupt(
-    file: &str,
-    out: &std::path::Path,
-    set: &[&str],
-    signal: &str,
-    wait: u64,
-) -> (Option<i32>, u64) {
-    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_cosserat"))
-        .args(["optimize", file, "-o", out.to_str().unwrap()])
-        .args(set)
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
-        .spawn()
-        .unwrap();
-    std::thread::sleep(std::time::Duration::from_millis(wait));
-    let _ = std::process::Command::new("kill")
-        .args([signal, &child.id().to_string()])
-        .status();
-    let code = child.wait().unwrap().code();
-    let f = hdf5::File::open(out).unwrap();
-    let reason = f
-        .attr("stop_reason")
-        .unwrap()
-        .read_scalar::<hdf5::types::VarLenUnicode>()
-        .unwrap();
-    assert_eq!(reason.as_str(), "interrupted");
-    let kept = f
-        .group("search")
-        .unwrap()
-        .attr("samples_done")
-        .unwrap()
-        .read_scalar::<u64>()
-        .unwrap();
-    (code, kept)
-}
-
-/// `optimize --resume` (issue 9): a run interrupted by SIGINT, or killed
-/// (SIGKILL, no handler: the checkpoint saved every 2 s), keeps its search
-/// progress; resuming goes on from there (not from the start) and ends on
-/// exactly the optimum of an uninterrupted run, with the same number of
-/// design evaluations — nothing lost, nothing done twice. A file of another
-/// problem is refused; a completed one has nothing to resume.
-#[test]
-fn interrupted_optimization_resumes_where_it_stopped() {
-    let dir = std::env::temp_dir().join(format!("cosserat-opt-resume-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = format!(
-        "{}/problems/longest_arm.toml",
-        concat!(env!("CARGO_MANIFEST_DIR"), "/../..")
-    );
-    let set = ["--set", "arm.samples=6000", "--set", "arm.straight=false"];
-    let reference = dir.join("reference.h5");
-    let whole = optimize(&[
-        &file,
-        "-o",
-        reference.to_str().unwrap(),
-        set[0],
-        set[1],
-        set[2],
-        set[3],
-    ]);
-    assert_eq!(whole.status.code(), Some(0));
-    let expected = read_reach(&reference);
-    for (signal, wait, code) in [("-INT", 1000, Some(130)), ("-KILL", 3000, None)] {
-        let out = dir.join(format!("arm{signal}.h5"));
-        let (got, kept) = interrupt(&file, &out, &set, signal, wait);
-        assert_eq!(got, code, "{signal}");
-        assert!((1..6000).contains(&kept), "{signal}: samples done {kept}");
-        let other = optimize(&[&file, "-o", out.to_str().unwrap(), "--resume"]);
-        assert_eq!(
-            other.status.code(),
-            Some(2),
-            "another problem (other --set) resumed"
-        );
-        let resume = [
-            &file,
-            "-o",
-            out.to_str().unwrap(),
-            "--resume",
-            set[0],
-            set[1],
-            set[2],
-            set[3],
-        ];
-        let resumed = optimize(&resume);
-        let text = String::from_utf8_lossy(&resumed.stdout);
-        assert_eq!(resumed.status.code(), Some(0), "{text}");
-        assert!(text.contains(&format!("after {kept} samples")), "{text}");
-        let got = read_reach(&out);
-        assert_eq!(
-            got, expected,
-            "{signal}: resumed {got:?} vs uninterrupted {expected:?}"
-        );
-        let again = optimize(&resume);
-        assert!(String::from_utf8_lossy(&again.stdout).contains("nothing to resume"));
-    }
-    std::fs::remove_dir_all(dir).unwrap();
-}
-
-/// `cosserat optimize problems/longest_arm_fig5.toml -o … --plot …`: the
-/// Fig. 5 file and chart. Checked from the file alone: 'Q' is the map
-/// sample of least Σb² (recomputed from /map/curvature_coefficients) with
-/// that sample's reach; the least-Σb² polish is no worse than Q; R* is at
-/// least every sample's reach (the map is the search's own first samples).
-#[test]
-fn fig5_file_and_chart() {
-    let dir = std::env::temp_dir().join(format!("cosserat-fig5-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let (out, png) = (dir.join("fig5.h5"), dir.join("fig5.png"));
-    let file = format!(
-        "{}/problems/longest_arm_fig5.toml",
-        concat!(env!("CARGO_MANIFEST_DIR"), "/../..")
-    );
-    let o = optimize(&[
-        &file,
-        "-o",
-        out.to_str().unwrap(),
-        "--plot",
-        png.to_str().unwrap(),
-        "--set",
-        "arm.map_samples=300",
-        "--set",
-        "arm.straight=false",
-    ]);
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    assert!(std::fs::metadata(&png).unwrap().len() > 10_000);
-    let f = hdf5::File::open(&out).unwrap();
-    let read = |name: &str| f.dataset(name).unwrap().read_raw::<f64>().unwrap();
-    let reach = read("map/reach");
-    let b = read("map/curvature_coefficients");
-    assert_eq!(b.len(), 4 * reach.len());
-    let norms: Vec<f64> = b.chunks(4).map(|r| r.iter().map(|v| v * v).sum()).collect();
-    let least = (0..norms.len())
-        .min_by(|&i, &j| norms[i].total_cmp(&norms[j]))
-        .unwrap();
-    let q = f.group("closest_straight").unwrap();
-    let index = q.attr("index").unwrap().read_scalar::<u64>().unwrap() as usize;
-    assert_eq!(index, least);
-    let q_reach = read("closest_straight/reach")[0];
-    assert!((q_reach - reach[least]).abs() < 1e-12);
-    let q_norm = read("closest_straight/curvature_norm")[0];
-    assert!((q_norm - norms[least]).abs() < 1e-9 * norms[least]);
-    assert!(read("least_curvature/curvature_norm")[0] <= q_norm);
-    let best = read("optimum/reach")[0];
-    assert!(
-        reach.iter().all(|r| *r <= best),
-        "a sample beats R* = {best}"
-    );
-    std::fs::remove_dir_all(dir).unwrap();
 }

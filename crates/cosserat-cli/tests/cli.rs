@@ -1,14 +1,14 @@
 //! The `cosserat solve` command: the HDF5 contract, overrides, and every
 //! class of bad input (exit code 2, a message naming the field, no output).
+mod common;
+use common::problems::shipped;
 
 use std::path::{Path, PathBuf};
 
-#[path = "common/run.rs"]
-mod common_run;
-use common_run::{run, stderr};
+use common::run::{entries, run, stderr};
 
 fn scratch(name: &str) -> PathBuf {
-    common_run::scratch("cli", name)
+    common::run::scratch("cli", name)
 }
 const CANTILEVER: &str = include_str!("../../../problems/cantilever_tip_load.toml");
 
@@ -17,6 +17,11 @@ const CANTILEVER: &str = include_str!("../../../problems/cantilever_tip_load.tom
 /// no output (nor a temporary) was left behind.
 fn rejects(name: &str, text: &str, extra: &[&str], expect: &[&str]) {
     ends_with(2, name, text, extra, expect);
+}
+
+/// [`rejects`] on the shipped cantilever with `edit.0` replaced by `edit.1`.
+fn rejects_edited(name: &str, edit: (&str, &str), expect: &[&str]) {
+    rejects(name, &CANTILEVER.replace(edit.0, edit.1), &[], expect);
 }
 
 /// A run that ends without a result: exit `code` (2 bad input, 3 no
@@ -39,42 +44,54 @@ fn ends_with(code: i32, name: &str, text: &str, extra: &[&str], expect: &[&str])
     for e in expect {
         assert!(err.contains(e), "{name}: `{e}` not in: {err}");
     }
-    let left: Vec<_> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name())
-        .collect();
+    let left = entries(&dir);
     assert_eq!(left.len(), 1, "{name}: output left behind: {left:?}");
     std::fs::remove_dir_all(dir).unwrap();
 }
 
 #[test]
 fn syntax_error_gives_line_and_column() {
-    let text = CANTILEVER.replace("length = 1.0", "length = = 1.0");
-    rejects("syntax", &text, &[], &["line 6, column", "length"]);
+    rejects_edited(
+        "syntax",
+        ("length = 1.0", "length = = 1.0"),
+        &["line 6, column", "length"],
+    );
 }
 
 #[test]
 fn unknown_key_is_named() {
-    let text = CANTILEVER.replace("length = 1.0", "lenght = 1.0");
-    rejects("unknown", &text, &[], &["unknown field `lenght`", "line 6"]);
+    rejects_edited(
+        "unknown",
+        ("length = 1.0", "lenght = 1.0"),
+        &["unknown field `lenght`", "line 6"],
+    );
 }
 
 #[test]
 fn missing_key_is_named() {
-    let text = CANTILEVER.replace("stiffness = [10.0, 1.0, 10.0]", "");
-    rejects("missing", &text, &[], &["missing field `stiffness`"]);
+    rejects_edited(
+        "missing",
+        ("stiffness = [10.0, 1.0, 10.0]", ""),
+        &["missing field `stiffness`"],
+    );
 }
 
 #[test]
 fn wrong_type_is_named() {
-    let text = CANTILEVER.replace("length = 1.0", "length = \"long\"");
-    rejects("type", &text, &[], &["invalid type", "line 6"]);
+    rejects_edited(
+        "type",
+        ("length = 1.0", "length = \"long\""),
+        &["invalid type", "line 6"],
+    );
 }
 
 #[test]
 fn non_positive_length_and_stiffness_are_named() {
-    let text = CANTILEVER.replace("length = 1.0", "length = 0.0");
-    rejects("length", &text, &[], &["rod.length", "positive"]);
+    rejects_edited(
+        "length",
+        ("length = 1.0", "length = 0.0"),
+        &["rod.length", "positive"],
+    );
     let text = CANTILEVER.replace("[10.0, 1.0, 10.0]", "[10.0, -1.0, 10.0]");
     rejects(
         "stiffness",
@@ -275,18 +292,16 @@ fn impossible_tolerance_is_an_error_not_a_result() {
 /// converges to a looped, unstable equilibrium: the report says so.
 #[test]
 fn unstable_result_is_flagged() {
-    let file = format!(
-        "{}/problems/cantilever_tip_load.toml",
-        concat!(env!("CARGO_MANIFEST_DIR"), "/../..")
-    );
-    let o = run(&[
+    let file = shipped("cantilever_tip_load");
+    let long = [
         "solve",
         &file,
         "--set",
         "rod.length=12",
         "--set",
         "loads.tip_force=[1,0,0]",
-    ]);
+    ];
+    let o = run(&long);
     let out = String::from_utf8_lossy(&o.stdout);
     let err = stderr(&o);
     assert!(
@@ -294,17 +309,15 @@ fn unstable_result_is_flagged() {
         "{out}\n{err}"
     );
     let o = run(&[
-        "solve",
-        &file,
-        "--set",
-        "rod.length=12",
-        "--set",
-        "loads.tip_force=[1,0,0]",
-        "--method",
-        "multiple-shooting",
-        "--set",
-        "solver.segments=16",
-    ]);
+        &long[..],
+        &[
+            "--method",
+            "multiple-shooting",
+            "--set",
+            "solver.segments=16",
+        ],
+    ]
+    .concat());
     assert!(String::from_utf8_lossy(&o.stdout).contains("stability stable"));
 }
 

@@ -1,15 +1,16 @@
 //! `cosserat stability`: the printed report and the HDF5 contract.
+mod common;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+
+use common::problems::shipped;
 use std::process::Command;
 
 const BIN: &str = env!("CARGO_BIN_EXE_cosserat");
 
-fn problem(name: &str) -> String {
-    format!(
-        "{}/problems/{name}",
-        concat!(env!("CARGO_MANIFEST_DIR"), "/../..")
-    )
+/// `cosserat stability` on the shipped problem `name`, writing `out`.
+fn stability(name: &str, out: &Path) -> (bool, String, String) {
+    run(&["stability", &shipped(name), "-o", out.to_str().unwrap()])
 }
 
 fn scratch(name: &str) -> PathBuf {
@@ -31,12 +32,7 @@ fn run(args: &[&str]) -> (bool, String, String) {
 fn fixed_shape_writes_the_critical_load() {
     let dir = scratch("ltb");
     let out = dir.join("ltb.h5");
-    let (ok, stdout, stderr) = run(&[
-        "stability",
-        &problem("timoshenko_ltb.toml"),
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let (ok, stdout, stderr) = stability("timoshenko_ltb", &out);
     assert!(ok, "{stderr}");
     assert!(stdout.contains("γ_crit"), "{stdout}");
     let f = hdf5::File::open(&out).unwrap();
@@ -58,12 +54,7 @@ fn fixed_shape_writes_the_critical_load() {
 fn equilibrium_writes_blocks_and_morse_index() {
     let dir = scratch("cantilever");
     let out = dir.join("c.h5");
-    let (ok, stdout, stderr) = run(&[
-        "stability",
-        &problem("cantilever_tip_load.toml"),
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let (ok, stdout, stderr) = stability("cantilever_tip_load", &out);
     assert!(ok, "{stderr}");
     assert!(stdout.contains("verdict   stable"), "{stdout}");
     let f = hdf5::File::open(&out).unwrap();
@@ -127,7 +118,7 @@ fn bad_stability_options_are_named() {
     let o = Command::new(BIN)
         .args([
             "stability",
-            &problem("euler_column.toml"),
+            &shipped("euler_column"),
             "--set",
             "stability.order=7",
         ])

@@ -1,12 +1,10 @@
 //! Continuation on the shipped problem files: Euler's branch point and the
 //! elastica, singular Hessian and BVP Jacobian at every special point, the
 //! Morse index across special points, a fold that natural-parameter
-//! stepping cannot pass, branch switching onto new branches, the HDF5
-//! diagram contract, and interrupted runs keeping their points.
-#[path = "common/h5.rs"]
-mod h5;
-#[path = "../../cosserat/tests/support/mod.rs"]
-mod support;
+//! stepping cannot pass, branch switching onto new branches, and the
+//! collocation discretization's order (the `continue` command itself, its
+//! file and interrupted runs: continuation_cli.rs).
+mod common;
 
 use std::f64::consts::PI;
 use std::path::Path;
@@ -17,9 +15,9 @@ use cosserat::bvp::{equations, newton::NonlinearSystem, ShootingSystem};
 use cosserat::continuation::{continuation, Diagram, Family, SpecialKind};
 use cosserat::input::Problem;
 use cosserat::model::ModelLevel;
+use cosserat::references::{ellip_e, ellip_f};
 use cosserat::stability::Block;
 use nalgebra::{DMatrix, DVector};
-use support::elliptic::{ellip_e, ellip_f};
 
 const FILES: [&str; 4] = [
     "euler_column",
@@ -28,13 +26,7 @@ const FILES: [&str; 4] = [
     "guided_column",
 ];
 
-fn problem(name: &str) -> Problem {
-    let path = format!(
-        "{}/problems/{name}.toml",
-        concat!(env!("CARGO_MANIFEST_DIR"), "/../..")
-    );
-    Problem::from_path(Path::new(&path), &[]).unwrap()
-}
+use common::problems::{load as problem, shipped};
 
 /// Each shipped diagram, computed once.
 fn diagram(name: &str) -> &'static (Problem, Diagram) {
@@ -345,212 +337,8 @@ fn lateral_torsional_branch_point_is_out_of_plane_and_above_timoshenko() {
     assert!(oop > 100.0 * ip, "{oop} vs {ip}");
     // The straight-rod value is 2 j₋₁/₄,₁ √(B1B3)/L² = 0.40126; in-plane
     // pre-buckling bending raises it (B2 is only 10× B1 here).
-    let timoshenko = 2.0 * support::bessel::first_zero(-0.25, 1.0, 3.0) * 0.1;
+    let timoshenko = 2.0 * cosserat::references::bessel_first_zero(-0.25, 1.0, 3.0) * 0.1;
     assert!(first.point.parameter > timoshenko && first.point.parameter < 1.3 * timoshenko);
-}
-
-fn read_f64(g: &hdf5::Group, name: &str) -> Vec<f64> {
-    g.dataset(name).unwrap().read_raw::<f64>().unwrap()
-}
-
-#[test]
-fn cli_writes_the_diagram_contract_and_a_plot() {
-    let dir = std::env::temp_dir().join(format!("cosserat-cont-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let out = dir.join("euler.h5");
-    let png = dir.join("euler.svg");
-    let file = format!(
-        "{}/problems/euler_column.toml",
-        concat!(env!("CARGO_MANIFEST_DIR"), "/../..")
-    );
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_cosserat"))
-        .args([
-            "continue",
-            &file,
-            "-o",
-            out.to_str().unwrap(),
-            "--plot",
-            png.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let f = hdf5::File::open(&out).unwrap();
-    assert!(f.attr("problem").is_ok());
-    let b0 = f.group("branches/0").unwrap();
-    let m = read_f64(&b0, "parameter").len();
-    assert!(m > 10);
-    assert_eq!(b0.dataset("tip_position").unwrap().shape(), vec![m, 3]);
-    assert_eq!(b0.dataset("eigenvalues").unwrap().shape()[0], m);
-    assert_eq!(b0.dataset("stable").unwrap().shape(), vec![m]);
-    assert_eq!(b0.dataset("morse_index").unwrap().shape(), vec![m]);
-    let sp = f.group("special_points").unwrap();
-    let kinds = sp
-        .dataset("kind")
-        .unwrap()
-        .read_raw::<hdf5::types::VarLenUnicode>()
-        .unwrap();
-    assert!(kinds
-        .iter()
-        .all(|k| k.as_str() == "fold" || k.as_str() == "branch_point"));
-    for name in [
-        "branch",
-        "index",
-        "parameter",
-        "tip_position",
-        "null_vectors",
-    ] {
-        assert!(sp.dataset(name).is_ok(), "{name}");
-    }
-    let svg = std::fs::read_to_string(&png).unwrap();
-    assert!(svg.contains("<svg") && svg.contains("BP1"));
-    std::fs::remove_dir_all(dir).unwrap();
-}
-
-/// `cosserat continue` on the Euler column with the arclength step fixed
-/// at `step`, so that the run lasts long enough to be interrupted.
-fn slow_euler(out: &Path, step: &str, extra: &[&str]) -> std::process::Command {
-    let file = format!(
-        "{}/problems/euler_column.toml",
-        concat!(env!("CARGO_MANIFEST_DIR"), "/../..")
-    );
-    let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_cosserat"));
-    c.args(["continue", &file, "-o", out.to_str().unwrap()])
-        .args(["--set", &format!("continuation.step={step}")])
-        .args(["--set", &format!("continuation.max_step={step}")])
-        .args(["--set", "continuation.max_points=100000"])
-        .args(extra)
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null());
-    c
-}
-
-/// Sends SIGINT after `ms` milliseconds and waits for the exit.
-fn interrupt_after(child: &mut std::process::Child, ms: u64) -> std::process::ExitStatus {
-    std::thread::sleep(std::time::Duration::from_millis(ms));
-    let _ = std::process::Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status();
-    child.wait().unwrap()
-}
-
-#[test]
-fn interrupted_run_keeps_its_points() {
-    let dir = std::env::temp_dir().join(format!("cosserat-int-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let out = dir.join("slow.h5");
-    let mut child = slow_euler(&out, "0.0005", &[]).spawn().unwrap();
-    let status = interrupt_after(&mut child, 2600);
-    assert_eq!(status.code(), Some(130), "interrupted runs exit with 130");
-    let f = hdf5::File::open(&out).unwrap();
-    let reason = f
-        .attr("stop_reason")
-        .unwrap()
-        .read_scalar::<hdf5::types::VarLenUnicode>()
-        .unwrap();
-    assert_eq!(reason.as_str(), "interrupted");
-    let points = read_f64(&f.group("branches/0").unwrap(), "parameter");
-    assert!(points.len() > 5, "{} points kept", points.len());
-    // No temporary files left behind.
-    let left: Vec<_> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name())
-        .collect();
-    assert_eq!(left.len(), 1, "{left:?}");
-    std::fs::remove_dir_all(dir).unwrap();
-}
-
-/// A kill (SIGKILL, no handler runs) loses at most the last 2 s: the
-/// checkpoint written while the run grew is a valid diagram file.
-#[test]
-fn killed_run_leaves_its_last_checkpoint() {
-    let dir = std::env::temp_dir().join(format!("cosserat-kill-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let out = dir.join("slow.h5");
-    let mut child = slow_euler(&out, "0.0005", &[]).spawn().unwrap();
-    std::thread::sleep(std::time::Duration::from_millis(3500));
-    child.kill().unwrap();
-    let _ = child.wait();
-    let f = hdf5::File::open(&out).expect("the checkpoint is a valid HDF5 file");
-    let points = read_f64(&f.group("branches/0").unwrap(), "parameter");
-    assert!(points.len() > 5, "{} points kept", points.len());
-    assert!(points.windows(2).all(|w| w[1] > w[0]), "points in order");
-    let reason = f
-        .attr("stop_reason")
-        .unwrap()
-        .read_scalar::<hdf5::types::VarLenUnicode>()
-        .unwrap();
-    assert_eq!(
-        reason.as_str(),
-        "in progress",
-        "a checkpoint is never marked completed"
-    );
-    drop(f);
-    // The lock of the killed process does not block the resumed run, which
-    // goes on from the checkpoint (more points) and cleans up after itself.
-    let mut child = slow_euler(&out, "0.0005", &["--resume"]).spawn().unwrap();
-    let status = interrupt_after(&mut child, 3000);
-    assert_eq!(status.code(), Some(130));
-    let f = hdf5::File::open(&out).unwrap();
-    let more = read_f64(&f.group("branches/0").unwrap(), "parameter");
-    assert!(
-        more.len() > points.len(),
-        "{} → {}",
-        points.len(),
-        more.len()
-    );
-    assert_eq!(more[..points.len()], points[..], "the kept points are kept");
-    let left: Vec<_> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name())
-        .collect();
-    assert_eq!(left.len(), 1, "no lock or temporary file left: {left:?}");
-    std::fs::remove_dir_all(dir).unwrap();
-}
-
-/// Interrupt a run (SIGINT, then SIGTERM, then SIGHUP), resume it each
-/// time, and get the file an uninterrupted run writes: the same datasets,
-/// bit for bit.
-#[test]
-fn interrupted_run_resumes_to_the_same_diagram() {
-    let dir = std::env::temp_dir().join(format!("cosserat-resume-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let (partial, full) = (dir.join("partial.h5"), dir.join("full.h5"));
-    let command = |out: &Path, extra: &[&str]| slow_euler(out, "0.004", extra);
-    let mut child = command(&partial, &[]).spawn().unwrap();
-    let status = interrupt_after(&mut child, 1500);
-    assert_eq!(
-        status.code(),
-        Some(130),
-        "the run should still be going at 1.5 s"
-    );
-    for signal in ["-TERM", "-HUP"] {
-        let mut child = command(&partial, &["--resume"]).spawn().unwrap();
-        std::thread::sleep(std::time::Duration::from_millis(700));
-        let _ = std::process::Command::new("kill")
-            .args([signal, &child.id().to_string()])
-            .status();
-        let code = child.wait().unwrap().code();
-        assert!(matches!(code, Some(0 | 130)), "{signal}: {code:?}");
-    }
-    assert!(command(&partial, &["--resume"]).status().unwrap().success());
-    assert!(command(&full, &[]).status().unwrap().success());
-    for f in [&partial, &full] {
-        let reason = hdf5::File::open(f)
-            .unwrap()
-            .attr("stop_reason")
-            .unwrap()
-            .read_scalar::<hdf5::types::VarLenUnicode>()
-            .unwrap();
-        assert_eq!(reason.as_str(), "completed");
-    }
-    h5::assert_same_datasets(&partial, &full);
-    let left: Vec<_> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name())
-        .collect();
-    assert_eq!(left.len(), 2, "no lock or temporary file left: {left:?}");
-    std::fs::remove_dir_all(dir).unwrap();
 }
 
 /// Continuation on the collocation discretization (Gauss–Legendre on a
@@ -563,10 +351,7 @@ fn collocation_continuation_converges_at_the_method_order() {
     let euler = PI * PI / 4.0;
     let branch_point = |stages: usize, intervals: usize| {
         let p = Problem::from_path(
-            Path::new(&format!(
-                "{}/problems/euler_column.toml",
-                concat!(env!("CARGO_MANIFEST_DIR"), "/../..")
-            )),
+            Path::new(&shipped("euler_column")),
             &[
                 "solver.method=\"collocation\"".into(),
                 format!("solver.stages={stages}"),

@@ -1,25 +1,16 @@
 //! SIGINT, SIGTERM or SIGHUP at random moments of `optimize` and `sweep`,
 //! then `--resume` until the run completes: the file is the one an
 //! uninterrupted run writes, bit for bit in its datasets. (`continue` is
-//! checked the same way in tests/continuation.rs and, at every point of
+//! checked the same way in tests/continuation_cli.rs and, at every point of
 //! the shipped diagrams, in tests/resume.rs.)
-#[path = "common/h5.rs"]
-mod h5;
-#[path = "../../cosserat/tests/support/mod.rs"]
-mod support;
+mod common;
+use common::problems::shipped;
 
 use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::Duration;
 
 const BIN: &str = env!("CARGO_BIN_EXE_cosserat");
-
-fn shipped(name: &str) -> String {
-    format!(
-        "{}/problems/{name}.toml",
-        concat!(env!("CARGO_MANIFEST_DIR"), "/../..")
-    )
-}
 
 /// Runs `args` with `-o out` (and `--resume` after the first run),
 /// signalling each run after the given delays, then once more to the end.
@@ -96,7 +87,7 @@ fn optimize_resumes_to_the_uninterrupted_file() {
     for seed in 1..=3 {
         let part = dir.join(format!("part{seed}.h5"));
         interrupted_then_resumed(&args, &part, &delays(seed, 3, 900));
-        h5::assert_same_datasets(&part, &full);
+        common::h5::assert_same_datasets(&part, &full);
     }
     let left = std::fs::read_dir(&dir).unwrap().count();
     assert_eq!(left, 4, "no lock or temporary file left");
@@ -120,7 +111,7 @@ fn sweep_resumes_to_the_uninterrupted_file() {
     for seed in 1..=2 {
         let part = dir.join(format!("part{seed}.h5"));
         interrupted_then_resumed(&args, &part, &delays(seed, 3, 2500));
-        h5::assert_same_datasets(&part, &full);
+        common::h5::assert_same_datasets(&part, &full);
     }
     std::fs::remove_dir_all(dir).unwrap();
 }

@@ -3,25 +3,18 @@
 //! file that is not an input, `--force` to replace it, no second process
 //! on it), images need `--force` like every other output, and what a killed
 //! run leaves (lock, temporary files) does not stand in the next run's way.
+mod common;
+use common::problems::shipped;
 
 use std::os::unix::fs::FileTypeExt;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-#[path = "common/run.rs"]
-mod common_run;
-use common_run::{run, stderr, BIN};
+use common::run::{run, stderr, BIN};
 
 fn scratch(name: &str) -> PathBuf {
-    common_run::scratch("lost", name)
-}
-
-fn shipped(name: &str) -> String {
-    format!(
-        "{}/problems/{name}.toml",
-        concat!(env!("CARGO_MANIFEST_DIR"), "/../..")
-    )
+    common::run::scratch("lost", name)
 }
 
 fn files(dir: &Path) -> Vec<String> {
@@ -171,9 +164,7 @@ fn a_second_writer_is_refused() {
     std::thread::sleep(Duration::from_millis(700));
     let second = run(&[&args[..], &["--force"]].concat());
     refused(&second, &["another cosserat process is writing"]);
-    let _ = Command::new("kill")
-        .args(["-TERM", &first.id().to_string()])
-        .status();
+    common::run::signal(&first, "-TERM");
     assert_eq!(first.wait().unwrap().code(), Some(130));
     assert_eq!(files(&dir), vec!["d.h5".to_string()], "no lock left");
     std::fs::remove_dir_all(dir).unwrap();

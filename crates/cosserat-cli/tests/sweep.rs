@@ -1,8 +1,8 @@
 //! `cosserat sweep` and `cosserat merge`: values against closed forms,
 //! results independent of threads, shards and interruptions, and every
 //! class of bad input (exit 2, the field named, nothing written).
-#[path = "../../cosserat/tests/support/mod.rs"]
-mod support;
+mod common;
+use common::problems::shipped;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
@@ -12,7 +12,7 @@ use cosserat::output::read_sweep;
 use cosserat::study::sweep::contour::{fit_power_law, GridField};
 use cosserat::study::sweep::Record;
 
-const BIN: &str = env!("CARGO_BIN_EXE_cosserat");
+use common::run::{interrupt_after, stderr, BIN};
 
 /// A small arm (M = 3, a short search) over B̄1 × B̄3 with two families;
 /// `count` values of B̄3 per line.
@@ -46,10 +46,7 @@ axes = [
 }
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("cosserat-sweep-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    common::run::scratch("sweep", name)
 }
 
 fn sweep(problem: &Path, out: &Path, extra: &[&str]) -> Command {
@@ -68,10 +65,6 @@ fn sweep(problem: &Path, out: &Path, extra: &[&str]) -> Command {
 
 fn run(c: &mut Command) -> Output {
     c.output().expect("the binary runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
 /// A record as bit patterns: index, numeric columns, labels.
@@ -118,7 +111,7 @@ fn straight_arm_grid_matches_timoshenko() {
     let (header, records) = read_sweep(&out).unwrap();
     assert_eq!(header.stop_reason, "completed");
     assert_eq!(records.len(), 6);
-    let j = support::bessel::first_zero(-0.25, 1.0, 3.0);
+    let j = cosserat::references::bessel_first_zero(-0.25, 1.0, 3.0);
     for r in &records {
         let (b1, b3) = (header.axes[0][r.index / 3], header.axes[1][r.index % 3]);
         let exact = (2.0 * j * (b1 * b3).sqrt()).sqrt();
@@ -285,11 +278,7 @@ fn interrupted_sweep_keeps_its_points() {
     std::fs::write(&problem, small_arm(30)).unwrap();
     let out = dir.join("s.h5");
     let mut child = sweep(&problem, &out, &["--threads", "1"]).spawn().unwrap();
-    std::thread::sleep(std::time::Duration::from_millis(1500));
-    let _ = Command::new("kill")
-        .args(["-INT", &child.id().to_string()])
-        .status();
-    let status = child.wait().unwrap();
+    let status = interrupt_after(&mut child, 1500);
     assert_eq!(status.code(), Some(130));
     let (h, records) = read_sweep(&out).unwrap();
     assert_eq!(h.stop_reason, "interrupted");
@@ -377,10 +366,7 @@ fn bad_sweeps_are_rejected_before_any_work() {
 #[test]
 fn fig6_problem_on_a_small_grid() {
     let dir = scratch("fig6");
-    let problem = format!(
-        "{}/problems/longest_arm_fig6.toml",
-        concat!(env!("CARGO_MANIFEST_DIR"), "/../..")
-    );
+    let problem = shipped("longest_arm_fig6");
     let out = dir.join("fig6.h5");
     let chart = dir.join("fig6.svg");
     let axes = "sweep.axes=[{key=\"energy.stiffness[0]\",linspace=[0.25,7,3]},\
@@ -420,10 +406,7 @@ fn fig6_problem_on_a_small_grid() {
 #[test]
 fn fig7_problem_reaches_euler_height_upwards() {
     let dir = scratch("fig7");
-    let problem = format!(
-        "{}/problems/longest_arm_fig7.toml",
-        concat!(env!("CARGO_MANIFEST_DIR"), "/../..")
-    );
+    let problem = shipped("longest_arm_fig7");
     let out = dir.join("fig7.h5");
     let axes = "sweep.axes=[{key=\"energy.stiffness[0]\",values=[1.0]},\
                 {key=\"arm.alpha\",values=[90,0]}]";
@@ -457,7 +440,7 @@ fn solve_sweep_follows_the_elastica() {
     assert_eq!(header.kind, "solve");
     for r in &records {
         let k = header.axes[0][r.index];
-        let exact = support::references::cantilever_tip(k);
+        let exact = cosserat::references::CantileverTip::at(k);
         let tip = &r.numbers["solve/tip_position"];
         assert_eq!(r.labels["solve/status"], "converged");
         assert!(

@@ -7,26 +7,12 @@
 #[path = "../tests/support/mod.rs"]
 mod support;
 
-use std::sync::Arc;
 use std::time::Instant;
 
 use cosserat::bvp::integrator::Tolerances;
 use cosserat::bvp::{solve, Method, SolverOptions};
-use cosserat::model::{Clamp, DeadLoads, LinearElastic, ModelChoice, ModelLevel, Rod};
-use nalgebra::Vector3;
-
-fn cantilever(k: f64) -> Rod {
-    Rod {
-        length: 1.0,
-        energy: Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
-            tip_force: Vector3::new(k, 0.0, 0.0),
-            ..Default::default()
-        },
-        support: None,
-    }
-}
+use cosserat::model::{ModelChoice, ModelLevel};
+use support::rods::cantilever;
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(|a, b| a.partial_cmp(b).unwrap());
@@ -39,7 +25,7 @@ fn main() {
         "k", "model", "method", "rtol", "tip error", "time [µs]", "ramp"
     );
     for k in [0.5, 3.0, 10.0] {
-        let reference = support::references::cantilever_tip(k);
+        let reference = cosserat::references::CantileverTip::at(k);
         let rod = cantilever(k);
         for level in [ModelLevel::Planar, ModelLevel::Kirchhoff] {
             let choice = ModelChoice::forced(&rod, level).unwrap();

@@ -6,16 +6,18 @@
 //! time of a fixed-shape critical load (the generalized eigenproblem
 //! K0 + λK1) at 100 elements.
 
-use std::sync::Arc;
+#[path = "../tests/support/mod.rs"]
+mod support;
+
 use std::time::Instant;
 
 use cosserat::bvp::{solve, SolverOptions};
-use cosserat::model::{Clamp, DeadLoads, LinearElastic, ModelChoice, Profile, Rod};
+use cosserat::model::{ModelChoice, Profile};
 use cosserat::stability::eigen::lowest_eigenpairs;
 use cosserat::stability::{
     coefficients, critical_load, Block, FiniteElements, FixedShape, StabilityOptions,
 };
-use nalgebra::Vector3;
+use support::rods::{cantilever, tip_force, uniform};
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(|a, b| a.total_cmp(b));
@@ -35,16 +37,7 @@ fn time(repeats: usize, mut f: impl FnMut()) -> f64 {
 }
 
 fn main() {
-    let rod = Rod {
-        length: 1.0,
-        energy: Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
-            tip_force: Vector3::new(3.0, 0.0, 0.0),
-            ..Default::default()
-        },
-        support: None,
-    };
+    let rod = cantilever(3.0);
     let opts = SolverOptions::default();
     let eq = solve(&rod, &ModelChoice::for_rod(&rod), &opts).unwrap();
     println!("lowest 4 eigenvalues of the in-plane block (order 2), cantilever k = 3");
@@ -83,16 +76,7 @@ fn main() {
         / points.iter().map(|p| (p.0 - mx).powi(2)).sum::<f64>();
     println!("log-log slope of time against elements: {slope:.2}");
 
-    let straight = Rod {
-        length: 1.0,
-        energy: Arc::new(LinearElastic::uniform([1.0, 1.0, 1.0], [0.0; 3])),
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
-            tip_force: Vector3::new(1.0, 0.0, 0.0),
-            ..Default::default()
-        },
-        support: None,
-    };
+    let straight = uniform(1.0, [1.0, 1.0, 1.0], tip_force(1.0, 0.0, 0.0));
     let shape = FixedShape {
         turning_angle: Profile::Constant(0.0),
     };

@@ -122,6 +122,25 @@ pub fn cantilever_tip(k: f64) -> (f64, f64, f64) {
     )
 }
 
+/// The cantilever's tip of [`cantilever_tip`] with named fields.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CantileverTip {
+    /// Deflection along the force.
+    pub x: f64,
+    /// Coordinate along the clamp's tangent.
+    pub z: f64,
+    /// Tip angle φ0 from the clamp's tangent.
+    pub angle: f64,
+}
+
+impl CantileverTip {
+    /// The tip at k = F L²/B (see [`cantilever_tip`]).
+    pub fn at(k: f64) -> Self {
+        let (x, z, angle) = cantilever_tip(k);
+        Self { x, z, angle }
+    }
+}
+
 /// The formulas a case file can name, with their parameters and their
 /// source; every length is for L = 1, every load is F L²/B.
 pub const FORMULAS: &[(&str, &str, &str)] = &[
@@ -342,8 +361,19 @@ mod tests {
         // K(1/√2) = Γ(1/4)²/(4√π) (DLMF 19.6.2 / 19.20).
         let k = ellip_f(FRAC_PI_2, FRAC_1_SQRT_2);
         assert!((k - 1.854_074_677_301_372).abs() < 1e-14, "{k}");
+        // E(1/√2) = 1.3506438810476755 (A&S Table 17.1; DLMF 19.6.2 / 19.20).
+        let e = ellip_e(FRAC_PI_2, FRAC_1_SQRT_2);
+        assert!((e - 1.350_643_881_047_675_5).abs() < 1e-14, "{e}");
+        // j_{0,1} = 2.404825557695773, j_{1,1} = 3.8317059702075125 (DLMF 10.21,
+        // A&S Table 9.5).
+        assert!((bessel_first_zero(0.0, 1.0, 3.0) - 2.404_825_557_695_773).abs() < 1e-13);
+        assert!((bessel_first_zero(1.0, 3.0, 4.5) - 3.831_705_970_207_512_5).abs() < 1e-13);
         // j₋₁/₄,₁: 2j = 4.0126 (Timoshenko & Gere).
         assert!((2.0 * bessel_first_zero(-0.25, 1.0, 3.0) - 4.0126).abs() < 1e-4);
+        // The paper's χ = √(2 j₋₁/₄,₁) ≈ 2.003 (Timoshenko & Gere 1961, Sec. 6.3:
+        // F L²/√(B1 B3) = 4.013 for the cantilever under a tip load).
+        let chi = evaluate("timoshenko_chi", &BTreeMap::new()).unwrap();
+        assert!((chi - 2.003).abs() < 5e-4, "{chi}");
         // The cantilever's small-load limit: x ≈ k/3.
         let (x, _, _) = cantilever_tip(1e-4);
         assert!((x - 1e-4 / 3.0).abs() < 1e-9);

@@ -4,7 +4,6 @@
 //! tolerance that cannot be met being reported.
 mod support;
 
-use std::sync::Arc;
 use std::time::Instant;
 
 use cosserat::bvp::newton::NewtonOptions;
@@ -12,29 +11,15 @@ use cosserat::bvp::{
     equations, solve_collocation, CollocationError, CollocationOptions, CollocationSolution,
 };
 use cosserat::equations::RodEquations;
-use cosserat::model::{Clamp, DeadLoads, LinearElastic, ModelLevel, Rod};
+use cosserat::model::ModelLevel;
+use cosserat::references::CantileverTip;
 use nalgebra::Vector3;
-use support::references::cantilever_tip;
-
-/// The paper's cantilever: L = 1, B = (10, 1, 10), clamp d1 = e1 (down),
-/// d3 = e3, tip force k e1.
-fn cantilever(k: f64) -> Rod {
-    Rod {
-        length: 1.0,
-        energy: Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
-            tip_force: Vector3::new(k, 0.0, 0.0),
-            ..Default::default()
-        },
-        support: None,
-    }
-}
+use support::rods::cantilever;
 
 /// Largest error of the tip position (x, z; y must vanish) against the
 /// elliptic-integral reference.
 fn tip_error(eq: &dyn RodEquations, sol: &CollocationSolution, k: f64) -> f64 {
-    let reference = cantilever_tip(k);
+    let reference = CantileverTip::at(k);
     let samples = sol.samples(eq);
     let tip = samples.last().unwrap().position;
     [

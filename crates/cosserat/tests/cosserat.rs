@@ -5,6 +5,7 @@
 //! the shear and extension stiffnesses grow, and the level chosen from a
 //! problem file.
 mod support;
+use support::methods::methods;
 
 use std::f64::consts::PI;
 use std::sync::Arc;
@@ -14,9 +15,9 @@ use cosserat::input::Problem;
 use cosserat::model::{
     Clamp, DeadLoads, LinearElastic, ModelChoice, ModelLevel, Rod, Shearable, StoredEnergy,
 };
+use cosserat::references::CantileverTip;
 use cosserat::stability::{analyze, StabilityOptions};
 use nalgebra::Vector3;
-use support::references::cantilever_tip;
 
 /// L = 1, B = (b1, 1, b3), shear and extension stiffnesses S, paper clamp
 /// (d1 = e1, d3 = e3), tip force f.
@@ -48,11 +49,7 @@ fn solve_cosserat(rod: &Rod, method: Method) -> Equilibrium {
     solve(rod, &choice, &opts).unwrap_or_else(|e| panic!("{method:?}: {e}"))
 }
 
-const METHODS: [Method; 3] = [
-    Method::Shooting,
-    Method::MultipleShooting { segments: 8 },
-    Method::Collocation { stages: 3 },
-];
+const METHODS: [Method; 3] = methods(8);
 
 /// Timoshenko beam theory: a tip force F across the rod deflects the tip by
 /// F L³/(3 B2) + F L/S1 (bending plus shear), up to O(F³).
@@ -135,7 +132,7 @@ fn shearable_column_buckles_at_haringx_load() {
 #[test]
 fn converges_to_kirchhoff_at_first_order() {
     let k = 3.0;
-    let reference = cantilever_tip(k);
+    let reference = CantileverTip::at(k);
     let stiffnesses = [1e3, 1e4, 1e5, 1e6];
     let errors: Vec<f64> = stiffnesses
         .iter()

@@ -2,6 +2,8 @@
 //! derivatives against central differences, the roll-up under an end couple
 //! against its closed form through a problem file that names the energy,
 //! and the errors a catalog gives.
+mod support;
+use support::methods::methods;
 
 #[allow(dead_code)]
 #[path = "../examples/custom_energy.rs"]
@@ -9,7 +11,7 @@ mod custom_energy;
 
 use std::path::Path;
 
-use cosserat::bvp::{solve, Method, SolverOptions};
+use cosserat::bvp::{solve, SolverOptions};
 use cosserat::input::Problem;
 use cosserat::model::{LinearElastic, Profile, StoredEnergy};
 use custom_energy::{catalog, HyperbolicStiffening};
@@ -65,11 +67,7 @@ fn roll_up_matches_closed_form_from_the_problem_file() {
     assert_eq!(problem.rod.energy.name(), "hyperbolic");
     let (a, c): (f64, f64) = (0.5, 4.0);
     let kappa = (a * c).asinh() / a;
-    for method in [
-        Method::Shooting,
-        Method::MultipleShooting { segments: 4 },
-        Method::Collocation { stages: 3 },
-    ] {
+    for method in methods(4) {
         let opts = SolverOptions {
             method,
             ..problem.options.clone()

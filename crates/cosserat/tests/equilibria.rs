@@ -10,23 +10,10 @@ use cosserat::bvp::{solve, Equilibrium, Method, SolverOptions};
 use cosserat::model::{
     Clamp, DeadLoads, LinearElastic, ModelChoice, ModelLevel, QuarticStiffening, Rod,
 };
+use cosserat::references::CantileverTip;
 use nalgebra::{Matrix3, Vector3};
-use support::references::cantilever_tip;
-
-/// The paper's cantilever: L = 1, B = (10, 1, 10), clamp d1 = e1 (down),
-/// d3 = e3, tip force k e1.
-fn cantilever(k: f64) -> Rod {
-    Rod {
-        length: 1.0,
-        energy: Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
-            tip_force: Vector3::new(k, 0.0, 0.0),
-            ..Default::default()
-        },
-        support: None,
-    }
-}
+use support::quadrature::simpson;
+use support::rods::cantilever;
 
 fn solve_with(rod: &Rod, level: ModelLevel, method: Method) -> Equilibrium {
     let choice = ModelChoice::forced(rod, level).unwrap();
@@ -50,7 +37,7 @@ const LEVELS: [ModelLevel; 2] = [ModelLevel::Planar, ModelLevel::Kirchhoff];
 #[test]
 fn cantilever_tip_matches_elliptic_integrals() {
     for k in [0.5, 1.0, 3.0, 10.0] {
-        let reference = cantilever_tip(k);
+        let reference = CantileverTip::at(k);
         let rod = cantilever(k);
         assert_eq!(ModelChoice::for_rod(&rod).level, ModelLevel::Planar);
         for level in LEVELS {
@@ -208,7 +195,7 @@ fn single_and_multiple_shooting_agree() {
 #[test]
 fn large_load_follows_the_loading_branch() {
     let k = 30.0;
-    let reference = cantilever_tip(k);
+    let reference = CantileverTip::at(k);
     for method in METHODS {
         let eq = solve_with(&cantilever(k), ModelLevel::Planar, method);
         assert!(eq.load_steps > 0, "{method:?} should ramp at k = {k}");
@@ -240,7 +227,7 @@ fn single_shooting_fails_clearly_where_multiple_shooting_recovers() {
         message.contains("stalled") || message.contains("did not converge"),
         "{message}"
     );
-    let reference = cantilever_tip(k);
+    let reference = CantileverTip::at(k);
     let eq = solve_with(&rod, ModelLevel::Planar, METHODS[1]);
     let tip = eq.tip().position;
     assert!((tip[0] - reference.x).abs() <= 1e-9, "x {}", tip[0]);
@@ -305,26 +292,8 @@ fn tabulated_intrinsic_curvature_gives_its_intrinsic_shape() {
         }
         acc
     };
-    let simpson = |f: &dyn Fn(f64) -> f64, a: f64, b: f64| {
-        let n = 2000;
-        let h = (b - a) / n as f64;
-        (0..=n)
-            .map(|i| {
-                let w = if i == 0 || i == n {
-                    1.0
-                } else if i % 2 == 1 {
-                    4.0
-                } else {
-                    2.0
-                };
-                w * f(a + h * i as f64)
-            })
-            .sum::<f64>()
-            * h
-            / 3.0
-    };
-    let x = simpson(&|s| phi(s).sin(), 0.0, 0.4) + simpson(&|s| phi(s).sin(), 0.4, 1.0);
-    let z = simpson(&|s| phi(s).cos(), 0.0, 0.4) + simpson(&|s| phi(s).cos(), 0.4, 1.0);
+    let x = simpson(|s| phi(s).sin(), 0.0, 0.4) + simpson(|s| phi(s).sin(), 0.4, 1.0);
+    let z = simpson(|s| phi(s).cos(), 0.0, 0.4) + simpson(|s| phi(s).cos(), 0.4, 1.0);
     for level in LEVELS {
         let eq = solve_with(&rod, level, Method::Shooting);
         let tip = eq.tip().position;

@@ -15,23 +15,15 @@ use cosserat::bvp::{
     solve, CollocationError, CollocationOptions, Discretization, Equilibrium, Method, SolveError,
     SolverOptions, Strategy,
 };
-use cosserat::model::{Clamp, DeadLoads, LinearElastic, ModelChoice, ModelLevel, Rod};
+use cosserat::model::{LinearElastic, ModelChoice, ModelLevel, Rod};
+use cosserat::references::CantileverTip;
 use nalgebra::Vector3;
-use support::references::cantilever_tip;
+use support::rods::{tip_force, uniform};
 
 /// The paper's cantilever of length `length`, B2 = 1, tip force `force`
 /// along d1(0) = e1: k = F L²/B2.
 fn cantilever(length: f64, force: f64) -> Rod {
-    Rod {
-        length,
-        energy: Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
-            tip_force: Vector3::new(force, 0.0, 0.0),
-            ..Default::default()
-        },
-        support: None,
-    }
+    uniform(length, [10.0, 1.0, 10.0], tip_force(force, 0.0, 0.0))
 }
 
 /// A planar rod with intrinsic curvature κ⁰2 = `kappa` (B2 = 1), unloaded
@@ -83,7 +75,7 @@ fn assert_clear_failure(result: Result<Equilibrium, SolveError>, method: &str) -
 /// Largest tip-position error against the elliptic-integral reference of
 /// a cantilever of length L with k = F L²/B (lengths scale with L).
 fn cantilever_error(eq: &Equilibrium, length: f64, force: f64) -> f64 {
-    let reference = cantilever_tip(force * length * length);
+    let reference = CantileverTip::at(force * length * length);
     let tip = eq.tip().position;
     [
         (tip[0] - length * reference.x).abs(),
@@ -349,7 +341,7 @@ fn continuation_recovers_on_multiple_shooting_for_a_long_rod() {
     assert!((b.points.last().unwrap().parameter - 1.0).abs() < 1e-12);
     for p in &b.points {
         let k = p.parameter * 256.0;
-        let exact = cantilever_tip(k);
+        let exact = CantileverTip::at(k);
         let tip = p.tip.position / 16.0;
         assert!(
             (tip[0] - exact.x).abs() < 1e-7 && (tip[2] - exact.z).abs() < 1e-7,

@@ -2,25 +2,20 @@
 //! the small-deflection closed form of beam theory, and at large deflection
 //! a mesh-convergence study of fixed-mesh collocation whose measured order
 //! is the method's, with every method agreeing on the converged tip.
-
-use std::sync::Arc;
+mod support;
+use support::methods::methods;
 
 use cosserat::bvp::{solve, CollocationOptions, Equilibrium, Method, SolverOptions};
-use cosserat::model::{Clamp, DeadLoads, LinearElastic, ModelChoice, Rod};
+use cosserat::model::{DeadLoads, ModelChoice, Rod};
 use nalgebra::Vector3;
 
 /// L = 1, B2 = 1, clamp tangent e3, weight q per length along e1.
 fn hanging(q: f64) -> Rod {
-    Rod {
-        length: 1.0,
-        energy: Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
-            distributed_force: Vector3::new(q, 0.0, 0.0),
-            ..Default::default()
-        },
-        support: None,
-    }
+    let loads = DeadLoads {
+        distributed_force: Vector3::new(q, 0.0, 0.0),
+        ..Default::default()
+    };
+    support::rods::uniform(1.0, [10.0, 1.0, 10.0], loads)
 }
 
 fn solve_with(rod: &Rod, opts: SolverOptions) -> Equilibrium {
@@ -33,11 +28,7 @@ fn solve_with(rod: &Rod, opts: SolverOptions) -> Equilibrium {
 fn small_deflection_matches_beam_theory() {
     let q = 1e-4;
     let rod = hanging(q);
-    for method in [
-        Method::Shooting,
-        Method::MultipleShooting { segments: 4 },
-        Method::Collocation { stages: 3 },
-    ] {
+    for method in methods(4) {
         let opts = SolverOptions {
             method,
             ..Default::default()
@@ -84,11 +75,7 @@ fn large_deflection_converges_at_the_method_order() {
         assert!((order - 4.0).abs() < 0.15, "order {order}: {x:?}");
     }
     let converged = x[4];
-    for method in [
-        Method::Shooting,
-        Method::MultipleShooting { segments: 8 },
-        Method::Collocation { stages: 3 },
-    ] {
+    for method in methods(8) {
         let opts = SolverOptions {
             method,
             ..Default::default()

@@ -16,9 +16,30 @@ use cosserat::model::{
 };
 use cosserat::stability::eigen::{count_below, dense_pencil, lowest_eigenpairs};
 use cosserat::stability::{
-    analyze, coefficients, critical_load, Block, FiniteElements, FormCoefficients, StabilityOptions,
+    analyze, coefficients, critical_load, Block, CriticalLoad, FiniteElements, FormCoefficients,
+    StabilityOptions,
 };
 use nalgebra::{Matrix3, Vector3};
+use support::rods::{cantilever, tip_force, uniform};
+
+/// The shipped problem `name` (problems/<name>.toml).
+fn shipped(name: &str) -> Problem {
+    let path = format!(
+        "{}/problems/{name}.toml",
+        concat!(env!("CARGO_MANIFEST_DIR"), "/../..")
+    );
+    Problem::from_path(std::path::Path::new(&path), &[]).unwrap()
+}
+
+/// The critical load of a problem's fixed shape with its stability options.
+fn fixed_shape_critical_load(problem: &Problem) -> CriticalLoad {
+    critical_load(
+        &problem.rod,
+        problem.shape.as_ref().unwrap(),
+        &problem.stability,
+    )
+    .unwrap()
+}
 
 fn so3_exp(w: &Vector3<f64>) -> Matrix3<f64> {
     let t = w.norm();
@@ -206,16 +227,7 @@ fn crossing(mut lo: f64, mut hi: f64, f: impl Fn(f64) -> f64) -> f64 {
 /// +χ²κ2, is singular elsewhere.
 #[test]
 fn zero_eigenvalue_is_where_the_shooting_jacobian_is_singular_on_a_bent_rod() {
-    let rod = |load: f64| Rod {
-        length: 1.0,
-        energy: Arc::new(LinearElastic::uniform([1.0, 10.0, 1.0], [0.0; 3])),
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
-            tip_force: Vector3::new(load, 0.0, 0.0),
-            ..Default::default()
-        },
-        support: None,
-    };
+    let rod = |load: f64| uniform(1.0, [1.0, 10.0, 1.0], tip_force(load, 0.0, 0.0));
     let det = |load: f64| {
         solve_level(&rod(load), ModelLevel::Kirchhoff)
             .jacobian
@@ -261,16 +273,7 @@ fn zero_eigenvalue_is_where_the_shooting_jacobian_is_singular_on_a_bent_rod() {
 #[test]
 fn zero_eigenvalue_is_where_the_shooting_jacobian_is_singular_on_straight_rods() {
     // Euler: −λ e3 on a straight column, B2 = 1 (in plane), B1 = 2.
-    let column = |load: f64| Rod {
-        length: 1.0,
-        energy: Arc::new(LinearElastic::uniform([2.0, 1.0, 1.0], [0.0; 3])),
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
-            tip_force: Vector3::new(0.0, 0.0, -load),
-            ..Default::default()
-        },
-        support: None,
-    };
+    let column = |load: f64| uniform(1.0, [2.0, 1.0, 1.0], tip_force(0.0, 0.0, -load));
     // The shooting Jacobian is as accurate as the integration; its
     // singularity is located to about the integrator's tolerance.
     let direct = SolverOptions {
@@ -300,12 +303,7 @@ fn zero_eigenvalue_is_where_the_shooting_jacobian_is_singular_on_straight_rods()
         &["energy.stiffness=[2.0, 1.0, 1.0]".into()],
     )
     .unwrap();
-    let c = critical_load(
-        &problem.rod,
-        problem.shape.as_ref().unwrap(),
-        &problem.stability,
-    )
-    .unwrap();
+    let c = fixed_shape_critical_load(&problem);
     let by_block = |b: Block| c.blocks.iter().find(|x| x.0 == b).unwrap().1.unwrap();
     assert!((by_block(Block::InPlane) - in_plane).abs() <= 1e-8 * euler);
     assert!((by_block(Block::OutOfPlane) - out_of_plane).abs() <= 1e-8 * euler);
@@ -336,20 +334,8 @@ fn zero_eigenvalue_is_where_the_shooting_jacobian_is_singular_on_straight_rods()
         eq.jacobian.determinant()
     };
     let from_jacobian = crossing(3.5, 4.5, det);
-    let problem = Problem::from_path(
-        std::path::Path::new(concat!(
-            concat!(env!("CARGO_MANIFEST_DIR"), "/../.."),
-            "/problems/timoshenko_ltb.toml"
-        )),
-        &[],
-    )
-    .unwrap();
-    let c = critical_load(
-        &problem.rod,
-        problem.shape.as_ref().unwrap(),
-        &problem.stability,
-    )
-    .unwrap();
+    let problem = shipped("timoshenko_ltb");
+    let c = fixed_shape_critical_load(&problem);
     let from_hessian = c.load_factor.unwrap();
     assert!(
         (from_hessian - from_jacobian).abs() <= 1e-7 * from_jacobian,
@@ -362,16 +348,7 @@ fn zero_eigenvalue_is_where_the_shooting_jacobian_is_singular_on_straight_rods()
 #[test]
 fn eigenvalues_converge_at_order_two_p() {
     let force = 1.0;
-    let rod = Rod {
-        length: 1.0,
-        energy: Arc::new(LinearElastic::uniform([1.0, 1.0, 1.0], [0.0; 3])),
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
-            tip_force: Vector3::new(0.0, 0.0, -force),
-            ..Default::default()
-        },
-        support: None,
-    };
+    let rod = uniform(1.0, [1.0, 1.0, 1.0], tip_force(0.0, 0.0, -force));
     let eq = solve_level(&rod, ModelLevel::Planar);
     let exact = PI * PI / 4.0 - force;
     for (order, meshes) in [(1, [4, 8, 16, 32]), (2, [2, 4, 8, 16])] {
@@ -406,20 +383,11 @@ fn eigenvalues_converge_at_order_two_p() {
 
 #[test]
 fn timoshenko_constant_from_the_problem_file() {
-    let path = concat!(
-        concat!(env!("CARGO_MANIFEST_DIR"), "/../.."),
-        "/problems/timoshenko_ltb.toml"
-    );
-    let problem = Problem::from_path(std::path::Path::new(path), &[]).unwrap();
-    let c = critical_load(
-        &problem.rod,
-        problem.shape.as_ref().unwrap(),
-        &problem.stability,
-    )
-    .unwrap();
+    let problem = shipped("timoshenko_ltb");
+    let c = fixed_shape_critical_load(&problem);
     // θ'' + (γ²/(B1B3)) (L − s)² θ = 0 with θ(0) = 0, θ'(L) = 0 is solved
     // by √x J₋₁/₄(γx²/2√(B1B3)), x = L − s: γL²/√(B1B3) = 2 j₋₁/₄,₁.
-    let reference = 2.0 * support::bessel::first_zero(-0.25, 1.0, 3.0);
+    let reference = 2.0 * cosserat::references::bessel_first_zero(-0.25, 1.0, 3.0);
     let gamma = c.gamma.unwrap();
     assert!(
         (gamma - reference).abs() <= 1e-6 * reference,
@@ -435,17 +403,8 @@ fn timoshenko_constant_from_the_problem_file() {
 
 #[test]
 fn euler_load_from_the_problem_file() {
-    let path = concat!(
-        concat!(env!("CARGO_MANIFEST_DIR"), "/../.."),
-        "/problems/euler_column.toml"
-    );
-    let problem = Problem::from_path(std::path::Path::new(path), &[]).unwrap();
-    let c = critical_load(
-        &problem.rod,
-        problem.shape.as_ref().unwrap(),
-        &problem.stability,
-    )
-    .unwrap();
+    let problem = shipped("euler_column");
+    let c = fixed_shape_critical_load(&problem);
     let gamma = c.gamma.unwrap();
     assert!(
         (gamma - PI * PI / 4.0).abs() <= 1e-8 * PI * PI / 4.0,
@@ -455,16 +414,7 @@ fn euler_load_from_the_problem_file() {
 
 #[test]
 fn banded_lanczos_agrees_with_the_dense_solver() {
-    let rod = Rod {
-        length: 1.0,
-        energy: Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
-            tip_force: Vector3::new(3.0, 0.0, 0.0),
-            ..Default::default()
-        },
-        support: None,
-    };
+    let rod = cantilever(3.0);
     let eq = solve_level(&rod, ModelLevel::Planar);
     let fe = FiniteElements::new(1.0, 200, 2);
     let samples = eq
@@ -495,16 +445,7 @@ fn morse_index_counts_the_unstable_modes() {
         ..Default::default()
     };
     for (load, morse) in [(2.0, 0), (3.0, 2)] {
-        let rod = Rod {
-            length: 1.0,
-            energy: Arc::new(LinearElastic::uniform([1.0, 1.0, 1.0], [0.0; 3])),
-            clamp: Clamp::paper(),
-            loads: DeadLoads {
-                tip_force: Vector3::new(0.0, 0.0, -load),
-                ..Default::default()
-            },
-            support: None,
-        };
+        let rod = uniform(1.0, [1.0, 1.0, 1.0], tip_force(0.0, 0.0, -load));
         let choice = ModelChoice::for_rod(&rod);
         let eq = solve(&rod, &choice, &direct).unwrap();
         let st = analyze(&rod, &eq, &direct, &StabilityOptions::default()).unwrap();

@@ -4,14 +4,16 @@
 //! constrained second variation and the BVP Jacobian, and Greenhill's
 //! twisted column with clamped ends.
 mod support;
+use support::methods::methods;
 
 use std::f64::consts::PI;
 
 use cosserat::bvp::{solve, Equilibrium, Method, SolverOptions};
 use cosserat::input::Problem;
 use cosserat::model::ModelLevel;
+use cosserat::references::greenhill_clamped;
 use cosserat::stability::{analyze, StabilityOptions};
-use support::columns::{clamped_pinned, greenhill_clamped};
+use support::columns::clamped_pinned;
 
 /// A unit column (B = 1, L = 1) along e3, clamped at the origin, with a tip
 /// support and loads given as overrides.
@@ -31,11 +33,7 @@ fn solve_with(p: &Problem, method: Method) -> Equilibrium {
     solve(&p.rod, &p.model, &opts).unwrap_or_else(|e| panic!("{method:?}: {e}"))
 }
 
-const METHODS: [Method; 3] = [
-    Method::Shooting,
-    Method::MultipleShooting { segments: 4 },
-    Method::Collocation { stages: 3 },
-];
+const METHODS: [Method; 3] = methods(4);
 
 /// A tip displaced across by δ: the guided clamp pushes back with 12Bδ/L³
 /// and bends the clamp with 6Bδ/L², the sliding pin with 3Bδ/L³ (linear
@@ -160,7 +158,7 @@ fn columns_buckle_at_their_classical_loads() {
 #[test]
 fn twisted_column_buckles_at_greenhill_load() {
     for torque in [2.0, 5.0] {
-        let reference = greenhill_clamped(torque, 1.0, 1.0);
+        let reference = greenhill_clamped(torque);
         let column = Column {
             overrides: vec![
                 "support.translation=\"axial\"".into(),

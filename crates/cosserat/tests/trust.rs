@@ -3,35 +3,24 @@
 //! to a turn by π. Each reference is independent of the code: the
 //! Bisshopp–Drucker elliptic integrals, and the straight rod.
 mod support;
+use support::methods::methods;
 
 use std::f64::consts::PI;
 use std::sync::Arc;
 
 use cosserat::bvp::{solve, Method, SolverOptions, Strategy};
 use cosserat::model::{Clamp, DeadLoads, Freedom, LinearElastic, ModelChoice, Rod, TipSupport};
-use nalgebra::{Matrix3, Vector3};
-use support::references::cantilever_tip;
+use cosserat::references::CantileverTip;
+use nalgebra::Matrix3;
+use support::rods::{tip_force, uniform};
 
 /// The paper's planar cantilever (k = F L²/B2 = 3) with out-of-plane
 /// stiffnesses B1 and B3 that the planar answer does not depend on.
 fn cantilever(b1: f64, b3: f64) -> Rod {
-    Rod {
-        length: 1.0,
-        energy: Arc::new(LinearElastic::uniform([b1, 1.0, b3], [0.0; 3])),
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
-            tip_force: Vector3::new(3.0, 0.0, 0.0),
-            ..Default::default()
-        },
-        support: None,
-    }
+    uniform(1.0, [b1, 1.0, b3], tip_force(3.0, 0.0, 0.0))
 }
 
-const METHODS: [Method; 3] = [
-    Method::Shooting,
-    Method::MultipleShooting { segments: 8 },
-    Method::Collocation { stages: 3 },
-];
+const METHODS: [Method; 3] = methods(8);
 
 /// The tip of the planar cantilever does not depend on B1 or B3: exact to
 /// 1e-8 for every ratio from 1e-3 to 1e12 and every method. (A residual
@@ -39,7 +28,7 @@ const METHODS: [Method; 3] = [
 /// B1 = 1e10.)
 #[test]
 fn planar_tip_is_exact_for_every_stiffness_ratio() {
-    let reference = cantilever_tip(3.0);
+    let reference = CantileverTip::at(3.0);
     let ratios = [1e-3, 1e-1, 1.0, 1e3, 1e5, 1e8, 1e10, 1e12];
     for b1 in ratios {
         for b3 in [1e-3, 10.0, 1e10, 1e12] {
@@ -70,7 +59,7 @@ fn planar_tip_is_exact_for_every_stiffness_ratio() {
 /// unknown and each tip moment is measured in its own stiffness.
 #[test]
 fn spatial_tip_is_exact_for_extreme_stiffness_ratios() {
-    let reference = cantilever_tip(3.0);
+    let reference = CantileverTip::at(3.0);
     for (b1, b3) in [(1e10, 10.0), (10.0, 1e10), (1e12, 1e12)] {
         let rod = cantilever(b1, b3);
         let model = ModelChoice::forced(&rod, cosserat::model::ModelLevel::Kirchhoff).unwrap();

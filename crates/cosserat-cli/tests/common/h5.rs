@@ -1,5 +1,7 @@
 //! Every dataset of an HDF5 file as text, for comparing two files bit for
-//! bit (floats by their bit patterns).
+//! bit (floats by their bit patterns), and the few reads the tests of
+//! result files repeat.
+#![allow(dead_code)]
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -57,4 +59,19 @@ pub fn assert_same_datasets(a: &Path, b: &Path) {
             b.display()
         );
     }
+}
+
+/// The floats of dataset `name` of `group`.
+pub fn read_f64(group: &hdf5::Group, name: &str) -> Vec<f64> {
+    group.dataset(name).unwrap().read_raw::<f64>().unwrap()
+}
+
+/// The `stop_reason` attribute of a result file.
+pub fn stop_reason(file: &hdf5::File) -> String {
+    file.attr("stop_reason")
+        .unwrap()
+        .read_scalar::<VarLenUnicode>()
+        .unwrap()
+        .as_str()
+        .to_string()
 }

@@ -2,8 +2,10 @@
 //! directory per test, the output and its stderr.
 #![allow(dead_code)]
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
+use std::ffi::OsString;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, ExitStatus, Output};
+use std::time::Duration;
 
 /// The binary under test.
 pub const BIN: &str = env!("CARGO_BIN_EXE_cosserat");
@@ -27,4 +29,26 @@ pub fn run(args: &[&str]) -> Output {
 /// The run's stderr as text.
 pub fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// The names of the files in `dir` (to check that nothing was left behind).
+pub fn entries(dir: &Path) -> Vec<OsString> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect()
+}
+
+/// Sends `signal` (`-INT`, `-TERM`, `-HUP`, ...) to `child`.
+pub fn signal(child: &Child, signal: &str) {
+    let _ = Command::new("kill")
+        .args([signal, &child.id().to_string()])
+        .status();
+}
+
+/// Sends SIGINT after `ms` milliseconds and waits for the exit.
+pub fn interrupt_after(child: &mut Child, ms: u64) -> ExitStatus {
+    std::thread::sleep(Duration::from_millis(ms));
+    signal(child, "-INT");
+    child.wait().unwrap()
 }

@@ -1,11 +1,12 @@
-//! The references themselves against published values and limits.
+//! The closed forms of `cosserat::references` (the one copy the validation
+//! runner and the tests share) against published values and limits.
 mod support;
-use support::elliptic::{ellip_e, ellip_f};
-use support::references::cantilever_tip;
+use cosserat::references::{bessel_first_zero, ellip_e, ellip_f, greenhill_clamped, CantileverTip};
 
 #[test]
 fn complete_integrals_match_tabulated_values() {
-    // K(k = sin 45°) and E(k = sin 45°), Abramowitz & Stegun Table 17.1.
+    // K(k = sin 45°) and E(k = sin 45°), i.e. parameter m = 1/2:
+    // Abramowitz & Stegun Table 17.1, DLMF 19.6.2 / 19.20.
     let k = std::f64::consts::FRAC_1_SQRT_2;
     let half_pi = std::f64::consts::FRAC_PI_2;
     assert!((ellip_f(half_pi, k) - 1.854_074_677_301_372).abs() < 1e-14);
@@ -15,7 +16,7 @@ fn complete_integrals_match_tabulated_values() {
 #[test]
 fn cantilever_reference_small_load_limit() {
     // Linear beam theory: deflection kL/3 for k → 0.
-    let t = cantilever_tip(1e-4);
+    let t = CantileverTip::at(1e-4);
     assert!((t.x / 1e-4 - 1.0 / 3.0).abs() < 1e-4);
     assert!((t.z - 1.0).abs() < 1e-7);
 }
@@ -24,7 +25,7 @@ fn cantilever_reference_small_load_limit() {
 fn cantilever_reference_matches_mattiasson_table() {
     // Mattiasson (1981), Table 1: k = 1: tip deflection 0.30172, horizontal
     // displacement 0.05643 (so z = 0.94357), tip rotation 0.46135.
-    let t = cantilever_tip(1.0);
+    let t = CantileverTip::at(1.0);
     assert!((t.x - 0.30172).abs() < 1e-5, "x {}", t.x);
     assert!((1.0 - t.z - 0.05643).abs() < 1e-5, "z {}", t.z);
     assert!((t.angle - 0.46135).abs() < 1e-5, "angle {}", t.angle);
@@ -33,22 +34,25 @@ fn cantilever_reference_matches_mattiasson_table() {
 #[test]
 fn bessel_zeros_match_tabulated_values() {
     // j_{0,1} = 2.404825557695773 and j_{1,1} = 3.831705970207512
-    // (Abramowitz & Stegun Table 9.5).
-    use support::bessel::first_zero;
-    assert!((first_zero(0.0, 1.0, 3.0) - 2.404_825_557_695_773).abs() < 1e-13);
-    assert!((first_zero(1.0, 3.0, 4.5) - 3.831_705_970_207_512).abs() < 1e-13);
+    // (Abramowitz & Stegun Table 9.5; DLMF 10.21).
+    assert!((bessel_first_zero(0.0, 1.0, 3.0) - 2.404_825_557_695_773).abs() < 1e-13);
+    assert!((bessel_first_zero(1.0, 3.0, 4.5) - 3.831_705_970_207_512).abs() < 1e-13);
 }
 
 #[test]
 fn column_references_match_their_classical_limits() {
-    use support::columns::{clamped_pinned, greenhill_clamped};
+    use support::columns::clamped_pinned;
     // tan x = x: x = 4.493409457909064 (A&S Table 4.19).
     assert!((clamped_pinned() - 4.493_409_457_909_064f64.powi(2)).abs() < 1e-12);
     // No torque: the clamped–guided column, 4π² B/L².
-    let p = greenhill_clamped(0.0, 1.0, 1.0);
+    let p = greenhill_clamped(0.0);
     assert!((p - 4.0 * std::f64::consts::PI.powi(2)).abs() < 1e-9, "{p}");
-    // The torque lowers the thrust; scaling B and L as P L²/B, M L/B.
-    assert!(greenhill_clamped(5.0, 1.0, 1.0) < greenhill_clamped(2.0, 1.0, 1.0));
-    let scaled = greenhill_clamped(4.0, 2.0, 1.0) / 2.0;
-    assert!((scaled - greenhill_clamped(2.0, 1.0, 1.0)).abs() < 1e-9);
+    // The torque lowers the thrust, to none at Greenhill's torque for
+    // clamped ends, tan(ML/2B) = ML/2B: M L/B = 2 × 4.4934 = 2.861π
+    // (Greenhill 1883; Ziegler, Principles of Structural Stability, Sec. 2.7).
+    assert!(greenhill_clamped(5.0) < greenhill_clamped(2.0));
+    let (near, nearer) = (greenhill_clamped(8.95), greenhill_clamped(8.98));
+    let vanishes_at = 8.98 + nearer * 0.03 / (near - nearer);
+    let greenhill = 2.0 * 4.493_409_457_909_064;
+    assert!((vanishes_at - greenhill).abs() < 2e-3, "{vanishes_at}");
 }
