@@ -22,10 +22,10 @@ pub use tracking::{Spectrum, Tracker};
 
 use nalgebra::{DMatrix, DVector, Vector3};
 
-use crate::bvp::newton::Convergence;
 use crate::bvp::{solve, SolverOptions, Strategy};
 use crate::equations::RodSample;
 use crate::model::{ModelChoice, ModelLevel};
+use crate::numerics::newton::{self, Damping, NewtonError, Options, System};
 use crate::stability::{Block, StabilityOptions};
 
 /// Continuation settings (BifurcationKit's ContinuationPar, in spirit).
@@ -317,6 +317,158 @@ fn bordered_solve(a: DMatrix<f64>, rhs: &DVector<f64>) -> Option<DVector<f64>> {
     svd.solve(rhs, tol).ok().filter(finite)
 }
 
+/// F(x, p) = 0 in x at a fixed parameter value p, for
+/// [`crate::numerics::newton`]: the family's residual and F_x, solved by
+/// dense LU.
+struct FixedParameter<'a> {
+    family: &'a Family,
+    p: f64,
+    r: DVector<f64>,
+    fx: DMatrix<f64>,
+    lu: Option<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>>,
+}
+
+impl<'a> FixedParameter<'a> {
+    fn new(family: &'a Family, p: f64, n: usize) -> Self {
+        FixedParameter {
+            family,
+            p,
+            r: DVector::zeros(n),
+            fx: DMatrix::zeros(n, n),
+            lu: None,
+        }
+    }
+}
+
+impl System for FixedParameter<'_> {
+    type Error = PointError;
+
+    fn size(&self) -> usize {
+        self.r.len()
+    }
+
+    fn residual(&mut self, x: &[f64], r: &mut [f64]) -> Result<(), PointError> {
+        self.family.residual(x, self.p, &mut self.r, &mut self.fx)?;
+        r.copy_from_slice(self.r.as_slice());
+        Ok(())
+    }
+
+    fn linearize(&mut self, _x: &[f64]) -> bool {
+        self.lu = Some(self.fx.clone().lu());
+        true
+    }
+
+    fn solve(&mut self, f: &[f64], delta: &mut [f64]) -> bool {
+        let rhs = -DVector::from_column_slice(f);
+        match self.lu.as_ref().and_then(|lu| lu.solve(&rhs)) {
+            Some(d) => {
+                delta.copy_from_slice(d.as_slice());
+                true
+            }
+            None => false,
+        }
+    }
+}
+
+/// The bordered system of a pseudo-arclength corrector in z = (x, p),
+///
+///   F(x, p) = 0,   ⟨z − z_pred, τ⟩ = 0,
+///
+/// with z_pred = z₀ + Δs τ the predictor along the unit tangent τ at z₀,
+/// so that the second row is Keller's (1977) arclength constraint
+/// ⟨x − x₀, ẋ₀⟩ + (p − p₀)ṗ₀ − Δs = 0. Its Jacobian is the bordered matrix
+/// [F_x F_p; τᵀ], regular at folds where F_x alone is singular, with F_p
+/// taken once at the predictor (a chord in the parameter column). The
+/// constraint row is linear, so one step satisfies it to round-off; it is
+/// measured against an absolute 1e-13 (its residual scale is 1e-13/τ).
+struct PseudoArclength<'a> {
+    family: &'a Family,
+    pred: &'a [f64],
+    tangent: &'a [f64],
+    fp: DVector<f64>,
+    tolerance: f64,
+    r: DVector<f64>,
+    /// F_x at the last evaluated point (the corrected one on success).
+    fx: DMatrix<f64>,
+    bordered: DMatrix<f64>,
+}
+
+impl<'a> PseudoArclength<'a> {
+    fn new(
+        family: &'a Family,
+        pred: &'a [f64],
+        tangent: &'a [f64],
+        fp: DVector<f64>,
+        tolerance: f64,
+    ) -> Self {
+        let n = pred.len() - 1;
+        PseudoArclength {
+            family,
+            pred,
+            tangent,
+            fp,
+            tolerance,
+            r: DVector::zeros(n),
+            fx: DMatrix::zeros(n, n),
+            bordered: DMatrix::zeros(n + 1, n + 1),
+        }
+    }
+}
+
+impl System for PseudoArclength<'_> {
+    type Error = PointError;
+
+    fn size(&self) -> usize {
+        self.pred.len()
+    }
+
+    fn residual(&mut self, z: &[f64], r: &mut [f64]) -> Result<(), PointError> {
+        let n = self.r.len();
+        self.family
+            .residual(&z[..n], z[n], &mut self.r, &mut self.fx)?;
+        let arc: f64 = self
+            .tangent
+            .iter()
+            .zip(z.iter().zip(self.pred))
+            .map(|(t, (a, b))| t * (a - b))
+            .sum();
+        r[..n].copy_from_slice(self.r.as_slice());
+        r[n] = arc;
+        Ok(())
+    }
+
+    fn linearize(&mut self, _z: &[f64]) -> bool {
+        let n = self.r.len();
+        let a = &mut self.bordered;
+        a.view_mut((0, 0), (n, n)).copy_from(&self.fx);
+        a.view_mut((0, n), (n, 1)).copy_from(&self.fp);
+        for (k, v) in self.tangent.iter().enumerate() {
+            a[(n, k)] = *v;
+        }
+        true
+    }
+
+    fn solve(&mut self, f: &[f64], delta: &mut [f64]) -> bool {
+        let rhs = -DVector::from_column_slice(f);
+        match bordered_solve(self.bordered.clone(), &rhs) {
+            Some(d) => {
+                delta.copy_from_slice(d.as_slice());
+                true
+            }
+            None => false,
+        }
+    }
+
+    fn residual_scales(&self) -> Vec<f64> {
+        let mut scales = vec![1.0; self.size()];
+        scales[self.r.len()] = ARC_TOLERANCE / self.tolerance;
+        scales
+    }
+}
+
+/// The absolute tolerance on the arclength constraint of the corrector.
+const ARC_TOLERANCE: f64 = 1e-13;
+
 /// A converged corrector: (x, p), its iterations and F_x there.
 type Corrected = (Vec<f64>, usize, DMatrix<f64>);
 
@@ -381,22 +533,22 @@ impl<'a> Run<'a> {
         self.point(x, p, tangent)
     }
 
-    /// Newton in x at fixed p (the start point of a branch).
+    /// Newton in x at fixed p (the start point of a branch, or a step
+    /// pulled back onto a bound): plain Newton steps ([`Damping::Full`]),
+    /// at most 29 of them (30 tests, as the loop this replaced), from a
+    /// guess already close.
     fn newton_at_fixed_p(&self, mut x: Vec<f64>, p: f64) -> Result<Vec<f64>, PointError> {
-        let n = x.len();
-        let (mut r, mut j) = (DVector::zeros(n), DMatrix::zeros(n, n));
-        let test = Convergence::new(self.opts.tolerance, vec![1.0; n]);
-        for _ in 0..30 {
-            self.family.residual(&x, p, &mut r, &mut j)?;
-            let Some(dx) = j.clone().lu().solve(&(-&r)) else {
-                break;
-            };
-            if test.met(r.amax(), &x, dx.as_slice()) {
-                return Ok(x);
-            }
-            x.iter_mut().zip(dx.iter()).for_each(|(a, b)| *a += b);
+        let mut system = FixedParameter::new(self.family, p, x.len());
+        let opts = Options {
+            tolerance: self.opts.tolerance,
+            max_iterations: 29,
+            damping: Damping::Full,
+        };
+        match newton::solve(&mut system, &mut x, &opts) {
+            Ok(_) => Ok(x),
+            Err(NewtonError::BadStart(e) | NewtonError::Evaluation { error: e, .. }) => Err(e),
+            Err(_) => Err(PointError::NoConvergence(p)),
         }
-        Err(PointError::NoConvergence(p))
     }
 
     /// The unit tangent at (x, p): the null vector of [F_x F_p], oriented
@@ -433,44 +585,26 @@ impl<'a> Run<'a> {
         Ok(t.as_slice().to_vec())
     }
 
-    /// Newton on F(x, p) = 0, τᵀ(z − z_pred) = 0 from the predictor.
+    /// Newton on the bordered system F(x, p) = 0, τᵀ(z − z_pred) = 0 from
+    /// the predictor z_pred ([`PseudoArclength`]): plain Newton steps, at
+    /// most 9 (10 tests). No damping on purpose: a corrector that does not
+    /// converge fast means the step was too long, and the caller halves
+    /// the arclength step instead (`walk`), which keeps the points evenly
+    /// spaced along the branch.
     fn correct(&self, pred: &[f64], tangent: &[f64]) -> Result<Option<Corrected>, PointError> {
         let n = pred.len() - 1;
+        let fp = self.family.parameter_derivative(&pred[..n], pred[n])?;
+        let mut system = PseudoArclength::new(self.family, pred, tangent, fp, self.opts.tolerance);
+        let opts = Options {
+            tolerance: self.opts.tolerance,
+            max_iterations: 9,
+            damping: Damping::Full,
+        };
         let mut z = pred.to_vec();
-        let (mut r, mut fx) = (DVector::zeros(n), DMatrix::zeros(n, n));
-        let fp = self.family.parameter_derivative(&z[..n], z[n])?;
-        let test = Convergence::new(self.opts.tolerance, vec![1.0; n + 1]);
-        for it in 0..10 {
-            if self
-                .family
-                .residual(&z[..n], z[n], &mut r, &mut fx)
-                .is_err()
-            {
-                return Ok(None);
-            }
-            let arc: f64 = tangent
-                .iter()
-                .zip(z.iter().zip(pred))
-                .map(|(t, (a, b))| t * (a - b))
-                .sum();
-            let mut a = DMatrix::zeros(n + 1, n + 1);
-            a.view_mut((0, 0), (n, n)).copy_from(&fx);
-            a.view_mut((0, n), (n, 1)).copy_from(&fp);
-            for (k, v) in tangent.iter().enumerate() {
-                a[(n, k)] = *v;
-            }
-            let mut rhs = DVector::zeros(n + 1);
-            rhs.rows_mut(0, n).copy_from(&(-&r));
-            rhs[n] = -arc;
-            let Some(dz) = bordered_solve(a, &rhs) else {
-                return Ok(None);
-            };
-            if arc.abs() <= 1e-13 && test.met(r.amax(), &z, dz.as_slice()) {
-                return Ok(Some((z, it, fx)));
-            }
-            z.iter_mut().zip(dz.iter()).for_each(|(a, b)| *a += b);
-        }
-        Ok(None)
+        Ok(match newton::solve(&mut system, &mut z, &opts) {
+            Ok(report) => Some((z, report.iterations, system.fx)),
+            Err(_) => None,
+        })
     }
 
     /// A complete point: tangent given, eigenvalues tracked.
