@@ -37,7 +37,8 @@ pub trait NonlinearSystem {
     }
 }
 
-/// Newton's settings.
+/// Newton's settings for the BVP solvers (shooting and collocation);
+/// [`NewtonOptions::damped`] turns them into the numerics layer's.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct NewtonOptions {
     /// Converged when the max-norm of the scaled residual is at most this

@@ -14,7 +14,13 @@ use crate::bvp::{solve, SolverOptions, Strategy};
 use crate::model::{ModelChoice, ModelLevel};
 use crate::stability::Block;
 
-/// Continues the family from `opts.start`.
+/// Continues the family F(x, p) = 0 from `opts.start`: the equilibrium
+/// there (the BVP solver with its load ramp, then Newton at fixed p), then
+/// predictor–corrector steps along the branch (one or both ways), folds
+/// and branch points located between points, and new branches switched
+/// onto at branch points down to `opts.switch_depth`. The monitor hears
+/// every point and may interrupt; an interrupted diagram keeps its points
+/// and can be resumed ([`super::resume`]).
 pub fn continuation(
     family: &Family,
     opts: &ContinuationOptions,

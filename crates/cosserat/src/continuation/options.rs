@@ -9,11 +9,14 @@ pub struct ContinuationOptions {
     pub start: f64,
     /// Stop when the parameter leaves [min, max].
     pub bounds: (f64, f64),
-    /// Initial arclength step.
+    /// Initial arclength step Δs of the constraint
+    /// ⟨x − x₀, ẋ₀⟩ + (p − p₀)ṗ₀ − Δs = 0, in the scaled unknowns.
     pub step: f64,
-    /// Smallest step before giving up.
+    /// Smallest step before giving up: a corrector that fails halves Δs,
+    /// and the branch ends ([`super::BranchEnd::StepTooSmall`]) below this.
     pub min_step: f64,
-    /// Largest step.
+    /// Largest step: a corrector that converges in at most 3 Newton
+    /// iterations lengthens Δs by 1.5, up to this.
     pub max_step: f64,
     /// Points per branch at most.
     pub max_points: usize,
@@ -26,7 +29,9 @@ pub struct ContinuationOptions {
     pub tip_angle_limit: Option<f64>,
     /// Discretization of the second variation and eigenvalues per block.
     pub stability: StabilityOptions,
-    /// Newton tolerance of the corrector (scaled residual).
+    /// Newton tolerance τ of the corrector and of Newton at fixed p: the
+    /// [`crate::numerics::newton::Convergence`] test, scaled residual ≤ τ and
+    /// relative correction ≤ √τ.
     pub tolerance: f64,
     /// Relative tolerance on the parameter when locating events.
     pub event_tolerance: f64,
