@@ -58,8 +58,8 @@ pub trait System {
 
     /// The correction δ = −J⁻¹ F of J δ = −F for the right-hand side
     /// `f` = F, with the J of the last [`System::linearize`], into
-    /// `delta`. False when J is singular; a correction that is not finite
-    /// counts as singular too.
+    /// `delta`. False when J is singular (Newton also treats a Newton
+    /// correction that is not finite as singular).
     fn solve(&mut self, f: &[f64], delta: &mut [f64]) -> bool;
 
     /// The unit ρ_i of each equation: the residual test measures
@@ -334,18 +334,9 @@ impl<E: fmt::Display> fmt::Display for NewtonError<E> {
     }
 }
 
-impl<E: std::error::Error + 'static> std::error::Error for NewtonError<E> {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            NewtonError::BadStart(e) | NewtonError::Evaluation { error: e, .. } => Some(e),
-            NewtonError::LineSearch {
-                last_trial: Trial::Failed(e),
-                ..
-            } => Some(e),
-            _ => None,
-        }
-    }
-}
+/// The reason a point was inadmissible is part of the message, so it is
+/// not repeated as a `source`.
+impl<E: fmt::Debug + fmt::Display> std::error::Error for NewtonError<E> {}
 
 /// Solves F(x) = 0 by Newton's method from the x given, which holds the
 /// last admissible accepted iterate on return — the root on success.
