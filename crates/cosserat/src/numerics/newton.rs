@@ -355,6 +355,7 @@ pub fn solve<S: System + ?Sized>(
     let mut history = vec![test.residual_norm(&r)];
     let mut damped_steps = 0;
     let (mut contraction, mut last_step_norm) = (0.0_f64, f64::NAN);
+    // The test is tried at x₀, …, x_max: a budget of max steps.
     for iteration in 0..=opts.max_iterations {
         let norm = *history.last().unwrap();
         let solved = system.linearize(x)
@@ -381,6 +382,12 @@ pub fn solve<S: System + ?Sized>(
             contraction = contraction.max(step_norm / last_step_norm);
         }
         last_step_norm = step_norm;
+        // λ = 1, ½, ¼, …: a full step unless damped; damped, the trial is
+        // accepted when F is defined there and the simplified correction,
+        // solved with J(x) already factored, passes the natural
+        // monotonicity test ‖J(x)⁻¹F(x + λδ)‖ ≤ (1 − λ/4)‖δ‖. (The order of
+        // the operations is the shooting solver's since it was written, so
+        // that every iterate is bit for bit what it was.)
         let mut lambda = 1.0;
         loop {
             for ((t, a), b) in trial.iter_mut().zip(x.iter()).zip(&step) {
