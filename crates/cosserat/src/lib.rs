@@ -18,7 +18,7 @@
 //!
 //! | stage | module | takes | gives |
 //! |---|---|---|---|
-//! | numerics | [`numerics`] | numbers | damped Newton's convergence test, Gauss–Legendre tables, scalar root finding and maximization, the banded LDLᵀ with inertia, the DOP853 integrator — nothing of rods |
+//! | numerics | [`numerics`] | numbers | the damped Newton method (a system's residual and linear solve) with its convergence test, Gauss–Legendre tables, scalar root finding and maximization, the banded LDLᵀ with inertia, the DOP853 integrator — nothing of rods |
 //! | model | [`model`] | lengths, stiffnesses, loads | [`model::Rod`]: length, `Arc<dyn` [`model::StoredEnergy`]`>`, clamp, [`model::DeadLoads`], an optional [`model::TipSupport`]; n(s) = P + R + ∫_s^L f is known up to the tip reaction R |
 //! | equations | [`equations`] | a rod and its [`model::ModelLevel`] | a [`equations::RodEquations`]: the first-order ODEs (planar 4, Kirchhoff 9, Cosserat 9 with ν = e3 + S⁻¹N), their linearization, clamp and tip residuals |
 //! | equilibrium | [`bvp`] | the equations | [`bvp::solve`] by shooting, multiple shooting or Gauss–Legendre collocation with damped Newton → [`bvp::Equilibrium`]: samples (s, r, d1, d2, d3, κ, M, n), unknowns, Jacobian |

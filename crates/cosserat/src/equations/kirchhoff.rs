@@ -24,7 +24,8 @@ use nalgebra::{DMatrix, Matrix3, Vector3};
 use super::planar::straight_rod_clamp_moment;
 use super::tip::{conditions, TipState};
 use super::{RodEquations, RodSample};
-use crate::model::{Rod, TipSupport};
+use crate::model::{Rod, StoredEnergy, TipSupport};
+use crate::numerics::newton::{self, Convergence, Damping, Options, System};
 
 /// The 9-ODE Kirchhoff equations (12 with the position), or the Cosserat
 /// ones when the compliance is non-zero.
@@ -322,18 +323,25 @@ impl RodEquations for KirchhoffEquations {
     fn initial_guess(&self) -> Vec<f64> {
         let m = self.rod.clamp.frame.transpose() * straight_rod_clamp_moment(&self.rod);
         let e = &self.rod.energy;
-        let mut k = Vector3::zeros();
-        for _ in 0..50 {
-            let Some(h_inv) = e.stiffness(0.0, &k).try_inverse() else {
-                break;
-            };
-            let step = h_inv * (e.moment(0.0, &k) - m);
-            k -= step;
-            if step.norm() <= 1e-14 * k.norm().max(1.0) {
-                break;
-            }
+        let mut k = [0.0; 3];
+        let mut system = ClampCurvature {
+            energy: e.as_ref(),
+            moment: m,
+            h_inv: None,
+        };
+        let opts = Options {
+            tolerance: 0.0,
+            max_iterations: 50,
+            damping: Damping::Full,
+        };
+        // A singular Hessian or the budget spent leaves the last iterate,
+        // a guess like any other; converged, the last correction is applied.
+        if let Ok(report) = newton::solve(&mut system, &mut k, &opts) {
+            k.iter_mut()
+                .zip(&report.correction)
+                .for_each(|(a, b)| *a += b);
         }
-        let mut u = k.as_slice().to_vec();
+        let mut u = k.to_vec();
         u.resize(self.unknowns(), 0.0);
         u
     }
@@ -372,5 +380,56 @@ impl RodEquations for KirchhoffEquations {
         scales[9..12].fill(l);
         scales[12..].fill(self.rod.residual_scales().force);
         scales
+    }
+}
+
+/// ∇W(0, κ) = M in κ: the clamp curvature whose moment is M, by Newton
+/// from κ = 0 with the Hessian H = ∂²W/∂κ² inverted (3 × 3, symmetric
+/// positive definite where the energy is admissible).
+///
+/// Its stopping rule differs from [`Convergence`] on purpose: the residual
+/// is a moment with no natural unit here, so only the correction is
+/// measured, |δ| ≤ 1e-14 max(|κ + δ|, 1) against the corrected iterate, and
+/// the caller applies that last correction — the loop this replaced did
+/// both, and the initial guesses (hence every solution started from them)
+/// stay bit-identical.
+struct ClampCurvature<'a> {
+    energy: &'a dyn StoredEnergy,
+    moment: Vector3<f64>,
+    h_inv: Option<Matrix3<f64>>,
+}
+
+impl System for ClampCurvature<'_> {
+    type Error = std::convert::Infallible;
+
+    fn size(&self) -> usize {
+        3
+    }
+
+    fn residual(&mut self, k: &[f64], r: &mut [f64]) -> Result<(), Self::Error> {
+        let k = Vector3::from_column_slice(k);
+        r.copy_from_slice((self.energy.moment(0.0, &k) - self.moment).as_slice());
+        Ok(())
+    }
+
+    fn linearize(&mut self, k: &[f64]) -> bool {
+        let k = Vector3::from_column_slice(k);
+        self.h_inv = self.energy.stiffness(0.0, &k).try_inverse();
+        self.h_inv.is_some()
+    }
+
+    fn solve(&mut self, f: &[f64], delta: &mut [f64]) -> bool {
+        let Some(h_inv) = self.h_inv else {
+            return false;
+        };
+        let d = h_inv * -Vector3::from_column_slice(f);
+        delta.copy_from_slice(d.as_slice());
+        true
+    }
+
+    fn converged(&self, _test: &Convergence, _residual: f64, k: &[f64], delta: &[f64]) -> bool {
+        let delta = Vector3::from_column_slice(delta);
+        let corrected = Vector3::from_column_slice(k) + delta;
+        delta.norm() <= 1e-14 * corrected.norm().max(1.0)
     }
 }

@@ -1,7 +1,8 @@
 //! Damped Newton on the collocation equations, and polishing.
 //!
 //! Steps x ← x + λδ with δ = −J(x)⁻¹F(x) from the condensed banded
-//! factorization; λ is accepted by Deuflhard's natural monotonicity test
+//! factorization, by the crate's one Newton method
+//! ([`crate::numerics::newton`]); λ is accepted by Deuflhard's natural monotonicity test
 //! ‖J(x)⁻¹F(x + λδ)‖ ≤ (1 − λ/4)‖δ‖ with the already factored J, so every
 //! trial costs one O(N) solve. After convergence a few full steps polish
 //! the solution to round-off.
@@ -9,7 +10,8 @@
 use super::grid::{Grid, Scratch};
 use super::lu::BandLu;
 use super::CollocationError;
-use crate::bvp::newton::{Convergence, NewtonOptions};
+use crate::bvp::newton::NewtonOptions;
+use crate::numerics::newton::{self, NewtonError, System, Trial};
 
 /// The factored Newton matrix: per interval the condensed stage block, in
 /// flat storage reused across Newton iterations.
@@ -45,9 +47,62 @@ pub(super) fn max_norm(r: &[f64]) -> f64 {
     )
 }
 
-/// Damped Newton with Deuflhard's natural monotonicity test (as in
-/// `newton::solve`): accept λ when ‖J(x)⁻¹F(x + λδ)‖ ≤ (1 − λ/4)‖δ‖, using
-/// the already factored J; every linear solve is O(N).
+/// The collocation equations as a [`System`] of the numerics layer: the
+/// residual of the mesh, the condensed banded factorization as the
+/// linearization (so that every solve is O(N)), and the mesh's own norm of
+/// a correction.
+struct Collocation<'g, 'a> {
+    grid: &'g Grid<'a>,
+    n: usize,
+    lin: Linearization,
+    ws: Scratch,
+}
+
+/// A residual that is not finite (its max-norm), which makes a point
+/// inadmissible.
+struct NonFinite(f64);
+
+impl System for Collocation<'_, '_> {
+    type Error = NonFinite;
+
+    fn size(&self) -> usize {
+        self.n
+    }
+
+    fn residual(&mut self, x: &[f64], r: &mut [f64]) -> Result<(), NonFinite> {
+        let f = self.grid.residual(x);
+        r.copy_from_slice(&f);
+        let norm = max_norm(&f);
+        if norm.is_finite() {
+            Ok(())
+        } else {
+            Err(NonFinite(norm))
+        }
+    }
+
+    fn linearize(&mut self, x: &[f64]) -> bool {
+        self.grid.linearize(x, &mut self.lin, &mut self.ws)
+    }
+
+    fn solve(&mut self, f: &[f64], delta: &mut [f64]) -> bool {
+        delta.copy_from_slice(&self.grid.newton_correction(&self.lin, f));
+        true
+    }
+
+    fn unknown_scales(&self) -> Vec<f64> {
+        self.grid.unknown_scales()
+    }
+
+    fn correction_norm(&self, delta: &[f64]) -> f64 {
+        self.grid.step_norm(delta)
+    }
+}
+
+/// Damped Newton ([`crate::numerics::newton`]) with Deuflhard's natural
+/// monotonicity test: accept λ when ‖J(x)⁻¹F(x + λδ)‖ ≤ (1 − λ/4)‖δ‖,
+/// using the already factored J; every linear solve is O(N). A residual
+/// that is not finite makes a trial point inadmissible. Converged, the
+/// solution is polished.
 pub(super) fn damped_newton(
     grid: &Grid,
     x0: Vec<f64>,
@@ -55,82 +110,64 @@ pub(super) fn damped_newton(
 ) -> Result<NewtonOutcome, CollocationError> {
     let intervals = grid.intervals();
     let mut x = x0;
-    let mut f = grid.residual(&x);
-    let mut history = vec![max_norm(&f)];
-    let (mut damped_steps, mut contraction, mut last_norm) = (0, 0.0f64, f64::NAN);
+    let mut system = Collocation {
+        grid,
+        n: x.len(),
+        lin: grid.new_linearization(),
+        ws: Scratch::new(grid.n, grid.tab.m),
+    };
     let fail = |reason: String, history: Vec<f64>| CollocationError::NoConvergence {
         intervals,
         reason,
         history,
     };
-    if !history[0].is_finite() {
-        return Err(fail(
+    match newton::solve(&mut system, &mut x, &opts.damped()) {
+        Ok(report) => {
+            let Collocation { lin, mut ws, .. } = system;
+            let mut out = polish(grid, x, report.residual, report.history, lin, &mut ws);
+            out.damped_steps = report.damped_steps;
+            out.contraction = report.contraction;
+            Ok(out)
+        }
+        Err(NewtonError::BadStart(NonFinite(norm))) => Err(fail(
             "the initial guess is inadmissible (non-finite residual)".into(),
-            history,
-        ));
-    }
-    let mut lin = grid.new_linearization();
-    let mut ws = Scratch::new(grid.n, grid.tab.m);
-    let test = Convergence::new(opts.tolerance, grid.unknown_scales());
-    for iteration in 0..=opts.max_iterations {
-        let singular = |history| CollocationError::SingularJacobian {
+            vec![norm],
+        )),
+        Err(NewtonError::SingularJacobian { iteration, history }) => {
+            Err(CollocationError::SingularJacobian {
+                iteration,
+                intervals,
+                history,
+            })
+        }
+        Err(NewtonError::LineSearch {
             iteration,
-            intervals,
+            min_damping,
+            last_trial: Trial::Residual(last) | Trial::Failed(NonFinite(last)),
             history,
-        };
-        let linearized = grid.linearize(&x, &mut lin, &mut ws);
-        let step = grid.newton_correction(&lin, &f);
-        let step_ok = linearized && step.iter().all(|v| v.is_finite());
-        if step_ok && test.met(*history.last().unwrap(), &x, &step) {
-            let mut out = polish(grid, x, f, history, lin, &mut ws);
-            out.damped_steps = damped_steps;
-            out.contraction = contraction;
-            return Ok(out);
-        }
-        if iteration == opts.max_iterations {
-            break;
-        }
-        if !step_ok {
-            return Err(singular(history));
-        }
-        let step_norm = grid.step_norm(&step);
-        if last_norm > 0.0 {
-            contraction = contraction.max(step_norm / last_norm);
-        }
-        last_norm = step_norm;
-        let mut lambda = 1.0;
-        loop {
-            let trial: Vec<f64> = x.iter().zip(&step).map(|(a, b)| a + lambda * b).collect();
-            let f_try = grid.residual(&trial);
-            let accepted = max_norm(&f_try).is_finite()
-                && grid.step_norm(&grid.newton_correction(&lin, &f_try))
-                    <= (1.0 - 0.25 * lambda) * step_norm;
-            if accepted {
-                (x, f) = (trial, f_try);
-                break;
-            }
-            lambda *= 0.5;
-            if lambda < opts.min_damping {
-                let reason = format!(
-                    "no damped step (down to λ = {}) passed the natural monotonicity test at iteration {iteration}; last trial residual {:.3e}",
-                    opts.min_damping,
-                    max_norm(&f_try)
-                );
-                return Err(fail(reason, history));
-            }
-        }
-        if lambda < 1.0 {
-            damped_steps += 1;
-        }
-        history.push(max_norm(&f));
+        }) => Err(fail(
+            format!(
+                "no damped step (down to λ = {min_damping}) passed the natural monotonicity test at iteration {iteration}; last trial residual {last:.3e}"
+            ),
+            history,
+        )),
+        Err(NewtonError::IterationLimit {
+            iterations,
+            history,
+        }) => Err(fail(
+            format!("{iterations} iterations without reaching the tolerance"),
+            history,
+        )),
+        // Damped steps never end on an inadmissible point.
+        Err(NewtonError::Evaluation {
+            iteration,
+            error: NonFinite(norm),
+            history,
+        }) => Err(fail(
+            format!("the step of iteration {iteration} has a residual of {norm:.3e}"),
+            history,
+        )),
     }
-    Err(fail(
-        format!(
-            "{} iterations without reaching the tolerance",
-            opts.max_iterations
-        ),
-        history,
-    ))
 }
 
 /// Polishing steps after the residual meets the tolerance.

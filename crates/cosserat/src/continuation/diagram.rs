@@ -1,0 +1,142 @@
+//! What a continuation run produces: points on branches, the special points
+//! between them, the diagram that holds both, and what a monitor hears.
+
+use nalgebra::Vector3;
+
+use super::{BranchEnd, PointError, RunState};
+use crate::equations::RodSample;
+use crate::stability::Block;
+
+/// One equilibrium on a branch.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Point {
+    /// The parameter value.
+    pub parameter: f64,
+    /// The discrete unknowns x.
+    pub unknowns: Vec<f64>,
+    /// The unit tangent (x, p) of the branch.
+    pub tangent: Vec<f64>,
+    /// The tip.
+    pub tip: RodSample,
+    /// The angle (rad) between the tip tangent and the clamp tangent.
+    pub tip_angle: f64,
+    /// Tracked eigenvalues, block after block.
+    pub eigenvalues: Vec<f64>,
+    /// Morse index.
+    pub morse_index: usize,
+    /// Stable (Morse index 0).
+    pub stable: bool,
+    /// The L² norm of the curvature, √∫|κ|².
+    pub norm: f64,
+    /// Positions along the rod (for pictures).
+    pub shape: Vec<Vector3<f64>>,
+}
+
+/// Kinds of special points.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SpecialKind {
+    /// The parameter turns back.
+    Fold,
+    /// Another branch crosses.
+    BranchPoint,
+}
+
+impl SpecialKind {
+    /// The name in output files.
+    pub fn name(self) -> &'static str {
+        match self {
+            SpecialKind::Fold => "fold",
+            SpecialKind::BranchPoint => "branch_point",
+        }
+    }
+}
+
+/// A located fold or branch point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SpecialPoint {
+    /// Fold or branch point.
+    pub kind: SpecialKind,
+    /// The branch it lies on.
+    pub branch: usize,
+    /// The index of the branch point just before it.
+    pub index: usize,
+    /// The located point.
+    pub point: Point,
+    /// The block whose eigenvalue vanishes.
+    pub block: Block,
+    /// The Hessian null mode as nodal rotations.
+    pub null_mode: Vec<Vector3<f64>>,
+    /// The bifurcating mode breaks a symmetry of the branch (out of the
+    /// plane of a planar branch, or bending of a straight one).
+    pub symmetry_breaking: bool,
+    /// The new branches started here.
+    pub children: Vec<usize>,
+    /// The located singularity: |det F_x| relative to its scale on the
+    /// neighbouring points, and the eigenvalue of the block there.
+    pub singularity: (f64, f64),
+}
+
+/// A followed branch.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Branch {
+    /// Its points in order.
+    pub points: Vec<Point>,
+    /// The special point it was switched from.
+    pub parent: Option<usize>,
+    /// Why it ended ([`BranchEnd::InProgress`] while it is followed).
+    pub stop_reason: BranchEnd,
+    /// The direction of travel: +1 along the stored tangents, −1 against
+    /// them (the backward half of a `both_directions` start).
+    pub direction: f64,
+    /// The arclength step the next point would be tried with: with the
+    /// points and the direction, all a resumed run needs to go on exactly
+    /// as an uninterrupted one.
+    pub next_step: f64,
+}
+
+/// A bifurcation diagram.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Diagram {
+    /// The branches.
+    pub branches: Vec<Branch>,
+    /// Folds and branch points.
+    pub special_points: Vec<SpecialPoint>,
+    /// Column names of the eigenvalues: `"in_plane[0]"`, ...
+    pub eigenvalue_names: Vec<String>,
+    /// Finite-element nodes of the null modes.
+    pub nodes: Vec<f64>,
+    /// Why the whole run ended: "in progress" while it runs (what a
+    /// checkpoint records), then "completed" or "interrupted".
+    pub stop_reason: RunState,
+    /// What the run noticed but could not settle: events detected (a Morse
+    /// index that changed) that could not be located.
+    pub warnings: Vec<String>,
+}
+
+/// Why continuation could not start.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ContinuationError {
+    /// No equilibrium at the start value.
+    #[error("no equilibrium at the start value p = {p}: {message}")]
+    Start {
+        /// The start value of the parameter.
+        p: f64,
+        /// Why no equilibrium was found there.
+        message: String,
+    },
+    /// A point could not be evaluated.
+    #[error(transparent)]
+    Point(#[from] PointError),
+}
+
+/// What a monitor hears after every point; returning false stops the run
+/// (an interrupt), keeping what was computed.
+#[derive(Debug, Clone, Copy)]
+pub struct Progress {
+    /// Points so far, all branches.
+    pub points: usize,
+    /// The branch being followed.
+    pub branch: usize,
+    /// The current parameter.
+    pub parameter: f64,
+}

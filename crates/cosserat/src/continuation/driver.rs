@@ -1,0 +1,362 @@
+//! The driver: follows branches point after point (predictor–corrector
+//! steps with step-size control), stops them for a reason, hands every
+//! point to the monitor, and switches onto new branches at branch points.
+//!
+//! The step-size control lives here, not in Newton: a corrector that fails
+//! halves the arclength step Δs (down to the minimum), one that converges
+//! in at most 3 iterations lengthens it by 1.5 (up to the maximum).
+
+use super::{
+    tip_angle, Branch, BranchEnd, ContinuationError, ContinuationOptions, Diagram, Family, Point,
+    PointError, Progress, RunState, Spectrum, Tracker,
+};
+use crate::bvp::{solve, SolverOptions, Strategy};
+use crate::model::{ModelChoice, ModelLevel};
+use crate::stability::Block;
+
+/// Continues the family F(x, p) = 0 from `opts.start`: the equilibrium
+/// there (the BVP solver with its load ramp, then Newton at fixed p), then
+/// predictor–corrector steps along the branch (one or both ways), folds
+/// and branch points located between points, and new branches switched
+/// onto at branch points down to `opts.switch_depth`. The monitor hears
+/// every point and may interrupt; an interrupted diagram keeps its points
+/// and can be resumed ([`super::resume`]).
+pub fn continuation(
+    family: &Family,
+    opts: &ContinuationOptions,
+    monitor: &mut dyn FnMut(Progress, &Diagram) -> bool,
+) -> Result<Diagram, ContinuationError> {
+    let start = family.rod_at(opts.start).map_err(PointError::from)?;
+    crate::stability::check_conservative(&start).map_err(|e| ContinuationError::Start {
+        p: opts.start,
+        message: e.to_string(),
+    })?;
+    let mut run = Run::new(family, opts);
+    let first = run.start_point()?;
+    let mut diagram = Diagram {
+        branches: vec![],
+        special_points: vec![],
+        eigenvalue_names: run.tracker.names(),
+        nodes: run.tracker.nodes(),
+        stop_reason: RunState::InProgress,
+        warnings: vec![],
+    };
+    // (start point, direction sign, parent special point, depth)
+    let mut queue = vec![(first, 1.0, None::<usize>, 0usize)];
+    if opts.both_directions {
+        let mut back = queue[0].clone();
+        back.1 = -1.0;
+        queue.push(back);
+    }
+    drain(&mut run, &mut diagram, queue, monitor);
+    Ok(diagram)
+}
+
+/// A branch to follow: start point, direction, parent special point, depth.
+pub(super) type Pending = (Point, f64, Option<usize>, usize);
+
+/// Follows queued branches, switching at their branch points to the
+/// configured depth, until the queue is empty ("completed") or the monitor
+/// interrupts ("interrupted").
+pub(super) fn drain(
+    run: &mut Run,
+    diagram: &mut Diagram,
+    mut queue: Vec<Pending>,
+    monitor: &mut dyn FnMut(Progress, &Diagram) -> bool,
+) {
+    diagram.stop_reason = RunState::InProgress;
+    while !queue.is_empty() {
+        let (start, sign, parent, depth) = queue.remove(0);
+        let index = diagram.branches.len();
+        diagram.branches.push(Branch {
+            points: vec![],
+            parent,
+            stop_reason: BranchEnd::InProgress,
+            direction: sign,
+            next_step: run.opts.step,
+        });
+        if let Some(sp) = parent {
+            diagram.special_points[sp].children.push(index);
+        }
+        let outcome = run.follow(start, sign, index, diagram, monitor);
+        diagram.branches[index].stop_reason = outcome.stop_reason.clone();
+        if outcome.interrupted {
+            diagram.stop_reason = RunState::Interrupted;
+            return;
+        }
+        queue.extend(run.switches(diagram, &outcome.special_points, depth));
+    }
+    diagram.stop_reason = RunState::Completed;
+}
+
+impl Run<'_> {
+    /// New branches from the given special points, if `depth` allows.
+    pub(super) fn switches(
+        &mut self,
+        diagram: &Diagram,
+        specials: &[usize],
+        depth: usize,
+    ) -> Vec<Pending> {
+        if depth >= self.opts.switch_depth {
+            return vec![];
+        }
+        let mut out = vec![];
+        for &sp in specials {
+            let special = diagram.special_points[sp].clone();
+            let neighbour = diagram.branches[special.branch].points[special.index].clone();
+            for (point, dir) in self.switch(&special, &neighbour) {
+                out.push((point, dir, Some(sp), depth + 1));
+            }
+        }
+        out
+    }
+}
+
+/// What following one branch produced.
+pub(super) struct Outcome {
+    pub(super) special_points: Vec<usize>,
+    pub(super) stop_reason: BranchEnd,
+    pub(super) interrupted: bool,
+}
+
+/// The state of one continuation run.
+pub(super) struct Run<'a> {
+    pub(super) family: &'a Family,
+    pub(super) opts: &'a ContinuationOptions,
+    pub(super) tracker: Tracker,
+    pub(super) total_points: usize,
+}
+
+impl<'a> Run<'a> {
+    pub(super) fn new(family: &'a Family, opts: &'a ContinuationOptions) -> Self {
+        let blocks = match family.level() {
+            ModelLevel::Planar => vec![Block::InPlane, Block::OutOfPlane],
+            ModelLevel::Kirchhoff | ModelLevel::Cosserat => vec![Block::Full],
+        };
+        Run {
+            family,
+            opts,
+            tracker: Tracker::new(family, blocks, opts.stability),
+            total_points: 0,
+        }
+    }
+
+    /// The equilibrium at the start value (the BVP solver with its load
+    /// ramp), with its tangent oriented towards increasing p.
+    pub(super) fn start_point(&mut self) -> Result<Point, ContinuationError> {
+        let p = self.opts.start;
+        let start_err = |message: String| ContinuationError::Start { p, message };
+        let rod = self
+            .family
+            .rod_at(p)
+            .map_err(|e| start_err(e.to_string()))?;
+        let model = ModelChoice::forced(&rod, self.family.level()).map_err(start_err)?;
+        let solver = SolverOptions {
+            method: self.family.method(),
+            strategy: Strategy::Auto,
+            ..Default::default()
+        };
+        let raw = solve(&rod, &model, &solver)
+            .map_err(|e| start_err(e.to_string()))?
+            .unknowns;
+        let x = self.family.scaled(&raw);
+        let x = self
+            .newton_at_fixed_p(x, p)
+            .map_err(|e| start_err(e.to_string()))?;
+        let mut forward = vec![0.0; x.len()];
+        forward.push(1.0);
+        let tangent = self.tangent(&x, p, &forward)?;
+        self.tracker.reset();
+        self.point(x, p, tangent)
+    }
+
+    /// A complete point: tangent given, eigenvalues tracked.
+    pub(super) fn point(
+        &mut self,
+        x: Vec<f64>,
+        p: f64,
+        tangent: Vec<f64>,
+    ) -> Result<Point, ContinuationError> {
+        let spectrum = self.tracker.measure(self.family, &x, p)?;
+        self.point_from(x, p, tangent, spectrum)
+    }
+
+    /// A complete point from its measured spectrum.
+    pub(super) fn point_from(
+        &self,
+        x: Vec<f64>,
+        p: f64,
+        tangent: Vec<f64>,
+        spectrum: Spectrum,
+    ) -> Result<Point, ContinuationError> {
+        let tip = spectrum.tip.clone();
+        let tip_angle = tip_angle(
+            &self.family.rod_at(p).map_err(PointError::from)?.clamp.frame,
+            &tip,
+        );
+        Ok(Point {
+            parameter: p,
+            unknowns: x,
+            tangent,
+            tip_angle,
+            tip,
+            morse_index: spectrum.morse_index,
+            stable: spectrum.morse_index == 0,
+            eigenvalues: spectrum.values,
+            norm: spectrum.curvature_norm,
+            shape: spectrum.shape,
+        })
+    }
+
+    pub(super) fn stop_reason(&self, point: &Point, count: usize) -> Option<BranchEnd> {
+        let (lo, hi) = self.opts.bounds;
+        if point.parameter < lo || point.parameter > hi {
+            return Some(BranchEnd::LeftBounds {
+                parameter: point.parameter,
+                bounds: (lo, hi),
+            });
+        }
+        if count > 1 && (point.parameter == lo || point.parameter == hi) {
+            return Some(BranchEnd::ReachedBound(point.parameter));
+        }
+        if count >= self.opts.max_points {
+            return Some(BranchEnd::MaxPoints(count));
+        }
+        // The point's own tip angle, measured against its clamp when the
+        // point was made.
+        match self.opts.tip_angle_limit {
+            Some(limit) if point.tip_angle >= limit => {
+                Some(BranchEnd::TipAngle(point.tip_angle.to_degrees()))
+            }
+            _ => None,
+        }
+    }
+
+    /// A step that leaves [min, max] is pulled back onto the bound it
+    /// crossed (Newton at fixed p from the linear interpolant), so that a
+    /// branch ends exactly at its bound — e.g. at the design load.
+    pub(super) fn land_on_bound(
+        &self,
+        last: &Point,
+        x: Vec<f64>,
+        p: f64,
+        tangent: Vec<f64>,
+    ) -> (Vec<f64>, f64, Vec<f64>) {
+        let (lo, hi) = self.opts.bounds;
+        let bound = if p > hi && last.parameter <= hi {
+            hi
+        } else if p < lo && last.parameter >= lo {
+            lo
+        } else {
+            return (x, p, tangent);
+        };
+        let t = (bound - last.parameter) / (p - last.parameter);
+        let guess: Vec<f64> = last
+            .unknowns
+            .iter()
+            .zip(&x)
+            .map(|(a, b)| a + t * (b - a))
+            .collect();
+        match self.newton_at_fixed_p(guess, bound) {
+            Ok(xb) => match self.tangent(&xb, bound, &tangent) {
+                Ok(tb) => (xb, bound, tb),
+                Err(_) => (x, p, tangent),
+            },
+            Err(_) => (x, p, tangent),
+        }
+    }
+
+    /// Follows one branch from `start` in direction `sign`, appending its
+    /// points to `diagram.branches[branch]` as they come (so a monitor that
+    /// saves the diagram keeps every point).
+    pub(super) fn follow(
+        &mut self,
+        start: Point,
+        sign: f64,
+        branch: usize,
+        diagram: &mut Diagram,
+        monitor: &mut dyn FnMut(Progress, &Diagram) -> bool,
+    ) -> Outcome {
+        self.tracker.reset();
+        match self.point(
+            start.unknowns.clone(),
+            start.parameter,
+            start.tangent.clone(),
+        ) {
+            Ok(p) => diagram.branches[branch].points.push(p),
+            Err(e) => {
+                return Outcome {
+                    special_points: vec![],
+                    stop_reason: BranchEnd::StartFailed(e.to_string()),
+                    interrupted: false,
+                }
+            }
+        }
+        diagram.branches[branch].next_step = self.opts.step;
+        self.walk(sign, branch, diagram, monitor)
+    }
+
+    /// Steps on from the last point of `diagram.branches[branch]` (the
+    /// tracker holding that point's modes) with the branch's next step,
+    /// until a stop reason or an interrupt.
+    pub(super) fn walk(
+        &mut self,
+        sign: f64,
+        branch: usize,
+        diagram: &mut Diagram,
+        monitor: &mut dyn FnMut(Progress, &Diagram) -> bool,
+    ) -> Outcome {
+        let mut specials = vec![];
+        let end = |specials: Vec<usize>, reason: BranchEnd, interrupted: bool| Outcome {
+            special_points: specials,
+            stop_reason: reason,
+            interrupted,
+        };
+        let mut ds = diagram.branches[branch].next_step;
+        loop {
+            let points = &diagram.branches[branch].points;
+            let last = points.last().expect("a branch has its start point").clone();
+            if let Some(reason) = self.stop_reason(&last, points.len()) {
+                return end(specials, reason, false);
+            }
+            let (x, p, tangent, iterations) = match self.step(&last, sign, ds) {
+                Ok(Some(stepped)) => stepped,
+                Ok(None) => {
+                    ds *= 0.5;
+                    if ds < self.opts.min_step {
+                        let reason = BranchEnd::StepTooSmall(self.opts.min_step);
+                        return end(specials, reason, false);
+                    }
+                    continue;
+                }
+                Err(e) => return end(specials, BranchEnd::Failed(e.to_string()), false),
+            };
+            let (x, p, tangent) = self.land_on_bound(&last, x, p, tangent);
+            let next = match self.point(x, p, tangent) {
+                Ok(pt) => pt,
+                Err(e) => return end(specials, BranchEnd::Failed(e.to_string()), false),
+            };
+            let index = diagram.branches[branch].points.len() - 1;
+            let (found, missed) = self.events(&last, &next, sign, branch, index);
+            for sp in found {
+                specials.push(diagram.special_points.len());
+                diagram.special_points.push(sp);
+            }
+            diagram.warnings.extend(missed);
+            diagram.branches[branch].points.push(next);
+            self.total_points += 1;
+            if iterations <= 3 {
+                ds = (ds * 1.5).min(self.opts.max_step);
+            }
+            diagram.branches[branch].next_step = ds;
+            let progress = Progress {
+                points: self.total_points,
+                branch,
+                parameter: p,
+            };
+            if !monitor(progress, diagram) {
+                return end(specials, BranchEnd::Interrupted, true);
+            }
+        }
+    }
+}

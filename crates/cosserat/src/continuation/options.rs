@@ -1,0 +1,61 @@
+//! The settings of a continuation run.
+
+use crate::stability::StabilityOptions;
+
+/// Continuation settings (BifurcationKit's ContinuationPar, in spirit).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ContinuationOptions {
+    /// The parameter value to start from.
+    pub start: f64,
+    /// Stop when the parameter leaves [min, max].
+    pub bounds: (f64, f64),
+    /// Initial arclength step Δs of the constraint
+    /// ⟨x − x₀, ẋ₀⟩ + (p − p₀)ṗ₀ − Δs = 0, in the scaled unknowns.
+    pub step: f64,
+    /// Smallest step before giving up: a corrector that fails halves Δs,
+    /// and the branch ends ([`super::BranchEnd::StepTooSmall`]) below this.
+    pub min_step: f64,
+    /// Largest step: a corrector that converges in at most 3 Newton
+    /// iterations lengthens Δs by 1.5, up to this.
+    pub max_step: f64,
+    /// Points per branch at most.
+    pub max_points: usize,
+    /// Follow the start branch in both directions.
+    pub both_directions: bool,
+    /// Depth of recursive branch switching (0: none).
+    pub switch_depth: usize,
+    /// Stop a branch when the tip tangent turns more than this (rad) from
+    /// the clamp tangent.
+    pub tip_angle_limit: Option<f64>,
+    /// Discretization of the second variation and eigenvalues per block.
+    pub stability: StabilityOptions,
+    /// Newton tolerance τ of the corrector and of Newton at fixed p: the
+    /// [`crate::numerics::newton::Convergence`] test, scaled residual ≤ τ and
+    /// relative correction ≤ √τ.
+    pub tolerance: f64,
+    /// Relative tolerance on the parameter when locating events.
+    pub event_tolerance: f64,
+}
+
+impl Default for ContinuationOptions {
+    fn default() -> Self {
+        ContinuationOptions {
+            start: 0.0,
+            bounds: (f64::NEG_INFINITY, f64::INFINITY),
+            step: 0.05,
+            min_step: 1e-7,
+            max_step: 0.2,
+            max_points: 400,
+            both_directions: false,
+            switch_depth: 1,
+            tip_angle_limit: None,
+            stability: StabilityOptions {
+                elements: 40,
+                order: 2,
+                eigenvalues: 4,
+            },
+            tolerance: 1e-11,
+            event_tolerance: 1e-11,
+        }
+    }
+}
