@@ -240,17 +240,18 @@ fn a_hanging_arm_has_no_critical_load() {
     use cosserat::stability::{critical_load, FixedShape, StabilityOptions};
     use nalgebra::Vector3;
     for (b1, b3) in [(4.0, 1.27), (1.0, 1.0), (0.25, 4.0)] {
-        let rod = Rod {
-            length: 1.0,
-            energy: std::sync::Arc::new(LinearElastic::uniform([b1, 1.0, b3], [0.0; 3])),
-            clamp: Clamp::paper(),
-            loads: DeadLoads {
+        let rod = Rod::new(
+            1.0,
+            std::sync::Arc::new(LinearElastic::uniform([b1, 1.0, b3], [0.0; 3])),
+            Clamp::paper(),
+            DeadLoads {
                 tip_force: Vector3::new(1.0, 0.0, 0.0),
                 tip_couple: Vector3::zeros(),
                 distributed_force: Vector3::zeros(),
             },
-            support: None,
-        };
+            None,
+        )
+        .unwrap();
         // φ = π/2 from the horizontal d3 towards d1 (down): hanging.
         let shape = FixedShape {
             turning_angle: Profile::Constant(std::f64::consts::FRAC_PI_2),
@@ -644,16 +645,17 @@ fn problem_files_are_bounded_regular_files() {
 fn stability_options_out_of_range_are_errors_not_clamps() {
     use cosserat::model::{Clamp, DeadLoads, LinearElastic, Profile, Rod};
     use cosserat::stability::{critical_load, FixedShape, StabilityOptions};
-    let rod = Rod {
-        length: 1.0,
-        energy: std::sync::Arc::new(LinearElastic::uniform([1.0, 1.0, 1.0], [0.0; 3])),
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
+    let rod = Rod::new(
+        1.0,
+        std::sync::Arc::new(LinearElastic::uniform([1.0, 1.0, 1.0], [0.0; 3])),
+        Clamp::paper(),
+        DeadLoads {
             tip_force: nalgebra::Vector3::new(1.0, 0.0, 0.0),
             ..Default::default()
         },
-        support: None,
-    };
+        None,
+    )
+    .unwrap();
     let shape = FixedShape {
         turning_angle: Profile::Constant(0.0),
     };

@@ -45,16 +45,17 @@ fn cantilever(shear: Option<f64>) -> Rod {
         }) as Arc<dyn StoredEnergy>,
         None => bending,
     };
-    Rod {
-        length: 1.0,
+    Rod::new(
+        1.0,
         energy,
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
+        Clamp::paper(),
+        DeadLoads {
             tip_force: Vector3::new(3.0, 0.0, 0.0),
             ..Default::default()
         },
-        support: None,
-    }
+        None,
+    )
+    .unwrap()
 }
 
 fn row(scene: &str, rod: &Rod, choice: &ModelChoice, reference: Option<Vector3<f64>>) {

@@ -16,16 +16,17 @@ use cosserat::model::{Clamp, DeadLoads, LinearElastic, ModelChoice, ModelLevel, 
 use nalgebra::Vector3;
 
 fn cantilever(k: f64) -> Rod {
-    Rod {
-        length: 1.0,
-        energy: Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
+    Rod::new(
+        1.0,
+        Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
+        Clamp::paper(),
+        DeadLoads {
             tip_force: Vector3::new(k, 0.0, 0.0),
             ..Default::default()
         },
-        support: None,
-    }
+        None,
+    )
+    .unwrap()
 }
 
 fn median(mut v: Vec<f64>) -> f64 {

@@ -35,16 +35,17 @@ fn time(repeats: usize, mut f: impl FnMut()) -> f64 {
 }
 
 fn main() {
-    let rod = Rod {
-        length: 1.0,
-        energy: Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
+    let rod = Rod::new(
+        1.0,
+        Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
+        Clamp::paper(),
+        DeadLoads {
             tip_force: Vector3::new(3.0, 0.0, 0.0),
             ..Default::default()
         },
-        support: None,
-    };
+        None,
+    )
+    .unwrap();
     let opts = SolverOptions::default();
     let eq = solve(&rod, &ModelChoice::for_rod(&rod), &opts).unwrap();
     println!("lowest 4 eigenvalues of the in-plane block (order 2), cantilever k = 3");
@@ -83,16 +84,17 @@ fn main() {
         / points.iter().map(|p| (p.0 - mx).powi(2)).sum::<f64>();
     println!("log-log slope of time against elements: {slope:.2}");
 
-    let straight = Rod {
-        length: 1.0,
-        energy: Arc::new(LinearElastic::uniform([1.0, 1.0, 1.0], [0.0; 3])),
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
+    let straight = Rod::new(
+        1.0,
+        Arc::new(LinearElastic::uniform([1.0, 1.0, 1.0], [0.0; 3])),
+        Clamp::paper(),
+        DeadLoads {
             tip_force: Vector3::new(1.0, 0.0, 0.0),
             ..Default::default()
         },
-        support: None,
-    };
+        None,
+    )
+    .unwrap();
     let shape = FixedShape {
         turning_angle: Profile::Constant(0.0),
     };

@@ -129,7 +129,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let problem = Problem::from_path_in(&path, &[], &catalog())?;
     let eq = solve(&problem.rod, &problem.model, &problem.options)?;
     let tip = eq.tip();
-    println!("energy    {}", problem.rod.energy.name());
+    println!("energy    {}", problem.rod.energy().name());
     println!("model     {}", problem.model.reason);
     println!("tip       {:?}", tip.position.as_slice());
     println!("residual  {:.3e}", eq.residual);

@@ -19,16 +19,17 @@ use support::references::cantilever_tip;
 /// The paper's cantilever: L = 1, B = (10, 1, 10), clamp d1 = e1 (down),
 /// d3 = e3, tip force k e1.
 fn cantilever(k: f64) -> Rod {
-    Rod {
-        length: 1.0,
-        energy: Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
+    Rod::new(
+        1.0,
+        Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
+        Clamp::paper(),
+        DeadLoads {
             tip_force: Vector3::new(k, 0.0, 0.0),
             ..Default::default()
         },
-        support: None,
-    }
+        None,
+    )
+    .unwrap()
 }
 
 /// Largest error of the tip position (x, z; y must vanish) against the
@@ -203,9 +204,11 @@ fn unreachable_tolerance_is_reported() {
 /// by discretization error, which falls with the tolerance.
 #[test]
 fn spatial_director_drift_is_discretization_error() {
-    let mut rod = cantilever(5.0);
-    rod.loads.tip_force = Vector3::new(5.0, 3.0, 0.0);
-    rod.loads.tip_couple = Vector3::new(0.0, 0.0, 2.0);
+    let rod = cantilever(5.0);
+    let mut loads = rod.loads().clone();
+    loads.tip_force = Vector3::new(5.0, 3.0, 0.0);
+    loads.tip_couple = Vector3::new(0.0, 0.0, 2.0);
+    let rod = rod.with_loads(loads).unwrap();
     let eq = equations(&rod, ModelLevel::Kirchhoff);
     let mut drifts = Vec::new();
     for tol in [1e-6, 1e-8, 1e-10] {

@@ -62,7 +62,7 @@ fn derivatives_match_central_differences() {
 #[test]
 fn roll_up_matches_closed_form_from_the_problem_file() {
     let problem = Problem::from_path_in(Path::new(FILE), &[], &catalog()).unwrap();
-    assert_eq!(problem.rod.energy.name(), "hyperbolic");
+    assert_eq!(problem.rod.energy().name(), "hyperbolic");
     let (a, c): (f64, f64) = (0.5, 4.0);
     let kappa = (a * c).asinh() / a;
     for method in [

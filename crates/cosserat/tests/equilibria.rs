@@ -16,16 +16,17 @@ use support::references::cantilever_tip;
 /// The paper's cantilever: L = 1, B = (10, 1, 10), clamp d1 = e1 (down),
 /// d3 = e3, tip force k e1.
 fn cantilever(k: f64) -> Rod {
-    Rod {
-        length: 1.0,
-        energy: Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
+    Rod::new(
+        1.0,
+        Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
+        Clamp::paper(),
+        DeadLoads {
             tip_force: Vector3::new(k, 0.0, 0.0),
             ..Default::default()
         },
-        support: None,
-    }
+        None,
+    )
+    .unwrap()
 }
 
 fn solve_with(rod: &Rod, level: ModelLevel, method: Method) -> Equilibrium {
@@ -99,8 +100,10 @@ fn planar_and_spatial_models_agree_on_planar_scenes() {
 #[test]
 fn end_couple_rolls_the_rod_into_a_circle() {
     let b2 = 1.0;
-    let mut rod = cantilever(0.0);
-    rod.loads.tip_couple = Vector3::new(0.0, TAU * b2 / rod.length, 0.0);
+    let rod = cantilever(0.0);
+    let mut loads = rod.loads().clone();
+    loads.tip_couple = Vector3::new(0.0, TAU * b2 / rod.length(), 0.0);
+    let rod = rod.with_loads(loads).unwrap();
     for level in LEVELS {
         for method in METHODS {
             let eq = solve_with(&rod, level, method);
@@ -112,7 +115,7 @@ fn end_couple_rolls_the_rod_into_a_circle() {
             );
             assert!((tip.directors[2] - Vector3::z()).norm() <= 1e-9);
             // A circle of radius L/2π through the clamp, centre at x = L/2π.
-            let r = rod.length / TAU;
+            let r = rod.length() / TAU;
             for p in &eq.samples {
                 let c = Vector3::new(r, 0.0, 0.0);
                 assert!(((p.position - c).norm() - r).abs() <= 1e-9, "s = {}", p.s);
@@ -136,13 +139,14 @@ fn helix_position(kappa0: Vector3<f64>, s: f64) -> Vector3<f64> {
 #[test]
 fn unloaded_rod_with_constant_intrinsic_curvature_is_a_helix() {
     let kappa0 = Vector3::new(1.3, -0.7, 2.1);
-    let rod = Rod {
-        length: 3.0,
-        energy: Arc::new(LinearElastic::uniform([1.0, 2.0, 0.8], kappa0.into())),
-        clamp: Clamp::new(Vector3::zeros(), Vector3::x(), Vector3::z()),
-        loads: DeadLoads::default(),
-        support: None,
-    };
+    let rod = Rod::new(
+        3.0,
+        Arc::new(LinearElastic::uniform([1.0, 2.0, 0.8], kappa0.into())),
+        Clamp::new(Vector3::zeros(), Vector3::x(), Vector3::z()).unwrap(),
+        DeadLoads::default(),
+        None,
+    )
+    .unwrap();
     let choice = ModelChoice::for_rod(&rod);
     assert_eq!(choice.level, ModelLevel::Kirchhoff, "{}", choice.reason);
     for method in METHODS {
@@ -184,17 +188,18 @@ fn single_and_multiple_shooting_agree() {
         }),
     ];
     for energy in energies {
-        let rod = Rod {
-            length: 2.0,
+        let rod = Rod::new(
+            2.0,
             energy,
-            clamp: Clamp::paper(),
-            loads: DeadLoads {
+            Clamp::paper(),
+            DeadLoads {
                 tip_force: Vector3::new(0.6, 0.2, -0.1),
                 tip_couple: Vector3::new(0.0, 0.1, 0.2),
                 distributed_force: Vector3::new(0.3, 0.0, 0.0),
             },
-            support: None,
-        };
+            None,
+        )
+        .unwrap();
         let single = solve_with(&rod, ModelLevel::Kirchhoff, Method::Shooting);
         let multi = solve_with(&rod, ModelLevel::Kirchhoff, METHODS[1]);
         for (a, b) in single.samples.iter().zip(&multi.samples) {
@@ -263,8 +268,7 @@ fn tapered_cantilever_matches_linear_beam_theory() {
         ],
         intrinsic_curvature: Default::default(),
     };
-    let mut rod = cantilever(force);
-    rod.energy = Arc::new(energy);
+    let rod = cantilever(force).with_energy(Arc::new(energy));
     let mut opts = SolverOptions::default();
     opts.newton.tolerance = 1e-14;
     let eq = solve(&rod, &ModelChoice::for_rod(&rod), &opts).unwrap();
@@ -292,8 +296,7 @@ fn tabulated_intrinsic_curvature_gives_its_intrinsic_shape() {
             Profile::Constant(0.0),
         ],
     };
-    let mut rod = cantilever(0.0);
-    rod.energy = Arc::new(energy);
+    let rod = cantilever(0.0).with_energy(Arc::new(energy));
     // φ(s) exactly: integral of the linear interpolant.
     let phi = |s: f64| {
         let mut acc = 0.0;
@@ -339,8 +342,8 @@ fn tabulated_intrinsic_curvature_gives_its_intrinsic_shape() {
 /// the problem-file checks do not apply) is a typed error naming the cause.
 #[test]
 fn singular_energy_hessian_is_a_typed_error() {
-    let mut rod = cantilever(1.0);
-    rod.energy = Arc::new(LinearElastic::uniform([1.0, 1.0, 0.0], [0.0; 3]));
+    let rod =
+        cantilever(1.0).with_energy(Arc::new(LinearElastic::uniform([1.0, 1.0, 0.0], [0.0; 3])));
     let err = solve(&rod, &ModelChoice::for_rod(&rod), &SolverOptions::default()).unwrap_err();
     assert!(matches!(err, cosserat::bvp::SolveError::Model(_)), "{err}");
     assert!(err.to_string().contains("not positive definite"), "{err}");

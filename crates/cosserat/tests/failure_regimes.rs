@@ -22,24 +22,26 @@ use support::references::cantilever_tip;
 /// The paper's cantilever of length `length`, B2 = 1, tip force `force`
 /// along d1(0) = e1: k = F L²/B2.
 fn cantilever(length: f64, force: f64) -> Rod {
-    Rod {
+    Rod::new(
         length,
-        energy: Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
+        Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
+        Clamp::paper(),
+        DeadLoads {
             tip_force: Vector3::new(force, 0.0, 0.0),
             ..Default::default()
         },
-        support: None,
-    }
+        None,
+    )
+    .unwrap()
 }
 
 /// A planar rod with intrinsic curvature κ⁰2 = `kappa` (B2 = 1), unloaded
 /// unless `force` ≠ 0.
 fn spiral(kappa: f64, force: f64) -> Rod {
-    let mut rod = cantilever(1.0, force);
-    rod.energy = Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0, kappa, 0.0]));
-    rod
+    cantilever(1.0, force).with_energy(Arc::new(LinearElastic::uniform(
+        [10.0, 1.0, 10.0],
+        [0.0, kappa, 0.0],
+    )))
 }
 
 fn run(rod: &Rod, method: Method, strategy: Strategy) -> Result<Equilibrium, SolveError> {

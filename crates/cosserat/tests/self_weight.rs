@@ -11,16 +11,17 @@ use nalgebra::Vector3;
 
 /// L = 1, B2 = 1, clamp tangent e3, weight q per length along e1.
 fn hanging(q: f64) -> Rod {
-    Rod {
-        length: 1.0,
-        energy: Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
+    Rod::new(
+        1.0,
+        Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
+        Clamp::paper(),
+        DeadLoads {
             distributed_force: Vector3::new(q, 0.0, 0.0),
             ..Default::default()
         },
-        support: None,
-    }
+        None,
+    )
+    .unwrap()
 }
 
 fn solve_with(rod: &Rod, opts: SolverOptions) -> Equilibrium {

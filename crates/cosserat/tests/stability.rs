@@ -103,17 +103,18 @@ fn form_is_the_second_derivative_of_the_exact_energy_density() {
 }
 
 fn helix_scene(energy: Arc<dyn StoredEnergy>) -> Rod {
-    Rod {
-        length: 1.5,
+    Rod::new(
+        1.5,
         energy,
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
+        Clamp::paper(),
+        DeadLoads {
             tip_force: Vector3::new(0.8, 0.3, -0.2),
             distributed_force: Vector3::new(0.4, 0.0, 0.1),
             ..Default::default()
         },
-        support: None,
-    }
+        None,
+    )
+    .unwrap()
 }
 
 fn solve_level(rod: &Rod, level: ModelLevel) -> Equilibrium {
@@ -128,7 +129,7 @@ fn assembled_matrix_is_the_hessian_of_the_discrete_potential() {
     for e in energies() {
         let rod = helix_scene(e.clone());
         let eq = solve_level(&rod, ModelLevel::Kirchhoff);
-        let fe = FiniteElements::new(rod.length, 6, 2);
+        let fe = FiniteElements::new(rod.length(), 6, 2);
         let samples = eq
             .resample(&rod, &SolverOptions::default(), &fe.quadrature_points())
             .unwrap();
@@ -206,15 +207,18 @@ fn crossing(mut lo: f64, mut hi: f64, f: impl Fn(f64) -> f64) -> f64 {
 /// +χ²κ2, is singular elsewhere.
 #[test]
 fn zero_eigenvalue_is_where_the_shooting_jacobian_is_singular_on_a_bent_rod() {
-    let rod = |load: f64| Rod {
-        length: 1.0,
-        energy: Arc::new(LinearElastic::uniform([1.0, 10.0, 1.0], [0.0; 3])),
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
-            tip_force: Vector3::new(load, 0.0, 0.0),
-            ..Default::default()
-        },
-        support: None,
+    let rod = |load: f64| {
+        Rod::new(
+            1.0,
+            Arc::new(LinearElastic::uniform([1.0, 10.0, 1.0], [0.0; 3])),
+            Clamp::paper(),
+            DeadLoads {
+                tip_force: Vector3::new(load, 0.0, 0.0),
+                ..Default::default()
+            },
+            None,
+        )
+        .unwrap()
     };
     let det = |load: f64| {
         solve_level(&rod(load), ModelLevel::Kirchhoff)
@@ -261,15 +265,18 @@ fn zero_eigenvalue_is_where_the_shooting_jacobian_is_singular_on_a_bent_rod() {
 #[test]
 fn zero_eigenvalue_is_where_the_shooting_jacobian_is_singular_on_straight_rods() {
     // Euler: −λ e3 on a straight column, B2 = 1 (in plane), B1 = 2.
-    let column = |load: f64| Rod {
-        length: 1.0,
-        energy: Arc::new(LinearElastic::uniform([2.0, 1.0, 1.0], [0.0; 3])),
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
-            tip_force: Vector3::new(0.0, 0.0, -load),
-            ..Default::default()
-        },
-        support: None,
+    let column = |load: f64| {
+        Rod::new(
+            1.0,
+            Arc::new(LinearElastic::uniform([2.0, 1.0, 1.0], [0.0; 3])),
+            Clamp::paper(),
+            DeadLoads {
+                tip_force: Vector3::new(0.0, 0.0, -load),
+                ..Default::default()
+            },
+            None,
+        )
+        .unwrap()
     };
     // The shooting Jacobian is as accurate as the integration; its
     // singularity is located to about the integrator's tolerance.
@@ -311,22 +318,25 @@ fn zero_eigenvalue_is_where_the_shooting_jacobian_is_singular_on_straight_rods()
     assert!((by_block(Block::OutOfPlane) - out_of_plane).abs() <= 1e-8 * euler);
 
     // Timoshenko: κ⁰2(s) = −λF(L − s)/B2 keeps the rod straight under λF e1.
-    let ltb = |load: f64| Rod {
-        length: 1.0,
-        energy: Arc::new(LinearElastic {
-            stiffness: [1.0, 1.0, 1.0].map(Profile::Constant),
-            intrinsic_curvature: [
-                Profile::Constant(0.0),
-                Profile::Polynomial(vec![-load, load]),
-                Profile::Constant(0.0),
-            ],
-        }),
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
-            tip_force: Vector3::new(load, 0.0, 0.0),
-            ..Default::default()
-        },
-        support: None,
+    let ltb = |load: f64| {
+        Rod::new(
+            1.0,
+            Arc::new(LinearElastic {
+                stiffness: [1.0, 1.0, 1.0].map(Profile::Constant),
+                intrinsic_curvature: [
+                    Profile::Constant(0.0),
+                    Profile::Polynomial(vec![-load, load]),
+                    Profile::Constant(0.0),
+                ],
+            }),
+            Clamp::paper(),
+            DeadLoads {
+                tip_force: Vector3::new(load, 0.0, 0.0),
+                ..Default::default()
+            },
+            None,
+        )
+        .unwrap()
     };
     let det = |load: f64| {
         let r = ltb(load);
@@ -362,16 +372,17 @@ fn zero_eigenvalue_is_where_the_shooting_jacobian_is_singular_on_straight_rods()
 #[test]
 fn eigenvalues_converge_at_order_two_p() {
     let force = 1.0;
-    let rod = Rod {
-        length: 1.0,
-        energy: Arc::new(LinearElastic::uniform([1.0, 1.0, 1.0], [0.0; 3])),
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
+    let rod = Rod::new(
+        1.0,
+        Arc::new(LinearElastic::uniform([1.0, 1.0, 1.0], [0.0; 3])),
+        Clamp::paper(),
+        DeadLoads {
             tip_force: Vector3::new(0.0, 0.0, -force),
             ..Default::default()
         },
-        support: None,
-    };
+        None,
+    )
+    .unwrap();
     let eq = solve_level(&rod, ModelLevel::Planar);
     let exact = PI * PI / 4.0 - force;
     for (order, meshes) in [(1, [4, 8, 16, 32]), (2, [2, 4, 8, 16])] {
@@ -455,16 +466,17 @@ fn euler_load_from_the_problem_file() {
 
 #[test]
 fn banded_lanczos_agrees_with_the_dense_solver() {
-    let rod = Rod {
-        length: 1.0,
-        energy: Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
+    let rod = Rod::new(
+        1.0,
+        Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
+        Clamp::paper(),
+        DeadLoads {
             tip_force: Vector3::new(3.0, 0.0, 0.0),
             ..Default::default()
         },
-        support: None,
-    };
+        None,
+    )
+    .unwrap();
     let eq = solve_level(&rod, ModelLevel::Planar);
     let fe = FiniteElements::new(1.0, 200, 2);
     let samples = eq
@@ -495,16 +507,17 @@ fn morse_index_counts_the_unstable_modes() {
         ..Default::default()
     };
     for (load, morse) in [(2.0, 0), (3.0, 2)] {
-        let rod = Rod {
-            length: 1.0,
-            energy: Arc::new(LinearElastic::uniform([1.0, 1.0, 1.0], [0.0; 3])),
-            clamp: Clamp::paper(),
-            loads: DeadLoads {
+        let rod = Rod::new(
+            1.0,
+            Arc::new(LinearElastic::uniform([1.0, 1.0, 1.0], [0.0; 3])),
+            Clamp::paper(),
+            DeadLoads {
                 tip_force: Vector3::new(0.0, 0.0, -load),
                 ..Default::default()
             },
-            support: None,
-        };
+            None,
+        )
+        .unwrap();
         let choice = ModelChoice::for_rod(&rod);
         let eq = solve(&rod, &choice, &direct).unwrap();
         let st = analyze(&rod, &eq, &direct, &StabilityOptions::default()).unwrap();

@@ -216,7 +216,7 @@ impl ArmProblem {
         design: ArmDesign,
         evaluations: usize,
     ) -> Option<ArmOptimum> {
-        let rod = self.rod_in(scene);
+        let rod = self.rod_in(scene).ok()?;
         let shape = FixedShape {
             turning_angle: Profile::Polynomial(design.shape_coefficients.clone()),
         };
