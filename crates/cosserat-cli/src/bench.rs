@@ -87,7 +87,10 @@ pub fn scenes() -> Vec<Scene> {
     let cantilever = |k: f64| {
         let rod = Rod::new(
             1.0,
-            Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
+            Arc::new(
+                LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])
+                    .expect("a fixed scene is a valid energy"),
+            ),
             Clamp::paper(),
             DeadLoads {
                 tip_force: Vector3::new(k, 0.0, 0.0),
@@ -104,7 +107,10 @@ pub fn scenes() -> Vec<Scene> {
     let kappa0 = Vector3::new(1.3, -0.7, 2.1);
     let helix = Rod::new(
         3.0,
-        Arc::new(LinearElastic::uniform([1.0, 2.0, 0.8], kappa0.into())),
+        Arc::new(
+            LinearElastic::uniform([1.0, 2.0, 0.8], kappa0.into())
+                .expect("a fixed scene is a valid energy"),
+        ),
         Clamp::paper(),
         DeadLoads::default(),
         None,

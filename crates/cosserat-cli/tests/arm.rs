@@ -291,7 +291,7 @@ fn straight_rod(b: [f64; 3], phi: f64) -> (cosserat::model::Rod, cosserat::stabi
     })
     .unwrap()
     .with_energy(std::sync::Arc::new(
-        cosserat::model::LinearElastic::uniform(b, [0.0; 3]),
+        cosserat::model::LinearElastic::uniform(b, [0.0; 3]).unwrap(),
     ));
     let shape = cosserat::stability::FixedShape {
         turning_angle: cosserat::model::Profile::Constant(phi),

@@ -242,7 +242,7 @@ fn a_hanging_arm_has_no_critical_load() {
     for (b1, b3) in [(4.0, 1.27), (1.0, 1.0), (0.25, 4.0)] {
         let rod = Rod::new(
             1.0,
-            std::sync::Arc::new(LinearElastic::uniform([b1, 1.0, b3], [0.0; 3])),
+            std::sync::Arc::new(LinearElastic::uniform([b1, 1.0, b3], [0.0; 3]).unwrap()),
             Clamp::paper(),
             DeadLoads {
                 tip_force: Vector3::new(1.0, 0.0, 0.0),
@@ -647,7 +647,7 @@ fn stability_options_out_of_range_are_errors_not_clamps() {
     use cosserat::stability::{critical_load, FixedShape, StabilityOptions};
     let rod = Rod::new(
         1.0,
-        std::sync::Arc::new(LinearElastic::uniform([1.0, 1.0, 1.0], [0.0; 3])),
+        std::sync::Arc::new(LinearElastic::uniform([1.0, 1.0, 1.0], [0.0; 3]).unwrap()),
         Clamp::paper(),
         DeadLoads {
             tip_force: nalgebra::Vector3::new(1.0, 0.0, 0.0),

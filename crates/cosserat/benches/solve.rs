@@ -18,7 +18,7 @@ use nalgebra::Vector3;
 fn cantilever(k: f64) -> Rod {
     Rod::new(
         1.0,
-        Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
+        Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3]).unwrap()),
         Clamp::paper(),
         DeadLoads {
             tip_force: Vector3::new(k, 0.0, 0.0),

@@ -37,7 +37,7 @@ fn time(repeats: usize, mut f: impl FnMut()) -> f64 {
 fn main() {
     let rod = Rod::new(
         1.0,
-        Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
+        Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3]).unwrap()),
         Clamp::paper(),
         DeadLoads {
             tip_force: Vector3::new(3.0, 0.0, 0.0),
@@ -86,7 +86,7 @@ fn main() {
 
     let straight = Rod::new(
         1.0,
-        Arc::new(LinearElastic::uniform([1.0, 1.0, 1.0], [0.0; 3])),
+        Arc::new(LinearElastic::uniform([1.0, 1.0, 1.0], [0.0; 3]).unwrap()),
         Clamp::paper(),
         DeadLoads {
             tip_force: Vector3::new(1.0, 0.0, 0.0),

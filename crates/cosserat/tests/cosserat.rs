@@ -22,13 +22,10 @@ use support::references::cantilever_tip;
 /// (d1 = e1, d3 = e3), tip force f.
 fn rod(shear: [f64; 3], force: Vector3<f64>) -> Rod {
     let bending: Arc<dyn StoredEnergy> =
-        Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3]));
+        Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3]).unwrap());
     Rod::new(
         1.0,
-        Arc::new(Shearable {
-            bending,
-            shear: Vector3::from(shear),
-        }),
+        Arc::new(Shearable::new(bending, Vector3::from(shear)).unwrap()),
         Clamp::paper(),
         DeadLoads {
             tip_force: force,

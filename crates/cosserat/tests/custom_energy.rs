@@ -23,18 +23,19 @@ const FILE: &str = concat!(
 #[test]
 fn derivatives_match_central_differences() {
     let e = HyperbolicStiffening {
-        linear: LinearElastic {
-            stiffness: [
+        linear: LinearElastic::new(
+            [
                 Profile::Polynomial(vec![2.0, -0.5]),
                 Profile::Constant(1.0),
                 Profile::Polynomial(vec![1.5, 0.2]),
             ],
-            intrinsic_curvature: [
+            [
                 Profile::Polynomial(vec![0.1, 0.4]),
                 Profile::Polynomial(vec![-0.3, 0.0, 1.0]),
                 Profile::Constant(0.7),
             ],
-        },
+        )
+        .unwrap(),
         stiffening: 0.8,
     };
     let (s, h) = (0.37, 1e-6);

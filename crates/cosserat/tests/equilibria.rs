@@ -18,7 +18,7 @@ use support::references::cantilever_tip;
 fn cantilever(k: f64) -> Rod {
     Rod::new(
         1.0,
-        Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
+        Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3]).unwrap()),
         Clamp::paper(),
         DeadLoads {
             tip_force: Vector3::new(k, 0.0, 0.0),
@@ -141,7 +141,7 @@ fn unloaded_rod_with_constant_intrinsic_curvature_is_a_helix() {
     let kappa0 = Vector3::new(1.3, -0.7, 2.1);
     let rod = Rod::new(
         3.0,
-        Arc::new(LinearElastic::uniform([1.0, 2.0, 0.8], kappa0.into())),
+        Arc::new(LinearElastic::uniform([1.0, 2.0, 0.8], kappa0.into()).unwrap()),
         Clamp::new(Vector3::zeros(), Vector3::x(), Vector3::z()).unwrap(),
         DeadLoads::default(),
         None,
@@ -179,13 +179,10 @@ fn unloaded_rod_with_constant_intrinsic_curvature_is_a_helix() {
 /// multiple shooting find the same equilibrium.
 #[test]
 fn single_and_multiple_shooting_agree() {
-    let linear = LinearElastic::uniform([1.0, 1.5, 0.7], [0.8, 0.3, 1.2]);
+    let linear = LinearElastic::uniform([1.0, 1.5, 0.7], [0.8, 0.3, 1.2]).unwrap();
     let energies: Vec<Arc<dyn cosserat::model::StoredEnergy>> = vec![
         Arc::new(linear.clone()),
-        Arc::new(QuarticStiffening {
-            linear,
-            quartic: 0.5,
-        }),
+        Arc::new(QuarticStiffening::new(linear, 0.5).unwrap()),
     ];
     for energy in energies {
         let rod = Rod::new(
@@ -260,14 +257,15 @@ fn single_shooting_fails_clearly_where_multiple_shooting_recovers() {
 fn tapered_cantilever_matches_linear_beam_theory() {
     use cosserat::model::Profile;
     let force = 1e-4;
-    let energy = LinearElastic {
-        stiffness: [
+    let energy = LinearElastic::new(
+        [
             Profile::Constant(10.0),
             Profile::Polynomial(vec![2.0, -1.0]),
             Profile::Constant(10.0),
         ],
-        intrinsic_curvature: Default::default(),
-    };
+        Default::default(),
+    )
+    .unwrap();
     let rod = cantilever(force).with_energy(Arc::new(energy));
     let mut opts = SolverOptions::default();
     opts.newton.tolerance = 1e-14;
@@ -285,9 +283,9 @@ fn tapered_cantilever_matches_linear_beam_theory() {
 fn tabulated_intrinsic_curvature_gives_its_intrinsic_shape() {
     use cosserat::model::Profile;
     let (knots, values) = ([0.0, 0.4, 1.0], [0.0, 3.0, -1.0]);
-    let energy = LinearElastic {
-        stiffness: [1.0, 1.0, 1.0].map(Profile::Constant),
-        intrinsic_curvature: [
+    let energy = LinearElastic::new(
+        [1.0, 1.0, 1.0].map(Profile::Constant),
+        [
             Profile::Constant(0.0),
             Profile::Table {
                 s: knots.to_vec(),
@@ -295,7 +293,8 @@ fn tabulated_intrinsic_curvature_gives_its_intrinsic_shape() {
             },
             Profile::Constant(0.0),
         ],
-    };
+    )
+    .unwrap();
     let rod = cantilever(0.0).with_energy(Arc::new(energy));
     // φ(s) exactly: integral of the linear interpolant.
     let phi = |s: f64| {
@@ -338,12 +337,26 @@ fn tabulated_intrinsic_curvature_gives_its_intrinsic_shape() {
     }
 }
 
-/// A singular energy Hessian (zero torsional stiffness, built in code where
-/// the problem-file checks do not apply) is a typed error naming the cause.
+/// A singular energy Hessian (a torsional stiffness B3 = 1 − 2s that
+/// vanishes at s = L/2, built in code where the problem-file checks do not
+/// apply) is a typed error naming the cause. A zero constant stiffness is
+/// refused when the energy is built.
 #[test]
 fn singular_energy_hessian_is_a_typed_error() {
-    let rod =
-        cantilever(1.0).with_energy(Arc::new(LinearElastic::uniform([1.0, 1.0, 0.0], [0.0; 3])));
+    assert!(matches!(
+        LinearElastic::uniform([1.0, 1.0, 0.0], [0.0; 3]),
+        Err(cosserat::model::ModelError::Stiffness { index: 2, .. })
+    ));
+    let vanishing = LinearElastic::new(
+        [
+            cosserat::model::Profile::Constant(1.0),
+            cosserat::model::Profile::Constant(1.0),
+            cosserat::model::Profile::Polynomial(vec![1.0, -2.0]),
+        ],
+        Default::default(),
+    )
+    .unwrap();
+    let rod = cantilever(1.0).with_energy(Arc::new(vanishing));
     let err = solve(&rod, &ModelChoice::for_rod(&rod), &SolverOptions::default()).unwrap_err();
     assert!(matches!(err, cosserat::bvp::SolveError::Model(_)), "{err}");
     assert!(err.to_string().contains("not positive definite"), "{err}");

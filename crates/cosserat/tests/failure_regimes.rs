@@ -24,7 +24,7 @@ use support::references::cantilever_tip;
 fn cantilever(length: f64, force: f64) -> Rod {
     Rod::new(
         length,
-        Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
+        Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3]).unwrap()),
         Clamp::paper(),
         DeadLoads {
             tip_force: Vector3::new(force, 0.0, 0.0),
@@ -38,10 +38,9 @@ fn cantilever(length: f64, force: f64) -> Rod {
 /// A planar rod with intrinsic curvature κ⁰2 = `kappa` (B2 = 1), unloaded
 /// unless `force` ≠ 0.
 fn spiral(kappa: f64, force: f64) -> Rod {
-    cantilever(1.0, force).with_energy(Arc::new(LinearElastic::uniform(
-        [10.0, 1.0, 10.0],
-        [0.0, kappa, 0.0],
-    )))
+    cantilever(1.0, force).with_energy(Arc::new(
+        LinearElastic::uniform([10.0, 1.0, 10.0], [0.0, kappa, 0.0]).unwrap(),
+    ))
 }
 
 fn run(rod: &Rod, method: Method, strategy: Strategy) -> Result<Equilibrium, SolveError> {

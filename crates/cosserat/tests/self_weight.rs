@@ -13,7 +13,7 @@ use nalgebra::Vector3;
 fn hanging(q: f64) -> Rod {
     Rod::new(
         1.0,
-        Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
+        Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3]).unwrap()),
         Clamp::paper(),
         DeadLoads {
             distributed_force: Vector3::new(q, 0.0, 0.0),

@@ -54,24 +54,22 @@ fn density(
 }
 
 fn energies() -> Vec<Arc<dyn StoredEnergy>> {
-    let linear = LinearElastic {
-        stiffness: [
+    let linear = LinearElastic::new(
+        [
             Profile::Constant(1.3),
             Profile::Polynomial(vec![2.0, -0.5]),
             Profile::Constant(0.8),
         ],
-        intrinsic_curvature: [
+        [
             Profile::Constant(0.4),
             Profile::Polynomial(vec![-0.3, 1.0]),
             Profile::Constant(0.9),
         ],
-    };
+    )
+    .unwrap();
     vec![
         Arc::new(linear.clone()),
-        Arc::new(QuarticStiffening {
-            linear,
-            quartic: 0.7,
-        }),
+        Arc::new(QuarticStiffening::new(linear, 0.7).unwrap()),
     ]
 }
 
@@ -210,7 +208,7 @@ fn zero_eigenvalue_is_where_the_shooting_jacobian_is_singular_on_a_bent_rod() {
     let rod = |load: f64| {
         Rod::new(
             1.0,
-            Arc::new(LinearElastic::uniform([1.0, 10.0, 1.0], [0.0; 3])),
+            Arc::new(LinearElastic::uniform([1.0, 10.0, 1.0], [0.0; 3]).unwrap()),
             Clamp::paper(),
             DeadLoads {
                 tip_force: Vector3::new(load, 0.0, 0.0),
@@ -268,7 +266,7 @@ fn zero_eigenvalue_is_where_the_shooting_jacobian_is_singular_on_straight_rods()
     let column = |load: f64| {
         Rod::new(
             1.0,
-            Arc::new(LinearElastic::uniform([2.0, 1.0, 1.0], [0.0; 3])),
+            Arc::new(LinearElastic::uniform([2.0, 1.0, 1.0], [0.0; 3]).unwrap()),
             Clamp::paper(),
             DeadLoads {
                 tip_force: Vector3::new(0.0, 0.0, -load),
@@ -321,14 +319,17 @@ fn zero_eigenvalue_is_where_the_shooting_jacobian_is_singular_on_straight_rods()
     let ltb = |load: f64| {
         Rod::new(
             1.0,
-            Arc::new(LinearElastic {
-                stiffness: [1.0, 1.0, 1.0].map(Profile::Constant),
-                intrinsic_curvature: [
-                    Profile::Constant(0.0),
-                    Profile::Polynomial(vec![-load, load]),
-                    Profile::Constant(0.0),
-                ],
-            }),
+            Arc::new(
+                LinearElastic::new(
+                    [1.0, 1.0, 1.0].map(Profile::Constant),
+                    [
+                        Profile::Constant(0.0),
+                        Profile::Polynomial(vec![-load, load]),
+                        Profile::Constant(0.0),
+                    ],
+                )
+                .unwrap(),
+            ),
             Clamp::paper(),
             DeadLoads {
                 tip_force: Vector3::new(load, 0.0, 0.0),
@@ -374,7 +375,7 @@ fn eigenvalues_converge_at_order_two_p() {
     let force = 1.0;
     let rod = Rod::new(
         1.0,
-        Arc::new(LinearElastic::uniform([1.0, 1.0, 1.0], [0.0; 3])),
+        Arc::new(LinearElastic::uniform([1.0, 1.0, 1.0], [0.0; 3]).unwrap()),
         Clamp::paper(),
         DeadLoads {
             tip_force: Vector3::new(0.0, 0.0, -force),
@@ -468,7 +469,7 @@ fn euler_load_from_the_problem_file() {
 fn banded_lanczos_agrees_with_the_dense_solver() {
     let rod = Rod::new(
         1.0,
-        Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
+        Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3]).unwrap()),
         Clamp::paper(),
         DeadLoads {
             tip_force: Vector3::new(3.0, 0.0, 0.0),
@@ -509,7 +510,7 @@ fn morse_index_counts_the_unstable_modes() {
     for (load, morse) in [(2.0, 0), (3.0, 2)] {
         let rod = Rod::new(
             1.0,
-            Arc::new(LinearElastic::uniform([1.0, 1.0, 1.0], [0.0; 3])),
+            Arc::new(LinearElastic::uniform([1.0, 1.0, 1.0], [0.0; 3]).unwrap()),
             Clamp::paper(),
             DeadLoads {
                 tip_force: Vector3::new(0.0, 0.0, -load),

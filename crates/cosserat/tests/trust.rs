@@ -17,7 +17,7 @@ use support::references::cantilever_tip;
 fn cantilever(b1: f64, b3: f64) -> Rod {
     Rod::new(
         1.0,
-        Arc::new(LinearElastic::uniform([b1, 1.0, b3], [0.0; 3])),
+        Arc::new(LinearElastic::uniform([b1, 1.0, b3], [0.0; 3]).unwrap()),
         Clamp::paper(),
         DeadLoads {
             tip_force: Vector3::new(3.0, 0.0, 0.0),
@@ -96,7 +96,7 @@ fn held_frame_is_not_met_by_the_flipped_frame() {
     let clamp = Clamp::paper();
     let rod = Rod::new(
         1.0,
-        Arc::new(LinearElastic::uniform([1.0, 1.0, 0.7], [0.0; 3])),
+        Arc::new(LinearElastic::uniform([1.0, 1.0, 0.7], [0.0; 3]).unwrap()),
         clamp.clone(),
         DeadLoads::default(),
         Some(TipSupport {

@@ -158,7 +158,7 @@ mod tests {
     fn sensitivity_matches_central_differences() {
         let rod = Rod::new(
             1.0,
-            Arc::new(LinearElastic::uniform([2.0, 1.0, 1.5], [0.3, -0.4, 0.7])),
+            Arc::new(LinearElastic::uniform([2.0, 1.0, 1.5], [0.3, -0.4, 0.7]).unwrap()),
             Clamp::paper(),
             DeadLoads {
                 tip_force: Vector3::new(1.5, 0.4, -0.3),

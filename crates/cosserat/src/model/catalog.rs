@@ -10,7 +10,7 @@
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
-use super::{LinearElastic, Profile, QuarticStiffening, StoredEnergy};
+use super::{LinearElastic, ModelError, Profile, QuarticStiffening, StoredEnergy};
 
 /// The `[energy]` table of a problem file, validated.
 #[derive(Debug, Clone, PartialEq)]
@@ -33,13 +33,31 @@ pub struct EnergySpecError {
     pub message: String,
 }
 
-impl EnergySpec {
-    /// The linear-elastic energy of the profiles (paper (17)).
-    pub fn linear(&self) -> LinearElastic {
-        LinearElastic {
-            stiffness: self.stiffness.clone(),
-            intrinsic_curvature: self.intrinsic_curvature.clone(),
+impl From<ModelError> for EnergySpecError {
+    /// The `[energy]` field a refused model value comes from.
+    fn from(e: ModelError) -> Self {
+        let field = match &e {
+            ModelError::Stiffness { index, .. } => format!("energy.stiffness[{index}]"),
+            ModelError::IntrinsicCurvature { index } => {
+                format!("energy.intrinsic_curvature[{index}]")
+            }
+            ModelError::Coefficient { .. } => "energy.parameters.quartic".into(),
+            _ => "energy".into(),
+        };
+        EnergySpecError {
+            field,
+            message: e.to_string(),
         }
+    }
+}
+
+impl EnergySpec {
+    /// The linear-elastic energy of the profiles (paper (17)); a refusal
+    /// of [`LinearElastic::new`] names its profile
+    /// (`energy.stiffness[i]`, `energy.intrinsic_curvature[i]`).
+    pub fn linear(&self) -> Result<LinearElastic, EnergySpecError> {
+        LinearElastic::new(self.stiffness.clone(), self.intrinsic_curvature.clone())
+            .map_err(EnergySpecError::from)
     }
 
     /// A required parameter.
@@ -104,7 +122,7 @@ impl EnergyCatalog {
         };
         c.register("linear", |spec| {
             spec.only(&[])?;
-            Ok(Arc::new(spec.linear()))
+            Ok(Arc::new(spec.linear()?))
         });
         c.register("quartic", |spec| {
             spec.only(&["quartic"])?;
@@ -115,10 +133,7 @@ impl EnergyCatalog {
                     message: format!("must be ≥ 0, got {quartic}"),
                 });
             }
-            Ok(Arc::new(QuarticStiffening {
-                linear: spec.linear(),
-                quartic,
-            }))
+            Ok(Arc::new(QuarticStiffening::new(spec.linear()?, quartic)?))
         });
         c
     }

@@ -39,14 +39,25 @@ pub enum ModelError {
         /// det Q (+1 for a rotation).
         determinant: f64,
     },
-    /// A stiffness is not positive and finite: `what` names it
-    /// ("bending/torsional stiffness B3", "shear stiffness S1", ...).
-    #[error("the {what} must be positive and finite, got {value}")]
+    /// A stiffness is not positive and finite: the `index`th (from 0) of
+    /// the kind `what` ("bending/torsional stiffness B", "shear/extension
+    /// stiffness S").
+    #[error("the {what}{} must be positive and finite, got {value}", .index + 1)]
     Stiffness {
-        /// Which stiffness.
-        what: String,
-        /// The refused value (for a profile, its smallest value found).
+        /// Which kind of stiffness.
+        what: &'static str,
+        /// Which component, from 0.
+        index: usize,
+        /// The refused value (NaN for a profile holding a non-finite
+        /// number).
         value: f64,
+    },
+    /// An intrinsic curvature profile κ⁰_i (`index` i from 0) holds a
+    /// non-finite number.
+    #[error("the intrinsic curvature κ⁰{} must hold finite numbers only", .index + 1)]
+    IntrinsicCurvature {
+        /// Which component, from 0.
+        index: usize,
     },
     /// A coefficient of an energy is out of its range (the quartic
     /// coefficient C ≥ 0, finite).

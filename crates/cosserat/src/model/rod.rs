@@ -293,7 +293,7 @@ mod tests {
     use crate::model::LinearElastic;
 
     fn energy() -> Arc<dyn StoredEnergy> {
-        Arc::new(LinearElastic::uniform([1.0, 1.0, 1.0], [0.0; 3]))
+        Arc::new(LinearElastic::uniform([1.0, 1.0, 1.0], [0.0; 3]).unwrap())
     }
 
     fn loads() -> DeadLoads {

@@ -94,10 +94,16 @@ pub(super) fn build_rod(file: &ProblemFile, catalog: &EnergyCatalog) -> Result<R
             file.solver.model.as_str(),
             "planar" | "kirchhoff" | "spatial"
         ) {
-            energy = Arc::new(Shearable {
-                bending: energy,
-                shear: shear_stiffness(shear)?,
-            });
+            // Checked by shear_stiffness with its keys; a refusal all the
+            // same names the component.
+            energy = Arc::new(Shearable::new(energy, shear_stiffness(shear)?).map_err(
+                |e| match e {
+                    ModelError::Stiffness { index, .. } => {
+                        invalid(format!("energy.shear[{index}]"), e.to_string())
+                    }
+                    _ => invalid("energy.shear", e.to_string()),
+                },
+            )?);
         }
     }
     let clamp = build_clamp(&file.clamp)?;

@@ -108,14 +108,16 @@ pub fn shape_holding_path_until(
         .collect();
     let dphi = derivative(&design.shape_coefficients);
     let unloaded: Vec<f64> = s.iter().map(|t| polynomial(&dphi, *t)).collect();
-    let base = target.clone().with_energy(Arc::new(LinearElastic {
-        stiffness: [problem.b1, 1.0, problem.b3].map(Profile::Constant),
-        intrinsic_curvature: [
+    let unloaded = LinearElastic::new(
+        [problem.b1, 1.0, problem.b3].map(Profile::Constant),
+        [
             Profile::Constant(0.0),
             Profile::spline(s, unloaded),
             Profile::Constant(0.0),
         ],
-    }));
+    )
+    .map_err(not_built)?;
+    let base = target.clone().with_energy(Arc::new(unloaded));
     let family = Family::towards(
         base,
         target.energy().clone(),

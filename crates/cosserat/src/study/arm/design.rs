@@ -66,7 +66,7 @@ impl ArmProblem {
     pub fn rod_in(&self, scene: &ArmScene) -> Result<Rod, ModelError> {
         Rod::new(
             1.0,
-            Arc::new(LinearElastic::uniform([self.b1, 1.0, self.b3], [0.0; 3])),
+            Arc::new(LinearElastic::uniform([self.b1, 1.0, self.b3], [0.0; 3])?),
             Clamp::paper(),
             scene.loads(),
             None,

@@ -169,14 +169,14 @@ pub fn designed_rod(
         .map(|p| polynomial(&dphi, p.s) - design.gamma * p.moment[1])
         .collect();
     let rod = rod0.clone();
-    let energy = Arc::new(LinearElastic {
-        stiffness: [problem.b1, 1.0, problem.b3].map(Profile::Constant),
-        intrinsic_curvature: [
+    let energy = Arc::new(LinearElastic::new(
+        [problem.b1, 1.0, problem.b3].map(Profile::Constant),
+        [
             Profile::Constant(0.0),
             Profile::spline(s, kappa0),
             Profile::Constant(0.0),
         ],
-    });
+    )?);
     let mut clamp = rod.clamp().clone();
     clamp.frame = clamp.turned_frame(c[0]);
     let loads = rod.loads().scaled(design.gamma);
