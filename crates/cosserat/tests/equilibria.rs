@@ -287,10 +287,7 @@ fn tabulated_intrinsic_curvature_gives_its_intrinsic_shape() {
         [1.0, 1.0, 1.0].map(Profile::Constant),
         [
             Profile::Constant(0.0),
-            Profile::Table {
-                s: knots.to_vec(),
-                values: values.to_vec(),
-            },
+            Profile::table(knots.to_vec(), values.to_vec()).unwrap(),
             Profile::Constant(0.0),
         ],
     )

@@ -20,7 +20,7 @@ pub use error::ModelError;
 pub use frame::Frame;
 pub use level::{ModelChoice, ModelLevel};
 pub use loads::DeadLoads;
-pub use profile::{Extremes, Profile};
+pub use profile::{Extremes, Knots, Profile, SplineKnots};
 pub use rod::{Clamp, ResidualScales, Rod};
 pub use shear::Shearable;
 pub use support::{across, Freedom, TipSupport};

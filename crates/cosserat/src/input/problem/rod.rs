@@ -43,10 +43,9 @@ pub(super) fn profile(field: &str, spec: &ProfileSpec) -> Result<Profile, Proble
             if !s.windows(2).all(|w| w[1] > w[0]) {
                 return Err(invalid(format!("{field}.s"), "must be strictly increasing"));
             }
-            Profile::Table {
-                s: s.clone(),
-                values: values.clone(),
-            }
+            // Shape checked above with its keys; a refusal all the same is
+            // named by the profile's key.
+            Profile::table(s.clone(), values.clone()).map_err(|e| invalid(field, e.to_string()))?
         }
     };
     if !p.is_finite() {

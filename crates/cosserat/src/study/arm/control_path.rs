@@ -112,7 +112,7 @@ pub fn shape_holding_path_until(
         [problem.b1, 1.0, problem.b3].map(Profile::Constant),
         [
             Profile::Constant(0.0),
-            Profile::spline(s, unloaded),
+            Profile::spline(s, unloaded).map_err(not_built)?,
             Profile::Constant(0.0),
         ],
     )

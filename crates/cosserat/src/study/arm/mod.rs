@@ -173,7 +173,7 @@ pub fn designed_rod(
         [problem.b1, 1.0, problem.b3].map(Profile::Constant),
         [
             Profile::Constant(0.0),
-            Profile::spline(s, kappa0),
+            Profile::spline(s, kappa0)?,
             Profile::Constant(0.0),
         ],
     )?);
