@@ -296,7 +296,7 @@ impl Family {
             Parameter::ClampAngle => {
                 // About d2 by +p: d3 turns towards d1 (R d3 = d3 cos p + d1 sin p).
                 let mut clamp = self.base.clamp().clone();
-                clamp.frame = clamp.turned_frame(p);
+                clamp.frame = clamp.turned_frame(p).map_err(|_| bad())?;
                 rod = rod.with_clamp(clamp).map_err(|_| bad())?;
             }
             Parameter::Stiffness(_) | Parameter::IntrinsicCurvature(_) => {

@@ -39,6 +39,9 @@ pub enum ModelError {
         /// det Q (+1 for a rotation).
         determinant: f64,
     },
+    /// A turning angle (rad) is not finite.
+    #[error("a turning angle must be finite, got {0}")]
+    Angle(f64),
     /// A stiffness is not positive and finite: the `index`th (from 0) of
     /// the kind `what` ("bending/torsional stiffness B", "shear/extension
     /// stiffness S").

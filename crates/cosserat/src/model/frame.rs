@@ -64,14 +64,19 @@ impl Frame {
         self.0.column(i).into_owned()
     }
 
-    /// The frame turned by `angle` (rad) about its own director d_axis:
-    /// R Q with R the rotation about d_axis. A product of rotations is a
-    /// rotation up to a few rounding units, far inside the tolerance, so it
-    /// is not checked again (a non-finite angle gives a non-finite frame,
-    /// which callers refuse with the angle).
-    pub fn turned(&self, axis: usize, angle: f64) -> Frame {
+    /// The frame turned by `angle` (rad) about its own director d_axis
+    /// (axis 0, 1 or 2): R Q with R the rotation about d_axis. Refused
+    /// ([`ModelError::Angle`]) for a non-finite angle. A product of
+    /// rotations is a rotation up to a few rounding units, far inside the
+    /// tolerance, so it is not checked again.
+    pub fn turned(&self, axis: usize, angle: f64) -> Result<Frame, ModelError> {
+        if !angle.is_finite() {
+            return Err(ModelError::Angle(angle));
+        }
         let a = Unit::new_normalize(self.director(axis));
-        Frame(Rotation3::from_axis_angle(&a, angle).matrix() * self.0)
+        Ok(Frame(
+            Rotation3::from_axis_angle(&a, angle).matrix() * self.0,
+        ))
     }
 }
 
@@ -103,7 +108,11 @@ mod tests {
         assert_eq!(f.director(2), q.column(2).into_owned());
         let g = Frame::from_directors(Vector3::x(), Vector3::z()).unwrap();
         assert_eq!(g, Frame::identity());
-        assert!((g.turned(1, 0.4).director(1) - Vector3::y()).norm() < 1e-15);
+        assert!((g.turned(1, 0.4).unwrap().director(1) - Vector3::y()).norm() < 1e-15);
+        assert!(matches!(
+            g.turned(1, f64::NAN),
+            Err(ModelError::Angle(a)) if a.is_nan()
+        ));
     }
 
     #[test]

@@ -62,7 +62,9 @@ impl Clamp {
     /// The frame turned by `angle` (rad) about d2(0), d3 towards d1:
     /// R [d1 d2 d3] with R d3 = d3 cos θ + d1 sin θ (the clamp angle of the
     /// paper's Fig. 2; a negative angle turns back).
-    pub fn turned_frame(&self, angle: f64) -> Frame {
+    ///
+    /// Refused ([`ModelError::Angle`]) for a non-finite angle.
+    pub fn turned_frame(&self, angle: f64) -> Result<Frame, ModelError> {
         self.frame.turned(1, angle)
     }
 }

@@ -67,7 +67,9 @@ pub(super) fn build_continuation(
     if parameter == Parameter::ClampAngle {
         // The parameter is the absolute angle: start from the unturned frame.
         let mut clamp = rod.clamp().clone();
-        clamp.frame = clamp.turned_frame(-file.clamp.angle);
+        clamp.frame = clamp
+            .turned_frame(-file.clamp.angle)
+            .map_err(|e| invalid("clamp.angle", e.to_string()))?;
         base = base
             .with_clamp(clamp)
             .map_err(|e| invalid("clamp.angle", e.to_string()))?;

@@ -290,7 +290,9 @@ pub(super) fn build_clamp(c: &ClampSection) -> Result<Clamp, ProblemError> {
     // frame refused all the same is named by its directors.
     let clamp = Clamp::new(position, d1, d3).map_err(|e| invalid("clamp.d3", e.to_string()))?;
     Ok(Clamp {
-        frame: clamp.turned_frame(angle),
+        frame: clamp
+            .turned_frame(angle)
+            .map_err(|e| invalid("clamp.angle", e.to_string()))?,
         hinge: c.hinge,
         ..clamp
     })

@@ -150,8 +150,10 @@ pub(super) fn intrinsic_shape(phi0: f64, s: &[f64], kappa0: &[f64], scale: f64) 
 pub(super) fn least_squares_polynomial(s: &[f64], y: &[f64], m: usize) -> Vec<f64> {
     let a = nalgebra::DMatrix::from_fn(s.len(), m, |i, j| s[i].powi(j as i32));
     let b = nalgebra::DVector::from_column_slice(y);
+    // SVD::solve fails only when U or Vᵀ was not computed; both are, so
+    // no failure can turn into numbers here (it had been NaN coefficients).
     a.svd(true, true)
         .solve(&b, 1e-14)
         .map(|v| v.as_slice().to_vec())
-        .unwrap_or_else(|_| vec![f64::NAN; m])
+        .expect("the SVD was computed with U and Vᵀ")
 }

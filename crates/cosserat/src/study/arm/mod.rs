@@ -178,7 +178,7 @@ pub fn designed_rod(
         ],
     )?);
     let mut clamp = rod.clamp().clone();
-    clamp.frame = clamp.turned_frame(c[0]);
+    clamp.frame = clamp.turned_frame(c[0])?;
     let loads = rod.loads().scaled(design.gamma);
     rod.with_energy(energy).with_clamp(clamp)?.with_loads(loads)
 }

@@ -62,7 +62,7 @@ impl ArmProblem {
         let rod = self.rod().ok()?;
         let loads = rod.loads().scaled(gamma);
         let mut clamp = rod.clamp().clone();
-        clamp.frame = clamp.turned_frame(theta);
+        clamp.frame = clamp.turned_frame(theta).ok()?;
         rod.with_loads(loads).ok()?.with_clamp(clamp).ok()
     }
 
