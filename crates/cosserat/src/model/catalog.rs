@@ -165,3 +165,38 @@ impl EnergyCatalog {
         self.builders.get(name).map(|b| b(spec))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A refusal of a checked constructor reaches the problem reader under
+    /// the key of the value refused.
+    #[test]
+    fn refused_energies_name_their_key() {
+        let spec = EnergySpec {
+            stiffness: [1.0, -2.0, 1.0].map(Profile::Constant),
+            intrinsic_curvature: Default::default(),
+            parameters: BTreeMap::new(),
+        };
+        let catalog = EnergyCatalog::standard();
+        let err = catalog.build("linear", &spec).unwrap().unwrap_err();
+        assert_eq!(err.field, "energy.stiffness[1]");
+        assert!(err.message.contains("B2"), "{}", err.message);
+        let spec = EnergySpec {
+            stiffness: [1.0; 3].map(Profile::Constant),
+            intrinsic_curvature: [0.0, 0.0, f64::NAN].map(Profile::Constant),
+            parameters: BTreeMap::from([("quartic".to_owned(), 0.5)]),
+        };
+        let err = catalog.build("quartic", &spec).unwrap().unwrap_err();
+        assert_eq!(err.field, "energy.intrinsic_curvature[2]");
+        let ok = EnergySpec {
+            intrinsic_curvature: Default::default(),
+            ..spec
+        };
+        assert_eq!(
+            catalog.build("quartic", &ok).unwrap().unwrap().name(),
+            "quartic"
+        );
+    }
+}

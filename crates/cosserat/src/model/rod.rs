@@ -316,6 +316,24 @@ mod tests {
         let rod = rod.with_length(3.0).unwrap();
         assert_eq!(rod.length(), 3.0);
         assert_eq!(rod.with_load_factor(2.0).unwrap().loads().tip_force.x, 2.0);
+        let clamp = Clamp::new(Vector3::zeros(), Vector3::x(), Vector3::z()).unwrap();
+        assert_eq!(clamp, Clamp::paper());
+        let turned = Clamp {
+            frame: clamp.turned_frame(0.3).unwrap(),
+            ..clamp
+        };
+        let support = TipSupport {
+            position: Vector3::new(0.1, 0.0, 0.9),
+            frame: Frame::identity(),
+            translation: Freedom::Axial(Vector3::z()),
+            rotation: Freedom::Fixed,
+        };
+        let rod = rod
+            .with_clamp(turned.clone())
+            .unwrap()
+            .with_support(Some(support.clone()))
+            .unwrap();
+        assert_eq!((rod.clamp(), rod.support()), (&turned, Some(&support)));
     }
 
     #[test]
@@ -351,8 +369,33 @@ mod tests {
             rotation: Freedom::Free,
         };
         assert!(matches!(
-            rod.with_support(Some(support)),
+            rod.clone().with_support(Some(support.clone())),
             Err(ModelError::Axis { .. })
+        ));
+        let nowhere = TipSupport {
+            position: Vector3::new(f64::INFINITY, 0.0, 0.0),
+            translation: Freedom::Fixed,
+            ..support
+        };
+        assert!(matches!(
+            rod.clone().with_support(Some(nowhere)),
+            Err(ModelError::NotFinite {
+                what: "support position",
+                ..
+            })
+        ));
+        let mut adrift = Clamp::paper();
+        adrift.position.x = f64::NAN;
+        assert!(matches!(
+            rod.clone().with_clamp(adrift),
+            Err(ModelError::NotFinite {
+                what: "clamp position",
+                ..
+            })
+        ));
+        assert!(matches!(
+            rod.with_length(-2.0),
+            Err(ModelError::Length(l)) if l == -2.0
         ));
     }
 }
