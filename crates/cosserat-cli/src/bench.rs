@@ -85,29 +85,37 @@ pub struct Scene {
 /// The three scenes of the chart.
 pub fn scenes() -> Vec<Scene> {
     let cantilever = |k: f64| {
-        let rod = Rod {
-            length: 1.0,
-            energy: Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])),
-            clamp: Clamp::paper(),
-            loads: DeadLoads {
+        let rod = Rod::new(
+            1.0,
+            Arc::new(
+                LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3])
+                    .expect("a fixed scene is a valid energy"),
+            ),
+            Clamp::paper(),
+            DeadLoads {
                 tip_force: Vector3::new(k, 0.0, 0.0),
                 ..Default::default()
             },
-            support: None,
-        };
+            None,
+        )
+        .expect("a fixed scene is a valid rod");
         let (x, z) = cantilever_tip(k);
         (rod, Vector3::new(x, 0.0, z))
     };
     let (k3, tip3) = cantilever(3.0);
     let (k10, tip10) = cantilever(10.0);
     let kappa0 = Vector3::new(1.3, -0.7, 2.1);
-    let helix = Rod {
-        length: 3.0,
-        energy: Arc::new(LinearElastic::uniform([1.0, 2.0, 0.8], kappa0.into())),
-        clamp: Clamp::new(Vector3::zeros(), Vector3::x(), Vector3::z()),
-        loads: DeadLoads::default(),
-        support: None,
-    };
+    let helix = Rod::new(
+        3.0,
+        Arc::new(
+            LinearElastic::uniform([1.0, 2.0, 0.8], kappa0.into())
+                .expect("a fixed scene is a valid energy"),
+        ),
+        Clamp::paper(),
+        DeadLoads::default(),
+        None,
+    )
+    .expect("a fixed scene is a valid rod");
     vec![
         Scene {
             name: "planar cantilever k = 3",

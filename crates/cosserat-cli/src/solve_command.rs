@@ -180,7 +180,7 @@ pub fn run_solve(path: PathBuf, output: Option<PathBuf>, set: &[String], force: 
         problem.model.level.name(),
         problem.model.reason
     );
-    println!("energy    {}", problem.rod.energy.name());
+    println!("energy    {}", problem.rod.energy().name());
     let eq = match solve(&problem.rod, &problem.model, &problem.options) {
         Ok(eq) => eq,
         Err(e) => return solve_failed(&e),

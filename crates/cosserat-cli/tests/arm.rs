@@ -220,7 +220,7 @@ fn section_4_4_arm_reaches_its_design_only_holding_its_shape() {
 }
 
 fn straight_rod(b: [f64; 3], phi: f64) -> (cosserat::model::Rod, cosserat::stability::FixedShape) {
-    let mut rod = ArmProblem {
+    let rod = ArmProblem {
         b1: b[0],
         b3: b[2],
         ..problem(1.0, 1.0, vec![])
@@ -228,8 +228,11 @@ fn straight_rod(b: [f64; 3], phi: f64) -> (cosserat::model::Rod, cosserat::stabi
     .rod_in(&cosserat::study::arm::ArmScene {
         weight: cosserat::study::arm::ArmWeight::Alone,
         max_curvature: None,
-    });
-    rod.energy = std::sync::Arc::new(cosserat::model::LinearElastic::uniform(b, [0.0; 3]));
+    })
+    .unwrap()
+    .with_energy(std::sync::Arc::new(
+        cosserat::model::LinearElastic::uniform(b, [0.0; 3]).unwrap(),
+    ));
     let shape = cosserat::stability::FixedShape {
         turning_angle: cosserat::model::Profile::Constant(phi),
     };

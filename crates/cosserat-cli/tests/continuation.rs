@@ -100,7 +100,7 @@ fn kirchhoff_singularity(f: &Family, x: &[f64], p: f64) -> f64 {
     let u = if f.level() == ModelLevel::Planar {
         let mut u = vec![0.0, x[0], 0.0];
         if x.len() == 3 {
-            let r = rod.clamp.director(0) * x[1] + rod.clamp.director(2) * x[2];
+            let r = rod.clamp().director(0) * x[1] + rod.clamp().director(2) * x[2];
             u.extend_from_slice(r.as_slice());
         }
         u
@@ -120,9 +120,9 @@ fn fine_eigenvalue(f: &Family, x: &[f64], p: f64, block: Block) -> f64 {
     use cosserat::stability::constrained::lowest_eigenpairs_constrained;
     use cosserat::stability::{coefficients, support_constraints, FiniteElements};
     let rod = f.rod_at(p).unwrap();
-    let fe = FiniteElements::new(rod.length, 480, 2);
+    let fe = FiniteElements::new(rod.length(), 480, 2);
     let mut points = fe.quadrature_points();
-    points.push(rod.length);
+    points.push(rod.length());
     let mut samples = f.samples(x, p, &points).unwrap();
     let tip = samples.pop().unwrap();
     let c = coefficients(&rod, &samples);

@@ -200,16 +200,17 @@ fn problem_files_are_bounded_regular_files() {
 fn stability_options_out_of_range_are_errors_not_clamps() {
     use cosserat::model::{Clamp, DeadLoads, LinearElastic, Profile, Rod};
     use cosserat::stability::{critical_load, FixedShape, StabilityOptions};
-    let rod = Rod {
-        length: 1.0,
-        energy: std::sync::Arc::new(LinearElastic::uniform([1.0, 1.0, 1.0], [0.0; 3])),
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
+    let rod = Rod::new(
+        1.0,
+        std::sync::Arc::new(LinearElastic::uniform([1.0, 1.0, 1.0], [0.0; 3]).unwrap()),
+        Clamp::paper(),
+        DeadLoads {
             tip_force: nalgebra::Vector3::new(1.0, 0.0, 0.0),
             ..Default::default()
         },
-        support: None,
-    };
+        None,
+    )
+    .unwrap();
     let shape = FixedShape {
         turning_angle: Profile::Constant(0.0),
     };

@@ -216,17 +216,18 @@ fn a_hanging_arm_has_no_critical_load() {
     use cosserat::stability::{critical_load, FixedShape, StabilityOptions};
     use nalgebra::Vector3;
     for (b1, b3) in [(4.0, 1.27), (1.0, 1.0), (0.25, 4.0)] {
-        let rod = Rod {
-            length: 1.0,
-            energy: std::sync::Arc::new(LinearElastic::uniform([b1, 1.0, b3], [0.0; 3])),
-            clamp: Clamp::paper(),
-            loads: DeadLoads {
+        let rod = Rod::new(
+            1.0,
+            std::sync::Arc::new(LinearElastic::uniform([b1, 1.0, b3], [0.0; 3]).unwrap()),
+            Clamp::paper(),
+            DeadLoads {
                 tip_force: Vector3::new(1.0, 0.0, 0.0),
                 tip_couple: Vector3::zeros(),
                 distributed_force: Vector3::zeros(),
             },
-            support: None,
-        };
+            None,
+        )
+        .unwrap();
         // φ = π/2 from the horizontal d3 towards d1 (down): hanging.
         let shape = FixedShape {
             turning_angle: Profile::Constant(std::f64::consts::FRAC_PI_2),

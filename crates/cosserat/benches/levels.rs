@@ -37,24 +37,23 @@ fn time<T>(mut f: impl FnMut() -> T) -> (f64, T) {
 
 fn cantilever(shear: Option<f64>) -> Rod {
     let bending: Arc<dyn StoredEnergy> =
-        Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3]));
+        Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3]).unwrap());
     let energy = match shear {
-        Some(s) => Arc::new(Shearable {
-            bending,
-            shear: Vector3::new(s, s, s),
-        }) as Arc<dyn StoredEnergy>,
+        Some(s) => Arc::new(Shearable::new(bending, Vector3::new(s, s, s)).unwrap())
+            as Arc<dyn StoredEnergy>,
         None => bending,
     };
-    Rod {
-        length: 1.0,
+    Rod::new(
+        1.0,
         energy,
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
+        Clamp::paper(),
+        DeadLoads {
             tip_force: Vector3::new(3.0, 0.0, 0.0),
             ..Default::default()
         },
-        support: None,
-    }
+        None,
+    )
+    .unwrap()
 }
 
 fn row(scene: &str, rod: &Rod, choice: &ModelChoice, reference: Option<Vector3<f64>>) {

@@ -33,13 +33,13 @@ impl HyperbolicStiffening {
     fn parts(&self, s: f64, kappa: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
         let a = self.stiffening;
         let u = kappa - self.linear.kappa0(s);
-        let b = Vector3::from_fn(|i, _| self.linear.stiffness[i].value(s));
+        let b = Vector3::from_fn(|i, _| self.linear.stiffness_profiles()[i].value(s));
         (u, b, u.map(|x| (a * x).sinh()))
     }
 
     fn rates(&self, s: f64) -> (Vector3<f64>, Vector3<f64>) {
-        let db = Vector3::from_fn(|i, _| self.linear.stiffness[i].derivative(s));
-        let dk0 = Vector3::from_fn(|i, _| self.linear.intrinsic_curvature[i].derivative(s));
+        let db = Vector3::from_fn(|i, _| self.linear.stiffness_profiles()[i].derivative(s));
+        let dk0 = Vector3::from_fn(|i, _| self.linear.intrinsic_curvature()[i].derivative(s));
         (db, dk0)
     }
 }
@@ -114,7 +114,7 @@ pub fn catalog() -> EnergyCatalog {
             });
         }
         Ok(Arc::new(HyperbolicStiffening {
-            linear: spec.linear(),
+            linear: spec.linear()?,
             stiffening: a,
         }))
     });
@@ -129,7 +129,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let problem = Problem::from_path_in(&path, &[], &catalog())?;
     let eq = solve(&problem.rod, &problem.model, &problem.options)?;
     let tip = eq.tip();
-    println!("energy    {}", problem.rod.energy.name());
+    println!("energy    {}", problem.rod.energy().name());
     println!("model     {}", problem.model.reason);
     println!("tip       {:?}", tip.position.as_slice());
     println!("residual  {:.3e}", eq.residual);

@@ -23,20 +23,18 @@ use nalgebra::Vector3;
 /// (d1 = e1, d3 = e3), tip force f.
 fn rod(shear: [f64; 3], force: Vector3<f64>) -> Rod {
     let bending: Arc<dyn StoredEnergy> =
-        Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3]));
-    Rod {
-        length: 1.0,
-        energy: Arc::new(Shearable {
-            bending,
-            shear: Vector3::from(shear),
-        }),
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
+        Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3]).unwrap());
+    Rod::new(
+        1.0,
+        Arc::new(Shearable::new(bending, Vector3::from(shear)).unwrap()),
+        Clamp::paper(),
+        DeadLoads {
             tip_force: force,
             ..Default::default()
         },
-        support: None,
-    }
+        None,
+    )
+    .unwrap()
 }
 
 fn solve_cosserat(rod: &Rod, method: Method) -> Equilibrium {
@@ -165,7 +163,7 @@ fn problem_file_chooses_the_cosserat_level() {
     );
     let forced = Problem::from_str_with(text, &["solver.model=\"kirchhoff\"".into()]).unwrap();
     assert_eq!(forced.model.level, ModelLevel::Kirchhoff);
-    assert!(forced.rod.energy.shear_stiffness(0.0).is_none());
+    assert!(forced.rod.energy().shear_stiffness(0.0).is_none());
     assert!(
         forced.model.reason.contains("ignored"),
         "{}",

@@ -86,8 +86,10 @@ fn planar_and_spatial_models_agree_on_planar_scenes() {
 #[test]
 fn end_couple_rolls_the_rod_into_a_circle() {
     let b2 = 1.0;
-    let mut rod = cantilever(0.0);
-    rod.loads.tip_couple = Vector3::new(0.0, TAU * b2 / rod.length, 0.0);
+    let rod = cantilever(0.0);
+    let mut loads = rod.loads().clone();
+    loads.tip_couple = Vector3::new(0.0, TAU * b2 / rod.length(), 0.0);
+    let rod = rod.with_loads(loads).unwrap();
     for level in LEVELS {
         for method in METHODS {
             let eq = solve_with(&rod, level, method);
@@ -99,7 +101,7 @@ fn end_couple_rolls_the_rod_into_a_circle() {
             );
             assert!((tip.directors[2] - Vector3::z()).norm() <= 1e-9);
             // A circle of radius L/2π through the clamp, centre at x = L/2π.
-            let r = rod.length / TAU;
+            let r = rod.length() / TAU;
             for p in &eq.samples {
                 let c = Vector3::new(r, 0.0, 0.0);
                 assert!(((p.position - c).norm() - r).abs() <= 1e-9, "s = {}", p.s);
@@ -123,13 +125,14 @@ fn helix_position(kappa0: Vector3<f64>, s: f64) -> Vector3<f64> {
 #[test]
 fn unloaded_rod_with_constant_intrinsic_curvature_is_a_helix() {
     let kappa0 = Vector3::new(1.3, -0.7, 2.1);
-    let rod = Rod {
-        length: 3.0,
-        energy: Arc::new(LinearElastic::uniform([1.0, 2.0, 0.8], kappa0.into())),
-        clamp: Clamp::new(Vector3::zeros(), Vector3::x(), Vector3::z()),
-        loads: DeadLoads::default(),
-        support: None,
-    };
+    let rod = Rod::new(
+        3.0,
+        Arc::new(LinearElastic::uniform([1.0, 2.0, 0.8], kappa0.into()).unwrap()),
+        Clamp::new(Vector3::zeros(), Vector3::x(), Vector3::z()).unwrap(),
+        DeadLoads::default(),
+        None,
+    )
+    .unwrap();
     let choice = ModelChoice::for_rod(&rod);
     assert_eq!(choice.level, ModelLevel::Kirchhoff, "{}", choice.reason);
     for method in METHODS {
@@ -162,26 +165,24 @@ fn unloaded_rod_with_constant_intrinsic_curvature_is_a_helix() {
 /// multiple shooting find the same equilibrium.
 #[test]
 fn single_and_multiple_shooting_agree() {
-    let linear = LinearElastic::uniform([1.0, 1.5, 0.7], [0.8, 0.3, 1.2]);
+    let linear = LinearElastic::uniform([1.0, 1.5, 0.7], [0.8, 0.3, 1.2]).unwrap();
     let energies: Vec<Arc<dyn cosserat::model::StoredEnergy>> = vec![
         Arc::new(linear.clone()),
-        Arc::new(QuarticStiffening {
-            linear,
-            quartic: 0.5,
-        }),
+        Arc::new(QuarticStiffening::new(linear, 0.5).unwrap()),
     ];
     for energy in energies {
-        let rod = Rod {
-            length: 2.0,
+        let rod = Rod::new(
+            2.0,
             energy,
-            clamp: Clamp::paper(),
-            loads: DeadLoads {
+            Clamp::paper(),
+            DeadLoads {
                 tip_force: Vector3::new(0.6, 0.2, -0.1),
                 tip_couple: Vector3::new(0.0, 0.1, 0.2),
                 distributed_force: Vector3::new(0.3, 0.0, 0.0),
             },
-            support: None,
-        };
+            None,
+        )
+        .unwrap();
         let single = solve_with(&rod, ModelLevel::Kirchhoff, Method::Shooting);
         let multi = solve_with(&rod, ModelLevel::Kirchhoff, METHODS[1]);
         for (a, b) in single.samples.iter().zip(&multi.samples) {
@@ -242,16 +243,16 @@ fn single_shooting_fails_clearly_where_multiple_shooting_recovers() {
 fn tapered_cantilever_matches_linear_beam_theory() {
     use cosserat::model::Profile;
     let force = 1e-4;
-    let energy = LinearElastic {
-        stiffness: [
+    let energy = LinearElastic::new(
+        [
             Profile::Constant(10.0),
             Profile::Polynomial(vec![2.0, -1.0]),
             Profile::Constant(10.0),
         ],
-        intrinsic_curvature: Default::default(),
-    };
-    let mut rod = cantilever(force);
-    rod.energy = Arc::new(energy);
+        Default::default(),
+    )
+    .unwrap();
+    let rod = cantilever(force).with_energy(Arc::new(energy));
     let mut opts = SolverOptions::default();
     opts.newton.tolerance = 1e-14;
     let eq = solve(&rod, &ModelChoice::for_rod(&rod), &opts).unwrap();
@@ -268,19 +269,16 @@ fn tapered_cantilever_matches_linear_beam_theory() {
 fn tabulated_intrinsic_curvature_gives_its_intrinsic_shape() {
     use cosserat::model::Profile;
     let (knots, values) = ([0.0, 0.4, 1.0], [0.0, 3.0, -1.0]);
-    let energy = LinearElastic {
-        stiffness: [1.0, 1.0, 1.0].map(Profile::Constant),
-        intrinsic_curvature: [
+    let energy = LinearElastic::new(
+        [1.0, 1.0, 1.0].map(Profile::Constant),
+        [
             Profile::Constant(0.0),
-            Profile::Table {
-                s: knots.to_vec(),
-                values: values.to_vec(),
-            },
+            Profile::table(knots.to_vec(), values.to_vec()).unwrap(),
             Profile::Constant(0.0),
         ],
-    };
-    let mut rod = cantilever(0.0);
-    rod.energy = Arc::new(energy);
+    )
+    .unwrap();
+    let rod = cantilever(0.0).with_energy(Arc::new(energy));
     // φ(s) exactly: integral of the linear interpolant.
     let phi = |s: f64| {
         let mut acc = 0.0;
@@ -304,12 +302,26 @@ fn tabulated_intrinsic_curvature_gives_its_intrinsic_shape() {
     }
 }
 
-/// A singular energy Hessian (zero torsional stiffness, built in code where
-/// the problem-file checks do not apply) is a typed error naming the cause.
+/// A singular energy Hessian (a torsional stiffness B3 = 1 − 2s that
+/// vanishes at s = L/2, built in code where the problem-file checks do not
+/// apply) is a typed error naming the cause. A zero constant stiffness is
+/// refused when the energy is built.
 #[test]
 fn singular_energy_hessian_is_a_typed_error() {
-    let mut rod = cantilever(1.0);
-    rod.energy = Arc::new(LinearElastic::uniform([1.0, 1.0, 0.0], [0.0; 3]));
+    assert!(matches!(
+        LinearElastic::uniform([1.0, 1.0, 0.0], [0.0; 3]),
+        Err(cosserat::model::ModelError::Stiffness { index: 2, .. })
+    ));
+    let vanishing = LinearElastic::new(
+        [
+            cosserat::model::Profile::Constant(1.0),
+            cosserat::model::Profile::Constant(1.0),
+            cosserat::model::Profile::Polynomial(vec![1.0, -2.0]),
+        ],
+        Default::default(),
+    )
+    .unwrap();
+    let rod = cantilever(1.0).with_energy(Arc::new(vanishing));
     let err = solve(&rod, &ModelChoice::for_rod(&rod), &SolverOptions::default()).unwrap_err();
     assert!(matches!(err, cosserat::bvp::SolveError::Model(_)), "{err}");
     assert!(err.to_string().contains("not positive definite"), "{err}");

@@ -29,9 +29,9 @@ fn cantilever(length: f64, force: f64) -> Rod {
 /// A planar rod with intrinsic curvature κ⁰2 = `kappa` (B2 = 1), unloaded
 /// unless `force` ≠ 0.
 fn spiral(kappa: f64, force: f64) -> Rod {
-    let mut rod = cantilever(1.0, force);
-    rod.energy = Arc::new(LinearElastic::uniform([10.0, 1.0, 10.0], [0.0, kappa, 0.0]));
-    rod
+    cantilever(1.0, force).with_energy(Arc::new(
+        LinearElastic::uniform([10.0, 1.0, 10.0], [0.0, kappa, 0.0]).unwrap(),
+    ))
 }
 
 fn run(rod: &Rod, method: Method, strategy: Strategy) -> Result<Equilibrium, SolveError> {

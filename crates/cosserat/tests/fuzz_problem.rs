@@ -150,7 +150,7 @@ fn check(text: &str, overrides: &[String]) -> Result<(), TestCaseError> {
     match result {
         Ok(p) => {
             ACCEPTED.fetch_add(1, Ordering::Relaxed);
-            prop_assert!(p.rod.length.is_finite() && p.rod.length > 0.0);
+            prop_assert!(p.rod.length().is_finite() && p.rod.length() > 0.0);
             prop_assert!(p.options.output_points >= 2);
         }
         Err(e) => {

@@ -75,24 +75,22 @@ fn density(
 }
 
 fn energies() -> Vec<Arc<dyn StoredEnergy>> {
-    let linear = LinearElastic {
-        stiffness: [
+    let linear = LinearElastic::new(
+        [
             Profile::Constant(1.3),
             Profile::Polynomial(vec![2.0, -0.5]),
             Profile::Constant(0.8),
         ],
-        intrinsic_curvature: [
+        [
             Profile::Constant(0.4),
             Profile::Polynomial(vec![-0.3, 1.0]),
             Profile::Constant(0.9),
         ],
-    };
+    )
+    .unwrap();
     vec![
         Arc::new(linear.clone()),
-        Arc::new(QuarticStiffening {
-            linear,
-            quartic: 0.7,
-        }),
+        Arc::new(QuarticStiffening::new(linear, 0.7).unwrap()),
     ]
 }
 
@@ -124,17 +122,18 @@ fn form_is_the_second_derivative_of_the_exact_energy_density() {
 }
 
 fn helix_scene(energy: Arc<dyn StoredEnergy>) -> Rod {
-    Rod {
-        length: 1.5,
+    Rod::new(
+        1.5,
         energy,
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
+        Clamp::paper(),
+        DeadLoads {
             tip_force: Vector3::new(0.8, 0.3, -0.2),
             distributed_force: Vector3::new(0.4, 0.0, 0.1),
             ..Default::default()
         },
-        support: None,
-    }
+        None,
+    )
+    .unwrap()
 }
 
 fn solve_level(rod: &Rod, level: ModelLevel) -> Equilibrium {
@@ -149,7 +148,7 @@ fn assembled_matrix_is_the_hessian_of_the_discrete_potential() {
     for e in energies() {
         let rod = helix_scene(e.clone());
         let eq = solve_level(&rod, ModelLevel::Kirchhoff);
-        let fe = FiniteElements::new(rod.length, 6, 2);
+        let fe = FiniteElements::new(rod.length(), 6, 2);
         let samples = eq
             .resample(&rod, &SolverOptions::default(), &fe.quadrature_points())
             .unwrap();
@@ -309,22 +308,28 @@ fn zero_eigenvalue_is_where_the_shooting_jacobian_is_singular_on_straight_rods()
     assert!((by_block(Block::OutOfPlane) - out_of_plane).abs() <= 1e-8 * euler);
 
     // Timoshenko: κ⁰2(s) = −λF(L − s)/B2 keeps the rod straight under λF e1.
-    let ltb = |load: f64| Rod {
-        length: 1.0,
-        energy: Arc::new(LinearElastic {
-            stiffness: [1.0, 1.0, 1.0].map(Profile::Constant),
-            intrinsic_curvature: [
-                Profile::Constant(0.0),
-                Profile::Polynomial(vec![-load, load]),
-                Profile::Constant(0.0),
-            ],
-        }),
-        clamp: Clamp::paper(),
-        loads: DeadLoads {
-            tip_force: Vector3::new(load, 0.0, 0.0),
-            ..Default::default()
-        },
-        support: None,
+    let ltb = |load: f64| {
+        Rod::new(
+            1.0,
+            Arc::new(
+                LinearElastic::new(
+                    [1.0, 1.0, 1.0].map(Profile::Constant),
+                    [
+                        Profile::Constant(0.0),
+                        Profile::Polynomial(vec![-load, load]),
+                        Profile::Constant(0.0),
+                    ],
+                )
+                .unwrap(),
+            ),
+            Clamp::paper(),
+            DeadLoads {
+                tip_force: Vector3::new(load, 0.0, 0.0),
+                ..Default::default()
+            },
+            None,
+        )
+        .unwrap()
     };
     let det = |load: f64| {
         let r = ltb(load);

@@ -82,18 +82,19 @@ fn spatial_tip_is_exact_for_extreme_stiffness_ratios() {
 #[test]
 fn held_frame_is_not_met_by_the_flipped_frame() {
     let clamp = Clamp::paper();
-    let rod = Rod {
-        length: 1.0,
-        energy: Arc::new(LinearElastic::uniform([1.0, 1.0, 0.7], [0.0; 3])),
-        clamp: clamp.clone(),
-        loads: DeadLoads::default(),
-        support: Some(TipSupport {
+    let rod = Rod::new(
+        1.0,
+        Arc::new(LinearElastic::uniform([1.0, 1.0, 0.7], [0.0; 3]).unwrap()),
+        clamp.clone(),
+        DeadLoads::default(),
+        Some(TipSupport {
             position: clamp.position + clamp.director(2) * 0.8 + clamp.director(0) * 0.3,
             frame: clamp.frame,
             translation: Freedom::Fixed,
             rotation: Freedom::Fixed,
         }),
-    };
+    )
+    .unwrap();
     let model = ModelChoice::forced(&rod, cosserat::model::ModelLevel::Kirchhoff).unwrap();
     let mut converged = 0;
     for twist in [0.9 * PI, 0.97 * PI, PI, 1.03 * PI, 1.1 * PI] {
@@ -112,7 +113,7 @@ fn held_frame_is_not_met_by_the_flipped_frame() {
             converged += 1;
             let tip = eq.tip();
             let frame = Matrix3::from_columns(&tip.directors);
-            let turn = (frame - clamp.frame).amax();
+            let turn = (frame - *clamp.frame).amax();
             assert!(
                 turn <= 1e-8,
                 "start twist {twist}, {method:?}: the tip frame is off the held one by {turn:.2e} (κ3 = {})",
@@ -129,8 +130,7 @@ fn held_frame_is_not_met_by_the_flipped_frame() {
 /// The looped equilibrium that single shooting reaches when all the load of
 /// a long soft cantilever (L = 30, k = 2700) is applied at once.
 fn looped_equilibrium() -> (Rod, SolverOptions, cosserat::bvp::Equilibrium) {
-    let mut rod = cantilever(10.0, 10.0);
-    rod.length = 30.0;
+    let rod = cantilever(10.0, 10.0).with_length(30.0).unwrap();
     let model = ModelChoice::for_rod(&rod);
     let opts = SolverOptions {
         strategy: Strategy::Direct,

@@ -106,7 +106,7 @@ fn tip_quantities(
     scale: f64,
 ) -> BTreeMap<String, Option<f64>> {
     let tip = eq.tip();
-    let clamp = &problem.rod.clamp;
+    let clamp = &problem.rod.clamp();
     let d3 = tip.directors[2];
     let angle = d3.dot(&clamp.director(0)).atan2(d3.dot(&clamp.director(2)));
     let chord = (tip.position - clamp.position).norm();

@@ -156,16 +156,17 @@ mod tests {
     /// on the spatial equations of a loaded, intrinsically curved rod.
     #[test]
     fn sensitivity_matches_central_differences() {
-        let rod = Rod {
-            length: 1.0,
-            energy: Arc::new(LinearElastic::uniform([2.0, 1.0, 1.5], [0.3, -0.4, 0.7])),
-            clamp: Clamp::paper(),
-            loads: DeadLoads {
+        let rod = Rod::new(
+            1.0,
+            Arc::new(LinearElastic::uniform([2.0, 1.0, 1.5], [0.3, -0.4, 0.7]).unwrap()),
+            Clamp::paper(),
+            DeadLoads {
                 tip_force: Vector3::new(1.5, 0.4, -0.3),
                 ..Default::default()
             },
-            support: None,
-        };
+            None,
+        )
+        .unwrap();
         let eq = KirchhoffEquations::new(rod);
         let tab = Tableau::gauss(3).unwrap();
         let mut y0 = vec![0.0; 12];

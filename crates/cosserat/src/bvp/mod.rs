@@ -278,7 +278,7 @@ pub fn solve(
         ));
     }
     check_energy(rod)?;
-    if rod.clamp.hinge && model.level != ModelLevel::Planar {
+    if rod.clamp().hinge && model.level != ModelLevel::Planar {
         return Err(SolveError::Model(format!(
             "a hinged base (clamp.hinge) is implemented in the planar model only; this scene \
              runs the {} model ({})",
@@ -305,7 +305,7 @@ pub fn solve(
         }
     };
     let eq = equations(rod, model.level);
-    let points = output_grid(rod.length, opts.output_points);
+    let points = output_grid(rod.length(), opts.output_points);
     let drift_of = |samples: &[RodSample]| {
         samples
             .iter()
@@ -408,14 +408,14 @@ impl Solved {
 fn check_energy(rod: &Rod) -> Result<(), SolveError> {
     let kappa = nalgebra::Vector3::zeros();
     for i in 0..=64 {
-        let s = rod.length * i as f64 / 64.0;
-        let h = rod.energy.stiffness(s, &kappa);
+        let s = rod.length() * i as f64 / 64.0;
+        let h = rod.energy().stiffness(s, &kappa);
         let finite = h.iter().all(|v| v.is_finite());
         if !finite || h.cholesky().is_none() {
             return Err(SolveError::Model(format!(
                 "the Hessian of the {} energy is not positive definite at s = {s} \
                  (diagonal {:e}, {:e}, {:e}); check energy.stiffness and the energy's parameters",
-                rod.energy.name(),
+                rod.energy().name(),
                 h[(0, 0)],
                 h[(1, 1)],
                 h[(2, 2)]
@@ -527,9 +527,9 @@ fn guess_for_level(
 /// The loads' moment over the stiffness moment B_min/L: the size of the
 /// deflection in radians that linear theory predicts.
 fn load_ratio(rod: &Rod) -> f64 {
-    let h = rod.energy.stiffness(0.0, &nalgebra::Vector3::zeros());
+    let h = rod.energy().stiffness(0.0, &nalgebra::Vector3::zeros());
     let b_min = h.symmetric_eigenvalues().min();
-    rod.loads.moment_scale(rod.length) * rod.length / b_min
+    rod.loads().moment_scale(rod.length()) * rod.length() / b_min
 }
 
 /// Natural-parameter continuation in a load factor λ from 0 to 1, each step
@@ -561,7 +561,10 @@ fn ramp(
     };
     while step >= 1e-4 && steps < 400 {
         let target = (lambda + step).min(1.0);
-        let scaled = rod.with_load_factor(target);
+        // λ ≤ 1 scales finite loads: never refused.
+        let scaled = rod
+            .with_load_factor(target)
+            .map_err(|e| SolveError::Model(e.to_string()))?;
         match solve_at(&scaled, level, &step_opts, x.as_ref(), stats) {
             Ok(solved) if solved.clean(RAMP_CONTRACTION) => {
                 steps += 1;

@@ -191,7 +191,12 @@ impl<'a> Run<'a> {
     ) -> Result<Point, ContinuationError> {
         let tip = spectrum.tip.clone();
         let tip_angle = tip_angle(
-            &self.family.rod_at(p).map_err(PointError::from)?.clamp.frame,
+            &self
+                .family
+                .rod_at(p)
+                .map_err(PointError::from)?
+                .clamp()
+                .frame,
             &tip,
         );
         Ok(Point {

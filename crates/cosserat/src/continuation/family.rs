@@ -226,7 +226,7 @@ impl Family {
 
     /// The length of the base rod (the problem's `rod.length`).
     pub fn base_length(&self) -> f64 {
-        self.base.length
+        self.base.length()
     }
 
     /// The model level.
@@ -250,38 +250,57 @@ impl Family {
             return Err(bad());
         }
         match self.parameter {
-            Parameter::LoadScale => rod.loads = self.base.loads.scaled(p),
+            Parameter::LoadScale => {
+                rod = rod
+                    .with_loads(self.base.loads().scaled(p))
+                    .map_err(|_| bad())?
+            }
             Parameter::ControlScale => {
-                rod.loads = self.base.loads.scaled(p);
-                rod.energy = self
-                    .base
-                    .energy
-                    .with_intrinsic_scaled(p)
-                    .ok_or(FamilyError::NotConstant(self.parameter))?;
+                rod = rod
+                    .with_loads(self.base.loads().scaled(p))
+                    .map_err(|_| bad())?;
+                rod = rod.with_energy(
+                    self.base
+                        .energy()
+                        .with_intrinsic_scaled(p)
+                        .ok_or(FamilyError::NotConstant(self.parameter))?,
+                );
             }
             Parameter::CurvatureTowards => {
-                rod.loads = self.base.loads.scaled(p);
-                rod.energy = self
-                    .target
-                    .as_ref()
-                    .and_then(|t| self.base.energy.with_intrinsic_towards(t.as_ref(), p))
-                    .ok_or(FamilyError::NotConstant(self.parameter))?;
+                rod = rod
+                    .with_loads(self.base.loads().scaled(p))
+                    .map_err(|_| bad())?;
+                rod = rod.with_energy(
+                    self.target
+                        .as_ref()
+                        .and_then(|t| self.base.energy().with_intrinsic_towards(t.as_ref(), p))
+                        .ok_or(FamilyError::NotConstant(self.parameter))?,
+                );
             }
-            Parameter::TipForce(i) => rod.loads.tip_force[i] = p,
-            Parameter::TipCouple(i) => rod.loads.tip_couple[i] = p,
-            Parameter::DistributedForce(i) => rod.loads.distributed_force[i] = p,
+            Parameter::TipForce(_) | Parameter::TipCouple(_) | Parameter::DistributedForce(_) => {
+                let mut loads = self.base.loads().clone();
+                match self.parameter {
+                    Parameter::TipForce(i) => loads.tip_force[i] = p,
+                    Parameter::TipCouple(i) => loads.tip_couple[i] = p,
+                    Parameter::DistributedForce(i) => loads.distributed_force[i] = p,
+                    _ => unreachable!("only load components"),
+                }
+                rod = rod.with_loads(loads).map_err(|_| bad())?;
+            }
             Parameter::Length => {
                 if p <= 0.0 {
                     return Err(bad());
                 }
-                rod.length = p;
+                rod = rod.with_length(p).map_err(|_| bad())?;
             }
             Parameter::ClampAngle => {
                 // About d2 by +p: d3 turns towards d1 (R d3 = d3 cos p + d1 sin p).
-                rod.clamp.frame = self.base.clamp.turned_frame(p);
+                let mut clamp = self.base.clamp().clone();
+                clamp.frame = clamp.turned_frame(p).map_err(|_| bad())?;
+                rod = rod.with_clamp(clamp).map_err(|_| bad())?;
             }
             Parameter::Stiffness(_) | Parameter::IntrinsicCurvature(_) => {
-                rod.energy = self.linear_with(p)?;
+                rod = rod.with_energy(self.linear_with(p)?);
             }
         }
         Ok(rod)
@@ -308,7 +327,7 @@ impl Family {
             _ => unreachable!("only profile parameters"),
         };
         self.base
-            .energy
+            .energy()
             .with_constant(kind, i, p)
             .ok_or(FamilyError::NotConstant(self.parameter))
     }
@@ -404,7 +423,7 @@ impl Family {
 
     /// The tip sample (position, directors) at (x, p).
     pub fn tip(&self, x: &[f64], p: f64) -> Result<RodSample, PointError> {
-        let l = self.rod_at(p)?.length;
+        let l = self.rod_at(p)?.length();
         Ok(self.samples(x, p, &[l])?.remove(0))
     }
 }

@@ -49,11 +49,7 @@ impl Default for ContinuationOptions {
             both_directions: false,
             switch_depth: 1,
             tip_angle_limit: None,
-            stability: StabilityOptions {
-                elements: 40,
-                order: 2,
-                eigenvalues: 4,
-            },
+            stability: StabilityOptions::default(),
             tolerance: 1e-11,
             event_tolerance: 1e-11,
         }

@@ -103,12 +103,12 @@ impl Tracker {
         self.opts
             .check()
             .map_err(|e| PointError::Eigen(e.to_string()))?;
-        let fe = FiniteElements::new(rod.length, self.opts.elements, self.opts.order)
-            .with_hinged_base(rod.clamp.hinge);
+        let fe = FiniteElements::new(rod.length(), self.opts.elements, self.opts.order)
+            .with_hinged_base(rod.clamp().hinge);
         // One integration for the quadrature points and the 21 shape points
         // (the last is the tip).
         let quadrature = fe.quadrature_points();
-        let grid: Vec<f64> = (0..21).map(|i| rod.length * i as f64 / 20.0).collect();
+        let grid: Vec<f64> = (0..21).map(|i| rod.length() * i as f64 / 20.0).collect();
         let mut all: Vec<(f64, bool)> = quadrature
             .iter()
             .map(|&s| (s, true))

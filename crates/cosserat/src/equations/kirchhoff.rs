@@ -95,20 +95,20 @@ impl KirchhoffEquations {
     /// stiffnesses S (Kirchhoff when the energy has none).
     pub fn cosserat(rod: Rod) -> Self {
         let compliance = rod
-            .energy
+            .energy()
             .shear_stiffness(0.0)
             .map_or_else(Vector3::zeros, |s| s.map(|v| 1.0 / v));
         KirchhoffEquations { rod, compliance }
     }
 
     fn balance(&self, s: f64, st: &State) -> Balance {
-        let e = &self.rod.energy;
+        let e = &self.rod.energy();
         let h = e.stiffness(s, &st.kappa);
         let h_inv = h
             .try_inverse()
             .unwrap_or_else(|| Matrix3::from_element(f64::NAN));
         let m = e.moment(s, &st.kappa);
-        let n = self.rod.loads.internal_force(s, self.rod.length) + st.reaction;
+        let n = self.rod.loads().internal_force(s, self.rod.length()) + st.reaction;
         let body_n = Vector3::new(n.dot(&st.d1), n.dot(&st.d2), n.dot(&st.d3));
         let nu = Vector3::z() + self.compliance.component_mul(&body_n);
         let q = m.cross(&st.kappa) + body_n.cross(&nu);
@@ -127,7 +127,7 @@ impl KirchhoffEquations {
     /// is carried as three constant states (R' = 0) with R(0) unknown.
     fn reacts(&self) -> bool {
         self.rod
-            .support
+            .support()
             .as_ref()
             .is_some_and(|s| s.holds_position())
     }
@@ -149,14 +149,14 @@ impl KirchhoffEquations {
     /// The residuals and Jacobian of a supported tip ([`super::tip`]).
     fn supported_tip(&self, support: &TipSupport, y: &[f64]) -> (Vec<f64>, DMatrix<f64>) {
         let st = State::read(y);
-        let l = self.rod.length;
+        let l = self.rod.length();
         let tip = TipState {
             d: [st.d1, st.d2, st.d3],
             r: Vector3::new(y[9], y[10], y[11]),
-            m: self.rod.energy.moment(l, &st.kappa),
-            h: self.rod.energy.stiffness(l, &st.kappa),
+            m: self.rod.energy().moment(l, &st.kappa),
+            h: self.rod.energy().stiffness(l, &st.kappa),
             reaction: st.reaction,
-            couple: &self.rod.loads.tip_couple,
+            couple: &self.rod.loads().tip_couple,
         };
         conditions(support, &tip, &self.rod.residual_scales(), self.dim())
     }
@@ -176,11 +176,11 @@ impl RodEquations for KirchhoffEquations {
     }
 
     fn length(&self) -> f64 {
-        self.rod.length
+        self.rod.length()
     }
 
     fn initial_state(&self, u: &[f64], y0: &mut [f64]) {
-        let c = &self.rod.clamp;
+        let c = &self.rod.clamp();
         y0[0..3].copy_from_slice(c.director(0).as_slice());
         y0[3..6].copy_from_slice(c.director(1).as_slice());
         y0[6..9].copy_from_slice(&u[..3]);
@@ -225,7 +225,7 @@ impl RodEquations for KirchhoffEquations {
         let b = self.balance(s, &st);
         Self::write_rates(&st, &b, dy);
         let body_n = Vector3::new(b.n.dot(&st.d1), b.n.dot(&st.d2), b.n.dot(&st.d3));
-        let e = &self.rod.energy;
+        let e = &self.rod.energy();
         let k = st.kappa;
         let kappa_jac = e.stiffness_rate(s, &k) + e.stiffness_derivative(s, &k, &b.rate);
         let n = self.dim();
@@ -266,13 +266,13 @@ impl RodEquations for KirchhoffEquations {
     }
 
     fn tip_residual(&self, y: &[f64], r: &mut [f64]) {
-        if let Some(support) = &self.rod.support {
+        if let Some(support) = &self.rod.support() {
             r.copy_from_slice(&self.supported_tip(support, y).0);
             return;
         }
         let st = State::read(y);
-        let m = self.rod.energy.moment(self.rod.length, &st.kappa);
-        let c = self.rod.loads.tip_couple;
+        let m = self.rod.energy().moment(self.rod.length(), &st.kappa);
+        let c = self.rod.loads().tip_couple;
         let unit = self.rod.residual_scales().moment;
         r[0] = (m[0] - c.dot(&st.d1)) / unit[0];
         r[1] = (m[1] - c.dot(&st.d2)) / unit[1];
@@ -281,12 +281,12 @@ impl RodEquations for KirchhoffEquations {
 
     /// ∂/∂κ = H(L); ∂(C·d3)/∂d1 = d2 × C, ∂(C·d3)/∂d2 = C × d1.
     fn tip_residual_jacobian(&self, y: &[f64]) -> DMatrix<f64> {
-        if let Some(support) = &self.rod.support {
+        if let Some(support) = &self.rod.support() {
             return self.supported_tip(support, y).1;
         }
         let st = State::read(y);
-        let c = self.rod.loads.tip_couple;
-        let h = self.rod.energy.stiffness(self.rod.length, &st.kappa);
+        let c = self.rod.loads().tip_couple;
+        let h = self.rod.energy().stiffness(self.rod.length(), &st.kappa);
         let mut g = DMatrix::zeros(3, 12);
         for j in 0..3 {
             g[(0, j)] = -c[j];
@@ -321,8 +321,8 @@ impl RodEquations for KirchhoffEquations {
     /// M(0) balancing the loads on the straight rod, in body components at
     /// the clamp, then κ(0) from ∇W(0, κ) = M(0) by Newton from κ = 0.
     fn initial_guess(&self) -> Vec<f64> {
-        let m = self.rod.clamp.frame.transpose() * straight_rod_clamp_moment(&self.rod);
-        let e = &self.rod.energy;
+        let m = self.rod.clamp().frame.transpose() * straight_rod_clamp_moment(&self.rod);
+        let e = self.rod.energy();
         let mut k = [0.0; 3];
         let mut system = ClampCurvature {
             energy: e.as_ref(),
@@ -359,13 +359,13 @@ impl RodEquations for KirchhoffEquations {
             position: Vector3::new(y[9], y[10], y[11]),
             directors: [st.d1, st.d2, st.d3],
             curvature: st.kappa,
-            moment: self.rod.energy.moment(s, &st.kappa),
-            force: self.rod.loads.internal_force(s, self.rod.length) + st.reaction,
+            moment: self.rod.energy().moment(s, &st.kappa),
+            force: self.rod.loads().internal_force(s, self.rod.length()) + st.reaction,
         }
     }
 
     fn straight_state(&self, s: f64) -> Vec<f64> {
-        let c = &self.rod.clamp;
+        let c = &self.rod.clamp();
         let mut y = vec![0.0; self.dim()];
         self.initial_state(&vec![0.0; self.unknowns()], &mut y);
         let r = c.position + c.director(2) * s;
@@ -374,7 +374,7 @@ impl RodEquations for KirchhoffEquations {
     }
 
     fn state_scales(&self) -> Vec<f64> {
-        let l = self.rod.length;
+        let l = self.rod.length();
         let mut scales = vec![1.0; self.dim()];
         scales[6..9].fill(1.0 / l);
         scales[9..12].fill(l);

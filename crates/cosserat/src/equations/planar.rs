@@ -47,7 +47,7 @@ impl PlanarEquations {
     /// Whether the support holds the tip's position (reaction states).
     fn reacts(&self) -> bool {
         self.rod
-            .support
+            .support()
             .as_ref()
             .is_some_and(|s| s.holds_position())
     }
@@ -55,15 +55,15 @@ impl PlanarEquations {
     /// (n_x, n_z): the internal force in the clamp frame's plane, with the
     /// reaction of a held tip.
     fn force_in_plane(&self, s: f64, y: &[f64]) -> (f64, f64) {
-        let n = self.rod.loads.internal_force(s, self.rod.length);
+        let n = self.rod.loads().internal_force(s, self.rod.length());
         let (rx, rz) = if y.len() > 4 {
             (y[4], y[5])
         } else {
             (0.0, 0.0)
         };
         (
-            n.dot(&self.rod.clamp.director(0)) + rx,
-            n.dot(&self.rod.clamp.director(2)) + rz,
+            n.dot(&self.rod.clamp().director(0)) + rx,
+            n.dot(&self.rod.clamp().director(2)) + rz,
         )
     }
 
@@ -71,7 +71,7 @@ impl PlanarEquations {
     /// (−cos φ, sin φ)/H22.
     fn curvature_rate(&self, s: f64, y: &[f64]) -> (f64, f64, f64) {
         let (phi, k2) = (y[2], y[3]);
-        let e = &self.rod.energy;
+        let e = &self.rod.energy();
         let kappa = Self::kappa(k2);
         let (nx, nz) = self.force_in_plane(s, y);
         let (sin, cos) = phi.sin_cos();
@@ -89,7 +89,7 @@ impl PlanarEquations {
     /// κ2(0) at a hinged base: the root of ∂W/∂κ2(0, κ2) = 0 (κ⁰2(0) for
     /// the linear energy), by Newton from κ2 = 0.
     fn hinge_curvature(&self) -> f64 {
-        let e = &self.rod.energy;
+        let e = &self.rod.energy();
         crate::numerics::scalar::newton(0.0, 50, 1e-15, |k2| {
             let kappa = Self::kappa(k2);
             e.moment(0.0, &kappa)[1] / e.stiffness(0.0, &kappa)[(1, 1)]
@@ -104,9 +104,9 @@ impl PlanarEquations {
     /// axes in the plane or, for rotation, along d2 (then free in-plane).
     fn supported_tip(&self, support: &TipSupport, y: &[f64]) -> (Vec<f64>, DMatrix<f64>) {
         let n = self.dim();
-        let l = self.rod.length;
+        let l = self.rod.length();
         let scales = self.rod.residual_scales();
-        let c = &self.rod.clamp;
+        let c = &self.rod.clamp();
         let (ex, ez) = (c.director(0), c.director(2));
         let target = support.position - c.position;
         let (px, pz) = (target.dot(&ex), target.dot(&ez));
@@ -141,10 +141,10 @@ impl PlanarEquations {
             }
             Freedom::Free | Freedom::Axial(_) => {
                 let kappa = Self::kappa(y[3]);
-                let e = &self.rod.energy;
+                let e = &self.rod.energy();
                 let m = scales.moment[1];
                 r.push(
-                    (e.moment(l, &kappa)[1] - self.rod.loads.tip_couple.dot(&c.director(1))) / m,
+                    (e.moment(l, &kappa)[1] - self.rod.loads().tip_couple.dot(&c.director(1))) / m,
                 );
                 g[(row, 3)] = e.stiffness(l, &kappa)[(1, 1)] / m;
             }
@@ -168,13 +168,13 @@ impl RodEquations for PlanarEquations {
     }
 
     fn length(&self) -> f64 {
-        self.rod.length
+        self.rod.length()
     }
 
     fn initial_state(&self, u: &[f64], y0: &mut [f64]) {
         y0[..3].fill(0.0);
         y0[3..].copy_from_slice(u);
-        if self.rod.clamp.hinge {
+        if self.rod.clamp().hinge {
             y0[2] = u[0];
             y0[3] = self.hinge_curvature();
         }
@@ -182,7 +182,7 @@ impl RodEquations for PlanarEquations {
 
     fn initial_sensitivity(&self) -> DMatrix<f64> {
         let n = self.dim();
-        let first = if self.rod.clamp.hinge { 2 } else { 3 };
+        let first = if self.rod.clamp().hinge { 2 } else { 3 };
         DMatrix::from_fn(n, n - 3, |i, j| {
             let row = if j == 0 { first } else { j + 3 };
             if i == row {
@@ -216,7 +216,7 @@ impl RodEquations for PlanarEquations {
         dy[..4].copy_from_slice(&[sin, cos, y[3], rate]);
         dy[4..].fill(0.0);
         let n = self.dim();
-        let h22 = self.rod.energy.stiffness(s, &Self::kappa(y[3]))[(1, 1)];
+        let h22 = self.rod.energy().stiffness(s, &Self::kappa(y[3]))[(1, 1)];
         for c in 0..cols {
             let v = &phi[n * c..n * (c + 1)];
             let out = &mut dphi[n * c..n * (c + 1)];
@@ -232,23 +232,32 @@ impl RodEquations for PlanarEquations {
     }
 
     fn tip_residual(&self, y: &[f64], r: &mut [f64]) {
-        if let Some(support) = &self.rod.support {
+        if let Some(support) = &self.rod.support() {
             r.copy_from_slice(&self.supported_tip(support, y).0);
             return;
         }
-        let m2 = self.rod.energy.moment(self.rod.length, &Self::kappa(y[3]))[1];
+        let m2 = self
+            .rod
+            .energy()
+            .moment(self.rod.length(), &Self::kappa(y[3]))[1];
         let unit = self.rod.residual_scales().moment[1];
-        r[0] = (m2 - self.rod.loads.tip_couple.dot(&self.rod.clamp.director(1))) / unit;
+        r[0] = (m2
+            - self
+                .rod
+                .loads()
+                .tip_couple
+                .dot(&self.rod.clamp().director(1)))
+            / unit;
     }
 
     fn tip_residual_jacobian(&self, y: &[f64]) -> DMatrix<f64> {
-        if let Some(support) = &self.rod.support {
+        if let Some(support) = &self.rod.support() {
             return self.supported_tip(support, y).1;
         }
         let h22 = self
             .rod
-            .energy
-            .stiffness(self.rod.length, &Self::kappa(y[3]))[(1, 1)];
+            .energy()
+            .stiffness(self.rod.length(), &Self::kappa(y[3]))[(1, 1)];
         let unit = self.rod.residual_scales().moment[1];
         DMatrix::from_row_slice(1, 4, &[0.0, 0.0, 0.0, h22 / unit])
     }
@@ -260,27 +269,27 @@ impl RodEquations for PlanarEquations {
     /// Newton on ∂W/∂κ2 = M2.
     fn initial_guess(&self) -> Vec<f64> {
         let m = straight_rod_clamp_moment(&self.rod);
-        let m2 = m.dot(&self.rod.clamp.director(1));
-        let e = &self.rod.energy;
+        let m2 = m.dot(&self.rod.clamp().director(1));
+        let e = &self.rod.energy();
         let k2 = crate::numerics::scalar::newton(0.0, 50, 1e-14, |k2| {
             let kappa = Self::kappa(k2);
             (e.moment(0.0, &kappa)[1] - m2) / e.stiffness(0.0, &kappa)[(1, 1)]
         });
-        let mut u = vec![if self.rod.clamp.hinge { 0.0 } else { k2 }];
+        let mut u = vec![if self.rod.clamp().hinge { 0.0 } else { k2 }];
         u.resize(self.unknowns(), 0.0);
         u
     }
 
     fn unknowns_of(&self, y0: &[f64]) -> Vec<f64> {
         let mut u = y0[3..].to_vec();
-        if self.rod.clamp.hinge {
+        if self.rod.clamp().hinge {
             u[0] = y0[2];
         }
         u
     }
 
     fn sample(&self, s: f64, y: &[f64]) -> RodSample {
-        let c = &self.rod.clamp;
+        let c = &self.rod.clamp();
         let (ex, ey, ez) = (c.director(0), c.director(1), c.director(2));
         let (sin, cos) = y[2].sin_cos();
         let kappa = Self::kappa(y[3]);
@@ -289,8 +298,8 @@ impl RodEquations for PlanarEquations {
             position: c.position + ex * y[0] + ez * y[1],
             directors: [ex * cos - ez * sin, ey, ex * sin + ez * cos],
             curvature: kappa,
-            moment: self.rod.energy.moment(s, &kappa),
-            force: self.rod.loads.internal_force(s, self.rod.length)
+            moment: self.rod.energy().moment(s, &kappa),
+            force: self.rod.loads().internal_force(s, self.rod.length())
                 + if y.len() > 4 {
                     ex * y[4] + ez * y[5]
                 } else {
@@ -306,7 +315,7 @@ impl RodEquations for PlanarEquations {
     }
 
     fn state_scales(&self) -> Vec<f64> {
-        let l = self.rod.length;
+        let l = self.rod.length();
         let mut scales = vec![l, l, 1.0, 1.0 / l];
         scales.resize(self.dim(), self.rod.residual_scales().force);
         scales
@@ -316,9 +325,9 @@ impl RodEquations for PlanarEquations {
 /// The moment at the clamp, m(0) = C + (r(L) − r(0)) × P + ∫ (r − r(0)) × f,
 /// on the straight rod r(s) = r(0) + s d3(0) (global components).
 pub(crate) fn straight_rod_clamp_moment(rod: &Rod) -> Vector3<f64> {
-    let t = rod.clamp.director(2);
-    let l = rod.length;
-    let loads = &rod.loads;
+    let t = rod.clamp().director(2);
+    let l = rod.length();
+    let loads = &rod.loads();
     loads.tip_couple
         + (t * l).cross(&loads.tip_force)
         + (t * (0.5 * l * l)).cross(&loads.distributed_force)

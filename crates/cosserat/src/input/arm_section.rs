@@ -64,7 +64,7 @@ fn default_true() -> bool {
 
 /// Both loads point down (e1) or are absent, with no tip couple.
 fn downward(rod: &Rod) -> Result<(f64, f64), ProblemError> {
-    let l = &rod.loads;
+    let l = &rod.loads();
     let down = |v: &nalgebra::Vector3<f64>| v[1] == 0.0 && v[2] == 0.0 && v[0] >= 0.0;
     if !(down(&l.tip_force) && down(&l.distributed_force) && l.tip_couple.norm() == 0.0) {
         return Err(invalid(
@@ -134,7 +134,7 @@ impl ArmSection {
     /// distributed force, or both in the ratio w = qL/F) and actuator limit.
     pub fn scene(&self, rod: &Rod) -> Result<ArmScene, ProblemError> {
         let (tip, weight) = downward(rod)?;
-        let ratio = weight * rod.length / tip;
+        let ratio = weight * rod.length() / tip;
         let weight = match (tip > 0.0, weight > 0.0) {
             (true, false) => ArmWeight::Weightless,
             (true, true) if ratio.is_finite() => ArmWeight::WithTipLoad(ratio),
@@ -162,11 +162,11 @@ impl ArmSection {
 
     /// The arm problem of `rod` (constant stiffness) and the search options.
     pub fn build(&self, rod: &Rod) -> Result<(ArmProblem, SearchOptions, bool), ProblemError> {
-        let h = rod.energy.stiffness(0.0, &nalgebra::Vector3::zeros());
-        let constant = rod.energy.is_quadratic()
+        let h = rod.energy().stiffness(0.0, &nalgebra::Vector3::zeros());
+        let constant = rod.energy().is_quadratic()
             && [0.5, 1.0].iter().all(|s| {
-                rod.energy
-                    .stiffness(s * rod.length, &nalgebra::Vector3::zeros())
+                rod.energy()
+                    .stiffness(s * rod.length(), &nalgebra::Vector3::zeros())
                     == h
             });
         if !constant {

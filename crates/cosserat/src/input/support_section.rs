@@ -10,11 +10,11 @@
 //! | guided clamp (slides along `axis`) | `"axial"` | `"fixed"` |
 //! | Greenhill's end: slides along and spins about `axis` | `"axial"` | `"axial"` |
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Vector3;
 use serde::{Deserialize, Serialize};
 
 use super::problem::{invalid, ProblemError};
-use crate::model::{Clamp, Freedom, TipSupport};
+use crate::model::{Clamp, Frame, Freedom, TipSupport};
 
 /// `[support]`.
 #[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
@@ -122,7 +122,7 @@ impl SupportSection {
     }
 
     /// The held tip frame from `d1`, `d3` (each defaulting to the clamp's).
-    fn frame(&self, clamp: &Clamp) -> Result<Matrix3<f64>, ProblemError> {
+    fn frame(&self, clamp: &Clamp) -> Result<Frame, ProblemError> {
         let d1 = match self.d1 {
             Some(v) => unit("support.d1", v)?,
             None => clamp.director(0),
@@ -137,6 +137,8 @@ impl SupportSection {
                 format!("must be orthogonal to support.d1, d1·d3 = {}", d1.dot(&d3)),
             ));
         }
-        Ok(Matrix3::from_columns(&[d1, d3.cross(&d1), d3]))
+        // Unit and orthogonal to 1e-9 above, so within Frame::TOLERANCE; a
+        // frame refused all the same is named by its directors.
+        Frame::from_directors(d1, d3).map_err(|e| invalid("support.d3", e.to_string()))
     }
 }

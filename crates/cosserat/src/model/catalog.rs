@@ -10,7 +10,7 @@
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
-use super::{LinearElastic, Profile, QuarticStiffening, StoredEnergy};
+use super::{LinearElastic, ModelError, Profile, QuarticStiffening, StoredEnergy};
 
 /// The `[energy]` table of a problem file, validated.
 #[derive(Debug, Clone, PartialEq)]
@@ -33,13 +33,31 @@ pub struct EnergySpecError {
     pub message: String,
 }
 
-impl EnergySpec {
-    /// The linear-elastic energy of the profiles (paper (17)).
-    pub fn linear(&self) -> LinearElastic {
-        LinearElastic {
-            stiffness: self.stiffness.clone(),
-            intrinsic_curvature: self.intrinsic_curvature.clone(),
+impl From<ModelError> for EnergySpecError {
+    /// The `[energy]` field a refused model value comes from.
+    fn from(e: ModelError) -> Self {
+        let field = match &e {
+            ModelError::Stiffness { index, .. } => format!("energy.stiffness[{index}]"),
+            ModelError::IntrinsicCurvature { index } => {
+                format!("energy.intrinsic_curvature[{index}]")
+            }
+            ModelError::Coefficient { .. } => "energy.parameters.quartic".into(),
+            _ => "energy".into(),
+        };
+        EnergySpecError {
+            field,
+            message: e.to_string(),
         }
+    }
+}
+
+impl EnergySpec {
+    /// The linear-elastic energy of the profiles (paper (17)); a refusal
+    /// of [`LinearElastic::new`] names its profile
+    /// (`energy.stiffness[i]`, `energy.intrinsic_curvature[i]`).
+    pub fn linear(&self) -> Result<LinearElastic, EnergySpecError> {
+        LinearElastic::new(self.stiffness.clone(), self.intrinsic_curvature.clone())
+            .map_err(EnergySpecError::from)
     }
 
     /// A required parameter.
@@ -104,7 +122,7 @@ impl EnergyCatalog {
         };
         c.register("linear", |spec| {
             spec.only(&[])?;
-            Ok(Arc::new(spec.linear()))
+            Ok(Arc::new(spec.linear()?))
         });
         c.register("quartic", |spec| {
             spec.only(&["quartic"])?;
@@ -115,10 +133,7 @@ impl EnergyCatalog {
                     message: format!("must be ≥ 0, got {quartic}"),
                 });
             }
-            Ok(Arc::new(QuarticStiffening {
-                linear: spec.linear(),
-                quartic,
-            }))
+            Ok(Arc::new(QuarticStiffening::new(spec.linear()?, quartic)?))
         });
         c
     }
@@ -148,5 +163,40 @@ impl EnergyCatalog {
         spec: &EnergySpec,
     ) -> Option<Result<Arc<dyn StoredEnergy>, EnergySpecError>> {
         self.builders.get(name).map(|b| b(spec))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A refusal of a checked constructor reaches the problem reader under
+    /// the key of the value refused.
+    #[test]
+    fn refused_energies_name_their_key() {
+        let spec = EnergySpec {
+            stiffness: [1.0, -2.0, 1.0].map(Profile::Constant),
+            intrinsic_curvature: Default::default(),
+            parameters: BTreeMap::new(),
+        };
+        let catalog = EnergyCatalog::standard();
+        let err = catalog.build("linear", &spec).unwrap().unwrap_err();
+        assert_eq!(err.field, "energy.stiffness[1]");
+        assert!(err.message.contains("B2"), "{}", err.message);
+        let spec = EnergySpec {
+            stiffness: [1.0; 3].map(Profile::Constant),
+            intrinsic_curvature: [0.0, 0.0, f64::NAN].map(Profile::Constant),
+            parameters: BTreeMap::from([("quartic".to_owned(), 0.5)]),
+        };
+        let err = catalog.build("quartic", &spec).unwrap().unwrap_err();
+        assert_eq!(err.field, "energy.intrinsic_curvature[2]");
+        let ok = EnergySpec {
+            intrinsic_curvature: Default::default(),
+            ..spec
+        };
+        assert_eq!(
+            catalog.build("quartic", &ok).unwrap().unwrap().name(),
+            "quartic"
+        );
     }
 }

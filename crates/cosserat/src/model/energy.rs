@@ -15,6 +15,7 @@
 use nalgebra::{Matrix3, Vector3};
 
 use super::profile::Profile;
+use super::ModelError;
 
 /// A stored energy density per unit reference length, W(s, κ) ≥ 0, C² in κ
 /// with positive definite Hessian.
@@ -65,7 +66,9 @@ pub trait StoredEnergy: std::fmt::Debug + Send + Sync {
     /// stiffness B_i or the intrinsic curvature κ⁰_i, for energies that
     /// have it as a separate profile and where that profile is a constant
     /// (None otherwise: replacing a varying profile by a number would
-    /// change the rod silently). Every other part of the material (the
+    /// change the rod silently), and None when the material's own checked
+    /// constructor refuses the value (a non-finite number, a non-positive
+    /// stiffness). Every other part of the material (the
     /// other profiles, a shear and extension part) is kept. Continuation
     /// in `energy.stiffness[i]` or `energy.intrinsic_curvature[i]`.
     fn with_constant(
@@ -99,21 +102,64 @@ pub enum ProfileKind {
 
 /// The linear-elastic energy with intrinsic curvature,
 /// W = ½ Σ B_i(s) (κ_i − κ⁰_i(s))² (paper eq. (17) with B_i varying in s).
+/// Built by the checked [`LinearElastic::new`]; the profiles are read
+/// through [`LinearElastic::stiffness_profiles`] and
+/// [`LinearElastic::intrinsic_curvature`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct LinearElastic {
-    /// Bending stiffnesses B1, B2 and torsional stiffness B3 (N·m²).
-    pub stiffness: [Profile; 3],
-    /// Intrinsic curvature κ⁰ in body components (1/m).
-    pub intrinsic_curvature: [Profile; 3],
+    stiffness: [Profile; 3],
+    intrinsic_curvature: [Profile; 3],
 }
 
 impl LinearElastic {
-    /// A prismatic rod with constant stiffness and intrinsic curvature.
-    pub fn uniform(b: [f64; 3], kappa0: [f64; 3]) -> Self {
-        LinearElastic {
-            stiffness: b.map(Profile::Constant),
-            intrinsic_curvature: kappa0.map(Profile::Constant),
+    /// The energy of the stiffness profiles B1, B2 (bending), B3 (torsion)
+    /// (N·m²) and the intrinsic curvature κ⁰ in body components (1/m).
+    /// Refused with [`ModelError::Stiffness`] when a profile holds a
+    /// non-finite number or a constant stiffness is not positive (H =
+    /// diag(B) must be positive definite). A varying stiffness (table,
+    /// polynomial, spline) is positive only on some interval, which the
+    /// energy does not know: the problem reader certifies it positive on
+    /// [0, L] ([`Profile::extremes_on`]), and a solve refuses a Hessian
+    /// that is not positive definite along the rod.
+    pub fn new(
+        stiffness: [Profile; 3],
+        intrinsic_curvature: [Profile; 3],
+    ) -> Result<Self, ModelError> {
+        for (index, b) in stiffness.iter().enumerate() {
+            let refused = |value| ModelError::Stiffness {
+                what: "bending/torsional stiffness B",
+                index,
+                value,
+            };
+            match b {
+                _ if !b.is_finite() => return Err(refused(f64::NAN)),
+                Profile::Constant(c) if *c <= 0.0 => return Err(refused(*c)),
+                _ => {}
+            }
         }
+        if let Some(index) = intrinsic_curvature.iter().position(|k| !k.is_finite()) {
+            return Err(ModelError::IntrinsicCurvature { index });
+        }
+        Ok(LinearElastic {
+            stiffness,
+            intrinsic_curvature,
+        })
+    }
+
+    /// A prismatic rod with constant stiffness B (positive) and intrinsic
+    /// curvature κ⁰; refused as in [`LinearElastic::new`].
+    pub fn uniform(b: [f64; 3], kappa0: [f64; 3]) -> Result<Self, ModelError> {
+        LinearElastic::new(b.map(Profile::Constant), kappa0.map(Profile::Constant))
+    }
+
+    /// The stiffness profiles B1, B2, B3 (N·m²).
+    pub fn stiffness_profiles(&self) -> &[Profile; 3] {
+        &self.stiffness
+    }
+
+    /// The intrinsic curvature profiles κ⁰1, κ⁰2, κ⁰3 (1/m).
+    pub fn intrinsic_curvature(&self) -> &[Profile; 3] {
+        &self.intrinsic_curvature
     }
 
     fn b(&self, s: f64) -> Vector3<f64> {
@@ -200,21 +246,21 @@ impl StoredEnergy for LinearElastic {
     ) -> Option<std::sync::Arc<dyn StoredEnergy>> {
         let to = target.intrinsic_profiles()?;
         let [a, b, c] = &self.intrinsic_curvature;
-        Some(std::sync::Arc::new(LinearElastic {
-            stiffness: self.stiffness.clone(),
-            intrinsic_curvature: [
-                a.blend(&to[0], p)?,
-                b.blend(&to[1], p)?,
-                c.blend(&to[2], p)?,
-            ],
-        }))
+        let blended = [
+            a.blend(&to[0], p)?,
+            b.blend(&to[1], p)?,
+            c.blend(&to[2], p)?,
+        ];
+        Some(std::sync::Arc::new(
+            LinearElastic::new(self.stiffness.clone(), blended).ok()?,
+        ))
     }
 
     fn with_intrinsic_scaled(&self, factor: f64) -> Option<std::sync::Arc<dyn StoredEnergy>> {
-        Some(std::sync::Arc::new(LinearElastic {
-            stiffness: self.stiffness.clone(),
-            intrinsic_curvature: self.intrinsic_curvature.clone().map(|p| p.scaled(factor)),
-        }))
+        let scaled = self.intrinsic_curvature.clone().map(|p| p.scaled(factor));
+        Some(std::sync::Arc::new(
+            LinearElastic::new(self.stiffness.clone(), scaled).ok()?,
+        ))
     }
 
     fn with_constant(
@@ -223,16 +269,19 @@ impl StoredEnergy for LinearElastic {
         i: usize,
         value: f64,
     ) -> Option<std::sync::Arc<dyn StoredEnergy>> {
-        let mut e = self.clone();
+        let (mut stiffness, mut kappa0) =
+            (self.stiffness.clone(), self.intrinsic_curvature.clone());
         let slot = match profile {
-            ProfileKind::Stiffness => e.stiffness.get_mut(i)?,
-            ProfileKind::IntrinsicCurvature => e.intrinsic_curvature.get_mut(i)?,
+            ProfileKind::Stiffness => stiffness.get_mut(i)?,
+            ProfileKind::IntrinsicCurvature => kappa0.get_mut(i)?,
         };
         if !matches!(slot, Profile::Constant(_)) {
             return None;
         }
         *slot = Profile::Constant(value);
-        Some(std::sync::Arc::new(e))
+        Some(std::sync::Arc::new(
+            LinearElastic::new(stiffness, kappa0).ok()?,
+        ))
     }
 }
 
@@ -242,16 +291,39 @@ impl StoredEnergy for LinearElastic {
 ///
 /// The quartic term couples the three components (H is not diagonal) and has
 /// a non-zero third derivative, so the equations exercise every method of
-/// [`StoredEnergy`].
+/// [`StoredEnergy`]. Built by the checked [`QuarticStiffening::new`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct QuarticStiffening {
-    /// The quadratic part.
-    pub linear: LinearElastic,
-    /// The stiffening coefficient C (N·m⁴), C ≥ 0.
-    pub quartic: f64,
+    linear: LinearElastic,
+    quartic: f64,
 }
 
 impl QuarticStiffening {
+    /// The linear energy `linear` stiffened by C = `quartic` (N·m⁴);
+    /// refused with [`ModelError::Coefficient`] unless C is finite and
+    /// C ≥ 0 (a negative C makes H indefinite at large curvature).
+    pub fn new(linear: LinearElastic, quartic: f64) -> Result<Self, ModelError> {
+        if quartic.is_finite() && quartic >= 0.0 {
+            Ok(QuarticStiffening { linear, quartic })
+        } else {
+            Err(ModelError::Coefficient {
+                what: "quartic coefficient C",
+                range: "finite and ≥ 0",
+                value: quartic,
+            })
+        }
+    }
+
+    /// The quadratic part.
+    pub fn linear(&self) -> &LinearElastic {
+        &self.linear
+    }
+
+    /// The stiffening coefficient C (N·m⁴), C ≥ 0.
+    pub fn quartic(&self) -> f64 {
+        self.quartic
+    }
+
     /// With u = κ − κ⁰ and S = |u|²: ∇ = C S u, H = C (S I + 2 u uᵀ).
     fn quartic_parts(&self, u: &Vector3<f64>) -> (Vector3<f64>, Matrix3<f64>) {
         let c = self.quartic;
@@ -312,25 +384,51 @@ mod tests {
     use super::*;
 
     fn energies() -> Vec<Box<dyn StoredEnergy>> {
-        let tapered = LinearElastic {
-            stiffness: [
+        let tapered = LinearElastic::new(
+            [
                 Profile::Polynomial(vec![2.0, -0.5]),
                 Profile::Polynomial(vec![1.0, 0.3, 0.2]),
                 Profile::Constant(1.5),
             ],
-            intrinsic_curvature: [
+            [
                 Profile::Polynomial(vec![0.1, 0.4]),
                 Profile::Polynomial(vec![-0.3, 0.0, 1.0]),
                 Profile::Constant(0.7),
             ],
-        };
+        )
+        .unwrap();
         vec![
             Box::new(tapered.clone()),
-            Box::new(QuarticStiffening {
-                linear: tapered,
-                quartic: 0.8,
-            }),
+            Box::new(QuarticStiffening::new(tapered, 0.8).unwrap()),
         ]
+    }
+
+    #[test]
+    fn checked_constructors_refuse_and_round_trip() {
+        let e = LinearElastic::uniform([1.0, 2.0, 3.0], [0.5, 0.0, -0.5]).unwrap();
+        assert_eq!(e.stiffness_profiles()[1], Profile::Constant(2.0));
+        assert_eq!(e.intrinsic_curvature()[2], Profile::Constant(-0.5));
+        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            assert!(matches!(
+                LinearElastic::uniform([1.0, 1.0, bad], [0.0; 3]),
+                Err(ModelError::Stiffness { index: 2, .. })
+            ));
+        }
+        assert!(matches!(
+            LinearElastic::uniform([1.0; 3], [0.0, f64::NAN, 0.0]),
+            Err(ModelError::IntrinsicCurvature { index: 1 })
+        ));
+        let q = QuarticStiffening::new(e.clone(), 0.25).unwrap();
+        assert_eq!((q.linear(), q.quartic()), (&e, 0.25));
+        for bad in [-1e-3, f64::NAN] {
+            assert!(matches!(
+                QuarticStiffening::new(e.clone(), bad),
+                Err(ModelError::Coefficient { .. })
+            ));
+        }
+        // A refused value through with_constant is None, never a rod.
+        assert!(e.with_constant(ProfileKind::Stiffness, 0, -1.0).is_none());
+        assert!(e.with_constant(ProfileKind::Stiffness, 0, 4.0).is_some());
     }
 
     const H: f64 = 1e-6;

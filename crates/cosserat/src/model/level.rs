@@ -49,7 +49,7 @@ impl ModelChoice {
     /// energy admits planar bending about d2(0) and every load keeps the rod
     /// in the plane of d1(0), d3(0); Kirchhoff otherwise.
     pub fn for_rod(rod: &Rod) -> ModelChoice {
-        if rod.energy.shear_stiffness(0.0).is_some() {
+        if rod.energy().shear_stiffness(0.0).is_some() {
             return ModelChoice {
                 level: ModelLevel::Cosserat,
                 reason: "cosserat: the energy has finite shear and extension stiffnesses \
@@ -76,7 +76,7 @@ impl ModelChoice {
     /// extension stiffnesses, and a shearable rod needs the Cosserat level
     /// (drop the shear part of the energy for the Kirchhoff limit).
     pub fn forced(rod: &Rod, level: ModelLevel) -> Result<ModelChoice, String> {
-        let shearable = rod.energy.shear_stiffness(0.0).is_some();
+        let shearable = rod.energy().shear_stiffness(0.0).is_some();
         match (level, planar_obstruction(rod)) {
             (ModelLevel::Cosserat, _) if !shearable => Err(
                 "the Cosserat level needs shear and extension stiffnesses (energy.shear)".into(),
@@ -99,16 +99,19 @@ impl ModelChoice {
 
 /// Why the scene is not planar, or None when it is.
 fn planar_obstruction(rod: &Rod) -> Option<String> {
-    if !rod.energy.admits_planar_bending() {
+    if !rod.energy().admits_planar_bending() {
         return Some("the intrinsic curvature has κ⁰1 or κ⁰3 components".into());
     }
-    let normal = rod.clamp.director(1);
-    let scale = rod.loads.moment_scale(rod.length).max(f64::MIN_POSITIVE);
-    let loads = &rod.loads;
-    if (loads.tip_force.dot(&normal) * rod.length).abs() > PLANE_TOLERANCE * scale {
+    let normal = rod.clamp().director(1);
+    let scale = rod
+        .loads()
+        .moment_scale(rod.length())
+        .max(f64::MIN_POSITIVE);
+    let loads = &rod.loads();
+    if (loads.tip_force.dot(&normal) * rod.length()).abs() > PLANE_TOLERANCE * scale {
         return Some("the tip force has a component along d2(0)".into());
     }
-    let f = loads.distributed_force.dot(&normal) * rod.length * rod.length;
+    let f = loads.distributed_force.dot(&normal) * rod.length() * rod.length();
     if f.abs() > PLANE_TOLERANCE * scale {
         return Some("the distributed force has a component along d2(0)".into());
     }
@@ -116,7 +119,7 @@ fn planar_obstruction(rod: &Rod) -> Option<String> {
     if c.norm() > PLANE_TOLERANCE * scale {
         return Some("the tip couple is not along d2(0)".into());
     }
-    rod.support
+    rod.support()
         .as_ref()
         .and_then(|support| support_obstruction(rod, support))
 }
@@ -125,10 +128,10 @@ fn planar_obstruction(rod: &Rod) -> Option<String> {
 /// a sliding axis out of it, a spin axis other than d2(0), or a prescribed
 /// tip frame whose d2 is not d2(0).
 fn support_obstruction(rod: &Rod, support: &TipSupport) -> Option<String> {
-    let normal = rod.clamp.director(1);
+    let normal = rod.clamp().director(1);
     let off = |v: &Vector3<f64>| v.dot(&normal).abs() > 1e-9 * v.norm().max(1.0);
     let held = support.holds_position();
-    if held && off(&((support.position - rod.clamp.position) / rod.length)) {
+    if held && off(&((support.position - rod.clamp().position) / rod.length())) {
         return Some("the tip support's position is off the plane of d1(0), d3(0)".into());
     }
     if let Freedom::Axial(a) = support.translation {

@@ -5,6 +5,8 @@
 
 mod catalog;
 mod energy;
+mod error;
+mod frame;
 mod level;
 mod loads;
 mod profile;
@@ -14,9 +16,11 @@ mod support;
 
 pub use catalog::{EnergyBuilder, EnergyCatalog, EnergySpec, EnergySpecError};
 pub use energy::{LinearElastic, ProfileKind, QuarticStiffening, StoredEnergy};
+pub use error::ModelError;
+pub use frame::Frame;
 pub use level::{ModelChoice, ModelLevel};
 pub use loads::DeadLoads;
-pub use profile::{Extremes, Profile};
+pub use profile::{Extremes, Knots, Profile, SplineKnots};
 pub use rod::{Clamp, ResidualScales, Rod};
 pub use shear::Shearable;
 pub use support::{across, Freedom, TipSupport};

@@ -8,6 +8,8 @@
 //! equations solve κ' = H⁻¹(M' − ∂s∇W) with H = ∂²W/∂κ² (Antman,
 //! *Nonlinear Problems of Elasticity*, 2nd ed., Ch. 8).
 
+use super::ModelError;
+
 /// A scalar function of the arc length s.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Profile {
@@ -15,24 +17,84 @@ pub enum Profile {
     Constant(f64),
     /// Σ c_k s^k, coefficients in increasing powers.
     Polynomial(Vec<f64>),
-    /// Piecewise-linear interpolation of (s_k, v_k), s strictly increasing;
-    /// held constant outside the table.
-    Table {
-        /// Knots s_k, strictly increasing.
-        s: Vec<f64>,
-        /// Values v_k at the knots.
-        values: Vec<f64>,
-    },
+    /// Piecewise-linear interpolation of (s_k, v_k), held constant outside
+    /// the table; build with [`Profile::table`].
+    Table(Knots),
     /// The natural cubic spline through (s_k, v_k) (C², so that equations
     /// using the derivative stay continuous); build with [`Profile::spline`].
-    Spline {
-        /// Knots s_k, strictly increasing.
-        s: Vec<f64>,
-        /// Values v_k at the knots.
-        values: Vec<f64>,
-        /// Second derivatives at the knots.
-        curvature: Vec<f64>,
-    },
+    Spline(SplineKnots),
+}
+
+/// The points (s_k, v_k) of a table or spline: at least two, as many
+/// values as knots, s strictly increasing (the interpolation divides by
+/// s_{k+1} − s_k and looks knots up by bisection). Checked by
+/// [`Knots::new`]; read through [`Knots::s`] and [`Knots::values`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Knots {
+    s: Vec<f64>,
+    values: Vec<f64>,
+}
+
+impl Knots {
+    /// The points (s_k, v_k); refused with [`ModelError::Profile`] when
+    /// there are fewer than two, the lengths differ, or s is not strictly
+    /// increasing (a NaN knot is not).
+    pub fn new(s: Vec<f64>, values: Vec<f64>) -> Result<Knots, ModelError> {
+        if s.len() < 2 || s.len() != values.len() {
+            return Err(ModelError::Profile(format!(
+                "a table or spline needs at least two knots and as many values ({} s, {} values)",
+                s.len(),
+                values.len()
+            )));
+        }
+        if !s.windows(2).all(|w| w[1] > w[0]) {
+            return Err(ModelError::Profile(
+                "the knots s must be strictly increasing".into(),
+            ));
+        }
+        Ok(Knots { s, values })
+    }
+
+    /// The knots s_k, strictly increasing.
+    pub fn s(&self) -> &[f64] {
+        &self.s
+    }
+
+    /// The values v_k at the knots.
+    pub fn values(&self) -> &[f64] {
+        &self.values
+    }
+
+    /// The same knots with other values (as many): the invariant is the
+    /// knots', so it holds.
+    fn with_values(&self, values: Vec<f64>) -> Knots {
+        debug_assert_eq!(values.len(), self.s.len());
+        Knots {
+            s: self.s.clone(),
+            values,
+        }
+    }
+}
+
+/// A natural cubic spline: its [`Knots`] and the second derivatives there,
+/// computed by [`Profile::spline`] (so that they always belong to the
+/// knots).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SplineKnots {
+    knots: Knots,
+    curvature: Vec<f64>,
+}
+
+impl SplineKnots {
+    /// The knots and values.
+    pub fn knots(&self) -> &Knots {
+        &self.knots
+    }
+
+    /// The second derivatives at the knots.
+    pub fn curvature(&self) -> &[f64] {
+        &self.curvature
+    }
 }
 
 impl Default for Profile {
@@ -42,11 +104,19 @@ impl Default for Profile {
 }
 
 impl Profile {
+    /// The piecewise-linear table through (s_k, v_k); refused as in
+    /// [`Knots::new`].
+    pub fn table(s: Vec<f64>, values: Vec<f64>) -> Result<Profile, ModelError> {
+        Ok(Profile::Table(Knots::new(s, values)?))
+    }
+
     /// The natural cubic spline through (s_k, v_k), s strictly increasing,
-    /// at least two knots (second derivatives from the tridiagonal system
-    /// with zero end curvature; de Boor, *A Practical Guide to Splines*,
-    /// ch. IV).
-    pub fn spline(s: Vec<f64>, values: Vec<f64>) -> Profile {
+    /// at least two knots (refused as in [`Knots::new`]; second derivatives
+    /// from the tridiagonal system with zero end curvature; de Boor, *A
+    /// Practical Guide to Splines*, ch. IV).
+    pub fn spline(s: Vec<f64>, values: Vec<f64>) -> Result<Profile, ModelError> {
+        let knots = Knots::new(s, values)?;
+        let (s, values) = (&knots.s, &knots.values);
         let n = s.len();
         let mut curvature = vec![0.0; n];
         if n > 2 {
@@ -71,11 +141,7 @@ impl Profile {
                 curvature[i] = (rhs[i] - upper) / diag[i];
             }
         }
-        Profile::Spline {
-            s,
-            values,
-            curvature,
-        }
+        Ok(Profile::Spline(SplineKnots { knots, curvature }))
     }
 
     /// The profile times a constant factor (a control raising an
@@ -85,19 +151,11 @@ impl Profile {
         match self {
             Profile::Constant(v) => Profile::Constant(v * factor),
             Profile::Polynomial(c) => Profile::Polynomial(times(c)),
-            Profile::Table { s, values } => Profile::Table {
-                s: s.clone(),
-                values: times(values),
-            },
-            Profile::Spline {
-                s,
-                values,
-                curvature,
-            } => Profile::Spline {
-                s: s.clone(),
-                values: times(values),
-                curvature: times(curvature),
-            },
+            Profile::Table(k) => Profile::Table(k.with_values(times(&k.values))),
+            Profile::Spline(sp) => Profile::Spline(SplineKnots {
+                knots: sp.knots.with_values(times(&sp.knots.values)),
+                curvature: times(&sp.curvature),
+            }),
         }
     }
 
@@ -125,28 +183,15 @@ impl Profile {
                 };
                 Profile::Polynomial(mix(&pad(a), &pad(b)))
             }
-            (Profile::Table { s, values: a }, Profile::Table { s: t, values: b }) if s == t => {
-                Profile::Table {
-                    s: s.clone(),
-                    values: mix(a, b),
-                }
+            (Profile::Table(a), Profile::Table(b)) if a.s == b.s => {
+                Profile::Table(a.with_values(mix(&a.values, &b.values)))
             }
-            (
-                Profile::Spline {
-                    s,
-                    values: a,
-                    curvature: ca,
-                },
-                Profile::Spline {
-                    s: t,
-                    values: b,
-                    curvature: cb,
-                },
-            ) if s == t => Profile::Spline {
-                s: s.clone(),
-                values: mix(a, b),
-                curvature: mix(ca, cb),
-            },
+            (Profile::Spline(a), Profile::Spline(b)) if a.knots.s == b.knots.s => {
+                Profile::Spline(SplineKnots {
+                    knots: a.knots.with_values(mix(&a.knots.values, &b.knots.values)),
+                    curvature: mix(&a.curvature, &b.curvature),
+                })
+            }
             _ => return None,
         })
     }
@@ -157,15 +202,14 @@ impl Profile {
         match self {
             Profile::Constant(c) => *c,
             Profile::Polynomial(c) => c.iter().rev().fold(0.0, |acc, &ck| acc * s + ck),
-            Profile::Table { s: knots, values } => {
+            Profile::Table(Knots { s: knots, values }) => {
                 let (k, t) = locate(knots, s);
                 values[k] + t * (values[k + 1] - values[k])
             }
-            Profile::Spline {
-                s: knots,
-                values,
+            Profile::Spline(SplineKnots {
+                knots: Knots { s: knots, values },
                 curvature,
-            } => {
+            }) => {
                 let (k, t) = locate(knots, s);
                 let h = knots[k + 1] - knots[k];
                 let (a, b) = (1.0 - t, t);
@@ -188,18 +232,17 @@ impl Profile {
                 .skip(1)
                 .rev()
                 .fold(0.0, |acc, (k, &ck)| acc * s + k as f64 * ck),
-            Profile::Table { s: knots, values } => {
+            Profile::Table(Knots { s: knots, values }) => {
                 if s < knots[0] || s > knots[knots.len() - 1] {
                     return 0.0;
                 }
                 let (k, _) = locate(knots, s);
                 (values[k + 1] - values[k]) / (knots[k + 1] - knots[k])
             }
-            Profile::Spline {
-                s: knots,
-                values,
+            Profile::Spline(SplineKnots {
+                knots: Knots { s: knots, values },
                 curvature,
-            } => {
+            }) => {
                 let (k, t) = locate(knots, s);
                 let h = knots[k + 1] - knots[k];
                 let (a, b) = (1.0 - t, t);
@@ -216,9 +259,11 @@ impl Profile {
         match self {
             Profile::Constant(c) => *c == 0.0,
             Profile::Polynomial(c) => c.iter().all(|&x| x == 0.0),
-            Profile::Table { values, .. } | Profile::Spline { values, .. } => {
-                values.iter().all(|&x| x == 0.0)
-            }
+            Profile::Table(Knots { values, .. })
+            | Profile::Spline(SplineKnots {
+                knots: Knots { values, .. },
+                ..
+            }) => values.iter().all(|&x| x == 0.0),
         }
     }
 
@@ -246,7 +291,7 @@ impl Profile {
     pub fn extremes_on(&self, length: f64) -> Extremes {
         match self {
             Profile::Constant(c) => Extremes::at(*c, 0.0, 0.0),
-            Profile::Table { s, values } => {
+            Profile::Table(Knots { s, values }) => {
                 let mut e = Extremes::at(self.value(0.0), 0.0, 0.0);
                 e.include(self.value(length), length, 0.0);
                 for (sk, vk) in s.iter().zip(values) {
@@ -258,11 +303,10 @@ impl Profile {
                 e
             }
             Profile::Polynomial(c) => polynomial_extremes(c, 0.0, length),
-            Profile::Spline {
-                s: knots,
-                values,
+            Profile::Spline(SplineKnots {
+                knots: Knots { s: knots, values },
                 curvature,
-            } => {
+            }) => {
                 let n = knots.len();
                 let mut e = Extremes::at(self.value(0.0), 0.0, 0.0);
                 e.include(self.value(length), length, 0.0);
@@ -292,12 +336,11 @@ impl Profile {
         match self {
             Profile::Constant(c) => c.is_finite(),
             Profile::Polynomial(c) => c.iter().all(|x| x.is_finite()),
-            Profile::Table { s, values } => s.iter().chain(values).all(|x| x.is_finite()),
-            Profile::Spline {
-                s,
-                values,
+            Profile::Table(Knots { s, values }) => s.iter().chain(values).all(|x| x.is_finite()),
+            Profile::Spline(SplineKnots {
+                knots: Knots { s, values },
                 curvature,
-            } => s
+            }) => s
                 .iter()
                 .chain(values)
                 .chain(curvature)
@@ -477,12 +520,13 @@ mod tests {
         let a: Vec<f64> = s.iter().map(|x| (3.0 * x).sin()).collect();
         let b: Vec<f64> = s.iter().map(|x| x * x - 2.0 * x).collect();
         let (sa, sb) = (
-            Profile::spline(s.clone(), a.clone()),
-            Profile::spline(s.clone(), b.clone()),
+            Profile::spline(s.clone(), a.clone()).unwrap(),
+            Profile::spline(s.clone(), b.clone()).unwrap(),
         );
         let mix: Vec<f64> = a.iter().zip(&b).map(|(x, y)| 0.7 * x + 0.3 * y).collect();
-        let fresh_mix = Profile::spline(s.clone(), mix);
-        let fresh_scaled = Profile::spline(s.clone(), a.iter().map(|x| -2.5 * x).collect());
+        let fresh_mix = Profile::spline(s.clone(), mix).unwrap();
+        let fresh_scaled =
+            Profile::spline(s.clone(), a.iter().map(|x| -2.5 * x).collect()).unwrap();
         let blended = sa.blend(&sb, 0.3).unwrap();
         let scaled = sa.scaled(-2.5);
         for t in [0.0, 0.13, 0.5, 0.77, 1.0] {
@@ -536,7 +580,7 @@ mod tests {
     fn spline_extremes_match_dense_sampling() {
         let s: Vec<f64> = (0..7).map(|i| i as f64 / 6.0).collect();
         let v: Vec<f64> = s.iter().map(|x| (7.0 * x).sin()).collect();
-        let p = Profile::spline(s, v);
+        let p = Profile::spline(s, v).unwrap();
         let e = p.extremes_on(1.0);
         let dense = (0..=200_000).map(|i| p.value(i as f64 / 200_000.0));
         let (lo, hi) = dense.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
@@ -559,7 +603,7 @@ mod tests {
     fn spline_interpolates_smoothly() {
         let f = |x: f64| (2.0 * x).sin();
         let s: Vec<f64> = (0..=200).map(|i| i as f64 / 200.0).collect();
-        let p = Profile::spline(s.clone(), s.iter().map(|&x| f(x)).collect());
+        let p = Profile::spline(s.clone(), s.iter().map(|&x| f(x)).collect()).unwrap();
         for x in [0.3, 0.5123, 0.77] {
             assert!((p.value(x) - f(x)).abs() < 1e-7, "{x}");
             let h = 1e-6;
@@ -571,14 +615,39 @@ mod tests {
 
     #[test]
     fn table_interpolates_and_clamps() {
-        let p = Profile::Table {
-            s: vec![0.0, 1.0, 3.0],
-            values: vec![1.0, 3.0, 2.0],
-        };
+        let p = Profile::table(vec![0.0, 1.0, 3.0], vec![1.0, 3.0, 2.0]).unwrap();
         assert_eq!(p.value(0.5), 2.0);
         assert_eq!(p.value(2.0), 2.5);
         assert_eq!(p.value(5.0), 2.0);
         assert_eq!(p.derivative(2.0), -0.5);
         assert_eq!(p.minimum_on(3.0), 1.0);
+    }
+
+    #[test]
+    fn knots_are_checked() {
+        let k = Knots::new(vec![0.0, 0.5, 1.0], vec![1.0, 2.0, 4.0]).unwrap();
+        assert_eq!(
+            (k.s(), k.values()),
+            (&[0.0, 0.5, 1.0][..], &[1.0, 2.0, 4.0][..])
+        );
+        let sp = Profile::spline(vec![0.0, 1.0], vec![2.0, 3.0]).unwrap();
+        let Profile::Spline(sp) = sp else {
+            panic!("a spline")
+        };
+        assert_eq!(sp.knots().values(), &[2.0, 3.0]);
+        assert_eq!(sp.curvature(), &[0.0, 0.0]);
+        for (s, v) in [
+            (vec![0.0], vec![1.0]),
+            (vec![0.0, 1.0], vec![1.0]),
+            (vec![0.0, 0.0], vec![1.0, 2.0]),
+            (vec![1.0, 0.0], vec![1.0, 2.0]),
+            (vec![0.0, f64::NAN], vec![1.0, 2.0]),
+        ] {
+            assert!(matches!(
+                Profile::table(s.clone(), v.clone()),
+                Err(ModelError::Profile(_))
+            ));
+            assert!(matches!(Profile::spline(s, v), Err(ModelError::Profile(_))));
+        }
     }
 }

@@ -1,10 +1,15 @@
 //! The rod: length, stored energy, clamp at s = 0 and dead loads.
+//!
+//! A [`Rod`] is built by the checked [`Rod::new`] and changed only by the
+//! checked `with_*` modifiers, so that every rod the solvers see has a
+//! positive finite length, finite loads and positions, unit support axes
+//! and director frames that are rotations ([`Frame`]).
 
 use std::sync::Arc;
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Vector3;
 
-use super::{DeadLoads, StoredEnergy, TipSupport};
+use super::{DeadLoads, Frame, Freedom, ModelError, StoredEnergy, TipSupport};
 
 /// The support at s = 0: position and the directors d1(0), d2(0), d3(0);
 /// a clamp, or a hinge about d2(0).
@@ -12,10 +17,10 @@ use super::{DeadLoads, StoredEnergy, TipSupport};
 pub struct Clamp {
     /// r(0) (m).
     pub position: Vector3<f64>,
-    /// The director frame [d1 d2 d3] at s = 0, as columns (orthonormal,
-    /// right-handed); for a hinge, the frame the turning angle is measured
-    /// from.
-    pub frame: Matrix3<f64>,
+    /// The director frame [d1 d2 d3] at s = 0, as columns (a rotation,
+    /// checked by [`Frame`]); for a hinge, the frame the turning angle is
+    /// measured from.
+    pub frame: Frame,
     /// A hinge about d2(0) instead of a clamp: the frame may turn about
     /// d2(0) (its angle is an unknown) and the moment about d2(0) vanishes
     /// there (planar scenes: the pinned end of a column).
@@ -23,20 +28,30 @@ pub struct Clamp {
 }
 
 impl Clamp {
-    /// A clamp from d1(0) and d3(0); d2 = d3 × d1 completes a right-handed
-    /// frame. Orthonormality is the caller's to check (problem files do).
-    pub fn new(position: Vector3<f64>, d1: Vector3<f64>, d3: Vector3<f64>) -> Self {
-        let d2 = d3.cross(&d1);
-        Clamp {
+    /// A clamp at `position` from d1(0) and d3(0); d2 = d3 × d1 completes a
+    /// right-handed frame ([`Frame::from_directors`]). Refused when d1, d3
+    /// are not orthonormal ([`ModelError::Frame`]) or the position is not
+    /// finite ([`ModelError::NotFinite`]).
+    pub fn new(
+        position: Vector3<f64>,
+        d1: Vector3<f64>,
+        d3: Vector3<f64>,
+    ) -> Result<Self, ModelError> {
+        finite("clamp position", &position)?;
+        Ok(Clamp {
             position,
-            frame: Matrix3::from_columns(&[d1, d2, d3]),
+            frame: Frame::from_directors(d1, d3)?,
             hinge: false,
-        }
+        })
     }
 
     /// The paper's clamp: origin, d1 = e1 (vertical, down), d3 = e3.
     pub fn paper() -> Self {
-        Clamp::new(Vector3::zeros(), Vector3::x(), Vector3::z())
+        Clamp {
+            position: Vector3::zeros(),
+            frame: Frame::identity(),
+            hinge: false,
+        }
     }
 
     /// d_i(0), i = 0, 1, 2.
@@ -47,9 +62,10 @@ impl Clamp {
     /// The frame turned by `angle` (rad) about d2(0), d3 towards d1:
     /// R [d1 d2 d3] with R d3 = d3 cos θ + d1 sin θ (the clamp angle of the
     /// paper's Fig. 2; a negative angle turns back).
-    pub fn turned_frame(&self, angle: f64) -> Matrix3<f64> {
-        let axis = nalgebra::Unit::new_normalize(self.director(1));
-        nalgebra::Rotation3::from_axis_angle(&axis, angle).matrix() * self.frame
+    ///
+    /// Refused ([`ModelError::Angle`]) for a non-finite angle.
+    pub fn turned_frame(&self, angle: f64) -> Result<Frame, ModelError> {
+        self.frame.turned(1, angle)
     }
 }
 
@@ -65,22 +81,154 @@ pub struct ResidualScales {
 }
 
 /// A rod clamped at s = 0 under dead loads, free at s = L or held there by
-/// a [`TipSupport`].
+/// a [`TipSupport`]. Its parts are read through accessors and changed
+/// through the checked `with_*` modifiers, so that no rod holds a value
+/// [`Rod::new`] refuses.
 #[derive(Debug, Clone)]
 pub struct Rod {
-    /// Reference length L (m).
-    pub length: f64,
-    /// The stored energy density W(s, κ).
-    pub energy: Arc<dyn StoredEnergy>,
-    /// The clamp at s = 0.
-    pub clamp: Clamp,
-    /// Dead loads.
-    pub loads: DeadLoads,
-    /// The support at s = L; None for a free tip (a cantilever).
-    pub support: Option<TipSupport>,
+    length: f64,
+    energy: Arc<dyn StoredEnergy>,
+    clamp: Clamp,
+    loads: DeadLoads,
+    support: Option<TipSupport>,
+}
+
+/// Refuses a vector with a non-finite component.
+fn finite(what: &'static str, v: &Vector3<f64>) -> Result<(), ModelError> {
+    if v.iter().all(|x| x.is_finite()) {
+        Ok(())
+    } else {
+        Err(ModelError::NotFinite {
+            what,
+            value: [v.x, v.y, v.z],
+        })
+    }
+}
+
+fn check_length(length: f64) -> Result<(), ModelError> {
+    if length.is_finite() && length > 0.0 {
+        Ok(())
+    } else {
+        Err(ModelError::Length(length))
+    }
+}
+
+fn check_clamp(clamp: &Clamp) -> Result<(), ModelError> {
+    finite("clamp position", &clamp.position)
+}
+
+fn check_loads(loads: &DeadLoads) -> Result<(), ModelError> {
+    finite("tip force", &loads.tip_force)?;
+    finite("tip couple", &loads.tip_couple)?;
+    finite("distributed force", &loads.distributed_force)
+}
+
+/// A support's position is finite and its axes are unit vectors (to
+/// [`Frame::TOLERANCE`]); its frame is a [`Frame`] already.
+fn check_support(support: &Option<TipSupport>) -> Result<(), ModelError> {
+    let Some(s) = support else {
+        return Ok(());
+    };
+    finite("support position", &s.position)?;
+    for freedom in [s.translation, s.rotation] {
+        if let Freedom::Axial(a) = freedom {
+            finite("support axis", &a)?;
+            if (a.norm() - 1.0).abs() > Frame::TOLERANCE {
+                return Err(ModelError::Axis { norm: a.norm() });
+            }
+        }
+    }
+    Ok(())
 }
 
 impl Rod {
+    /// A rod of reference length `length` (m) with stored energy `energy`,
+    /// clamped by `clamp` at s = 0, under dead `loads`, free at s = L
+    /// (`support` None) or held there. Refused with the named
+    /// [`ModelError`] when the length is not positive and finite, a load or
+    /// a position is not finite, or a support axis is not a unit vector
+    /// (frames are [`Frame`]s, checked when built). The energy is the
+    /// caller's: its Hessian is checked along the rod when a solve starts.
+    pub fn new(
+        length: f64,
+        energy: Arc<dyn StoredEnergy>,
+        clamp: Clamp,
+        loads: DeadLoads,
+        support: Option<TipSupport>,
+    ) -> Result<Rod, ModelError> {
+        check_length(length)?;
+        check_clamp(&clamp)?;
+        check_loads(&loads)?;
+        check_support(&support)?;
+        Ok(Rod {
+            length,
+            energy,
+            clamp,
+            loads,
+            support,
+        })
+    }
+
+    /// Reference length L (m).
+    pub fn length(&self) -> f64 {
+        self.length
+    }
+
+    /// The stored energy density W(s, κ).
+    pub fn energy(&self) -> &Arc<dyn StoredEnergy> {
+        &self.energy
+    }
+
+    /// The clamp at s = 0.
+    pub fn clamp(&self) -> &Clamp {
+        &self.clamp
+    }
+
+    /// Dead loads.
+    pub fn loads(&self) -> &DeadLoads {
+        &self.loads
+    }
+
+    /// The support at s = L; None for a free tip (a cantilever).
+    pub fn support(&self) -> Option<&TipSupport> {
+        self.support.as_ref()
+    }
+
+    /// The same rod with another length, checked as in [`Rod::new`].
+    pub fn with_length(mut self, length: f64) -> Result<Rod, ModelError> {
+        check_length(length)?;
+        self.length = length;
+        Ok(self)
+    }
+
+    /// The same rod with another stored energy (nothing to check here: see
+    /// [`Rod::new`]).
+    pub fn with_energy(mut self, energy: Arc<dyn StoredEnergy>) -> Rod {
+        self.energy = energy;
+        self
+    }
+
+    /// The same rod with another clamp, checked as in [`Rod::new`].
+    pub fn with_clamp(mut self, clamp: Clamp) -> Result<Rod, ModelError> {
+        check_clamp(&clamp)?;
+        self.clamp = clamp;
+        Ok(self)
+    }
+
+    /// The same rod under other loads, checked as in [`Rod::new`].
+    pub fn with_loads(mut self, loads: DeadLoads) -> Result<Rod, ModelError> {
+        check_loads(&loads)?;
+        self.loads = loads;
+        Ok(self)
+    }
+
+    /// The same rod with another tip support, checked as in [`Rod::new`].
+    pub fn with_support(mut self, support: Option<TipSupport>) -> Result<Rod, ModelError> {
+        check_support(&support)?;
+        self.support = support;
+        Ok(self)
+    }
+
     /// A characteristic moment (N·m) of the whole rod: the larger of the
     /// largest bending moment B/L that curves the rod by one radian and the
     /// moments of the loads. Only for order-of-magnitude checks; residuals
@@ -134,11 +282,120 @@ impl Rod {
             .fold(Vector3::zeros(), |a, m| a.sup(&m))
     }
 
-    /// The same rod under loads scaled by `factor`.
-    pub fn with_load_factor(&self, factor: f64) -> Rod {
-        Rod {
-            loads: self.loads.scaled(factor),
-            ..self.clone()
+    /// The same rod under loads scaled by `factor`; refused when the
+    /// scaled loads are not finite (a non-finite factor, or an overflow).
+    pub fn with_load_factor(&self, factor: f64) -> Result<Rod, ModelError> {
+        self.clone().with_loads(self.loads.scaled(factor))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::LinearElastic;
+
+    fn energy() -> Arc<dyn StoredEnergy> {
+        Arc::new(LinearElastic::uniform([1.0, 1.0, 1.0], [0.0; 3]).unwrap())
+    }
+
+    fn loads() -> DeadLoads {
+        DeadLoads {
+            tip_force: Vector3::new(1.0, 0.0, 0.0),
+            ..Default::default()
         }
+    }
+
+    #[test]
+    fn a_valid_rod_round_trips() {
+        let rod = Rod::new(2.0, energy(), Clamp::paper(), loads(), None).unwrap();
+        assert_eq!(rod.length(), 2.0);
+        assert_eq!(rod.clamp(), &Clamp::paper());
+        assert_eq!(rod.loads(), &loads());
+        assert!(rod.support().is_none());
+        assert_eq!(rod.energy().name(), "linear");
+        let rod = rod.with_length(3.0).unwrap();
+        assert_eq!(rod.length(), 3.0);
+        assert_eq!(rod.with_load_factor(2.0).unwrap().loads().tip_force.x, 2.0);
+        let clamp = Clamp::new(Vector3::zeros(), Vector3::x(), Vector3::z()).unwrap();
+        assert_eq!(clamp, Clamp::paper());
+        let turned = Clamp {
+            frame: clamp.turned_frame(0.3).unwrap(),
+            ..clamp
+        };
+        let support = TipSupport {
+            position: Vector3::new(0.1, 0.0, 0.9),
+            frame: Frame::identity(),
+            translation: Freedom::Axial(Vector3::z()),
+            rotation: Freedom::Fixed,
+        };
+        let rod = rod
+            .with_clamp(turned.clone())
+            .unwrap()
+            .with_support(Some(support.clone()))
+            .unwrap();
+        assert_eq!((rod.clamp(), rod.support()), (&turned, Some(&support)));
+    }
+
+    #[test]
+    fn refused_values_give_named_errors() {
+        for l in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            assert!(matches!(
+                Rod::new(l, energy(), Clamp::paper(), loads(), None),
+                Err(ModelError::Length(_))
+            ));
+        }
+        let mut bad = loads();
+        bad.tip_couple.y = f64::NAN;
+        assert!(matches!(
+            Rod::new(1.0, energy(), Clamp::paper(), bad, None),
+            Err(ModelError::NotFinite {
+                what: "tip couple",
+                ..
+            })
+        ));
+        let rod = Rod::new(1.0, energy(), Clamp::paper(), loads(), None).unwrap();
+        assert!(matches!(
+            rod.with_load_factor(f64::INFINITY),
+            Err(ModelError::NotFinite { .. })
+        ));
+        assert!(matches!(
+            Clamp::new(Vector3::zeros(), Vector3::x(), Vector3::new(0.0, 0.1, 1.0)),
+            Err(ModelError::Frame { .. })
+        ));
+        let support = TipSupport {
+            position: Vector3::z(),
+            frame: Frame::identity(),
+            translation: Freedom::Axial(Vector3::new(0.0, 0.0, 2.0)),
+            rotation: Freedom::Free,
+        };
+        assert!(matches!(
+            rod.clone().with_support(Some(support.clone())),
+            Err(ModelError::Axis { .. })
+        ));
+        let nowhere = TipSupport {
+            position: Vector3::new(f64::INFINITY, 0.0, 0.0),
+            translation: Freedom::Fixed,
+            ..support
+        };
+        assert!(matches!(
+            rod.clone().with_support(Some(nowhere)),
+            Err(ModelError::NotFinite {
+                what: "support position",
+                ..
+            })
+        ));
+        let mut adrift = Clamp::paper();
+        adrift.position.x = f64::NAN;
+        assert!(matches!(
+            rod.clone().with_clamp(adrift),
+            Err(ModelError::NotFinite {
+                what: "clamp position",
+                ..
+            })
+        ));
+        assert!(matches!(
+            rod.with_length(-2.0),
+            Err(ModelError::Length(l)) if l == -2.0
+        ));
     }
 }

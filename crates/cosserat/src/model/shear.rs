@@ -14,17 +14,43 @@ use std::sync::Arc;
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::{Profile, StoredEnergy};
+use super::{ModelError, Profile, StoredEnergy};
 
 /// A bending energy W_b(s, κ) with the quadratic shear and extension
-/// energy ½ (ν − e3)ᵀ diag(S) (ν − e3).
+/// energy ½ (ν − e3)ᵀ diag(S) (ν − e3). Built by the checked
+/// [`Shearable::new`], so that S is positive definite.
 #[derive(Debug, Clone)]
 pub struct Shearable {
+    bending: Arc<dyn StoredEnergy>,
+    shear: Vector3<f64>,
+}
+
+impl Shearable {
+    /// The bending energy W_b with shear and extension stiffnesses
+    /// S = (S1, S2, S3) = (k G A, k G A, E A) (N). Refused with
+    /// [`ModelError::Stiffness`] unless every S_i is positive and finite
+    /// (ν = e3 + S⁻¹N needs S invertible; a negative S_i has no minimum).
+    pub fn new(bending: Arc<dyn StoredEnergy>, shear: Vector3<f64>) -> Result<Self, ModelError> {
+        if let Some(index) = (0..3).find(|&i| !(shear[i].is_finite() && shear[i] > 0.0)) {
+            return Err(ModelError::Stiffness {
+                what: "shear/extension stiffness S",
+                index,
+                value: shear[index],
+            });
+        }
+        Ok(Shearable { bending, shear })
+    }
+
     /// W_b(s, κ).
-    pub bending: Arc<dyn StoredEnergy>,
+    pub fn bending(&self) -> &Arc<dyn StoredEnergy> {
+        &self.bending
+    }
+
     /// S = (S1, S2, S3): shear stiffnesses k G A about d1, d2 and the
     /// extensional stiffness E A (N), all positive.
-    pub shear: Vector3<f64>,
+    pub fn shear(&self) -> Vector3<f64> {
+        self.shear
+    }
 }
 
 impl StoredEnergy for Shearable {
@@ -98,11 +124,34 @@ impl StoredEnergy for Shearable {
 }
 
 impl Shearable {
-    /// The same shear part on another bending energy.
+    /// The same shear part (checked when this one was built) on another
+    /// bending energy.
     fn with_bending(&self, bending: Arc<dyn StoredEnergy>) -> Arc<dyn StoredEnergy> {
         Arc::new(Shearable {
             bending,
             shear: self.shear,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::LinearElastic;
+
+    #[test]
+    fn shear_stiffness_is_checked() {
+        let b: Arc<dyn StoredEnergy> =
+            Arc::new(LinearElastic::uniform([1.0; 3], [0.0; 3]).unwrap());
+        let s = Shearable::new(b.clone(), Vector3::new(10.0, 20.0, 30.0)).unwrap();
+        assert_eq!(s.shear(), Vector3::new(10.0, 20.0, 30.0));
+        assert_eq!(s.shear_stiffness(0.3), Some(s.shear()));
+        assert_eq!(s.bending().name(), "linear");
+        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            assert!(matches!(
+                Shearable::new(b.clone(), Vector3::new(1.0, bad, 1.0)),
+                Err(ModelError::Stiffness { index: 1, .. })
+            ));
+        }
     }
 }

@@ -13,7 +13,9 @@
 //! * `Axial(a)`: free only along (translation) or about (rotation) the unit
 //!   axis a: 2 conditions across a plus the natural condition along a.
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Vector3;
+
+use super::Frame;
 
 /// Freedom of the tip in translation or rotation.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -22,7 +24,8 @@ pub enum Freedom {
     Fixed,
     /// Unconstrained: the load (tip force or couple) acts alone.
     Free,
-    /// Free only along / about this unit axis (global components).
+    /// Free only along / about this unit axis (global components; a unit
+    /// vector to [`Frame::TOLERANCE`], checked by [`super::Rod::new`]).
     Axial(Vector3<f64>),
 }
 
@@ -32,8 +35,8 @@ pub struct TipSupport {
     /// The prescribed tip position r(L) (used unless translation is free).
     pub position: Vector3<f64>,
     /// The prescribed tip frame (d1 d2 d3)(L), the directors as columns (used unless
-    /// rotation is free).
-    pub frame: Matrix3<f64>,
+    /// rotation is free); a rotation, checked by [`Frame`].
+    pub frame: Frame,
     /// Translation freedom of the tip.
     pub translation: Freedom,
     /// Rotation freedom of the tip.

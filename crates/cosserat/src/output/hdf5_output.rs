@@ -278,6 +278,8 @@ fn write_critical_load(file: &hdf5::File, c: &CriticalLoad) -> hdf5::Result<()> 
     array(&g, "nodes", &[n], &c.nodes)?;
     g.new_dataset::<f64>()
         .create("critical_load")?
+        // None: stable under any load, so the critical load is +∞ (the
+        // value, not a placeholder).
         .write_scalar(&c.gamma.unwrap_or(f64::INFINITY))?;
     g.new_dataset::<f64>()
         .create("load_factor")?

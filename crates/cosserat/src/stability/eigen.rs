@@ -370,6 +370,9 @@ pub(super) fn lanczos(
             }
         }
         metric.matvec(&w, &mut mw);
+        // wᵀMw ≥ 0 for the positive definite metric M; a negative value is
+        // round-off of a w already M-orthogonal to the basis (b ≈ 0, the
+        // space exhausted), not data, so it is read as 0.
         let b = dot(&w, &mw).max(0.0).sqrt();
         let exhausted = b <= 1e-14 * alpha[j].abs().max(f64::MIN_POSITIVE);
         let done = j + 1 >= steps

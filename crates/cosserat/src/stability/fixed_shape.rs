@@ -47,7 +47,7 @@ impl FixedShape {
     /// when the shape's quadrature does (a length or shape so extreme that
     /// the integrator's step underflows).
     pub fn samples(&self, rod: &Rod, points: &[f64]) -> Result<Vec<RodSample>, StabilityError> {
-        let c = &rod.clamp;
+        let c = &rod.clamp();
         let (ex, ez) = (c.director(0), c.director(2));
         let phi = &self.turning_angle;
         // y = (x, z, X, Z): position in the plane and its running integral,
@@ -57,7 +57,7 @@ impl FixedShape {
             d.copy_from_slice(&[sin, cos, y[0], y[1]]);
         };
         let mut stops = points.to_vec();
-        stops.push(rod.length);
+        stops.push(rod.length());
         let mut states = Vec::with_capacity(stops.len());
         let mut y = [0.0; 4];
         let tol = Tolerances::default();
@@ -65,7 +65,7 @@ impl FixedShape {
             .integrate(
                 rhs,
                 0.0,
-                rod.length,
+                rod.length(),
                 &mut y,
                 4,
                 &tol,
@@ -79,7 +79,7 @@ impl FixedShape {
         let (_, tip) = *states.last().expect("the tip is a stop");
         // In-plane vectors to global: (a, b) ↦ a ex + b ez.
         let global = |a: f64, b: f64| ex * a + ez * b;
-        let loads = &rod.loads;
+        let loads = &rod.loads();
         Ok(states[..points.len()]
             .iter()
             .map(|(s, v)| {
@@ -91,7 +91,7 @@ impl FixedShape {
                 ]);
                 let to_tip = global(tip[0] - v[0], tip[1] - v[1]);
                 // ∫_s^L (r(t) − r(s)) dt = Q(L) − Q(s) − (L − s) r(s), in plane.
-                let rest = rod.length - s;
+                let rest = rod.length() - s;
                 let lever = global(tip[2] - v[2] - rest * v[0], tip[3] - v[3] - rest * v[1]);
                 let m = loads.tip_couple
                     + to_tip.cross(&loads.tip_force)
@@ -106,7 +106,7 @@ impl FixedShape {
                     ],
                     curvature: Vector3::new(0.0, phi.derivative(*s), 0.0),
                     moment: frame.transpose() * m,
-                    force: loads.internal_force(*s, rod.length),
+                    force: loads.internal_force(*s, rod.length()),
                 }
             })
             .collect())
@@ -124,7 +124,7 @@ fn split_coefficients(
         .map(|p| {
             let frame = Matrix3::from_columns(&p.directors);
             let force = frame.transpose() * p.force;
-            let h = rod.energy.stiffness(p.s, &p.curvature);
+            let h = rod.energy().stiffness(p.s, &p.curvature);
             (
                 FormCoefficients::at(&h, &p.curvature, &zero, &zero),
                 FormCoefficients::at(&Matrix3::zeros(), &p.curvature, &p.moment, &force),
@@ -139,35 +139,35 @@ pub fn critical_load(
     shape: &FixedShape,
     opts: &StabilityOptions,
 ) -> Result<CriticalLoad, StabilityError> {
-    if !rod.energy.is_quadratic() {
+    if !rod.energy().is_quadratic() {
         return Err(StabilityError::FixedShape(format!(
             "the {} energy's Hessian depends on the load through κ − κ⁰, so K(λ) is not linear in λ; \
              use the linear energy",
-            rod.energy.name()
+            rod.energy().name()
         )));
     }
-    if rod.loads.tip_couple.norm() > 0.0 {
+    if rod.loads().tip_couple.norm() > 0.0 {
         return Err(StabilityError::NonConservative(
             "a fixed-shape scene takes forces only".into(),
         ));
     }
-    if rod.clamp.hinge || rod.support.is_some() || rod.energy.shear_stiffness(0.0).is_some() {
+    if rod.clamp().hinge || rod.support().is_some() || rod.energy().shear_stiffness(0.0).is_some() {
         return Err(StabilityError::FixedShape(
             "a fixed shape is a clamped, free-tipped Kirchhoff cantilever (paper Sec. 3); \
              remove clamp.hinge, [support] and energy.shear"
                 .into(),
         ));
     }
-    let normal = rod.clamp.director(1);
+    let normal = rod.clamp().director(1);
     let off_plane =
-        rod.loads.tip_force.dot(&normal).abs() + rod.loads.distributed_force.dot(&normal).abs();
+        rod.loads().tip_force.dot(&normal).abs() + rod.loads().distributed_force.dot(&normal).abs();
     if off_plane > 0.0 {
         return Err(StabilityError::FixedShape(
             "the loads must lie in the plane of d1(0), d3(0)".into(),
         ));
     }
     opts.check()?;
-    let fe = FiniteElements::new(rod.length, opts.elements, opts.order);
+    let fe = FiniteElements::new(rod.length(), opts.elements, opts.order);
     let samples = shape.samples(rod, &fe.quadrature_points())?;
     let (c0, c1) = split_coefficients(rod, &samples);
     let mut blocks = Vec::new();
@@ -181,12 +181,12 @@ pub fn critical_load(
         blocks.push((block, lambda, mode));
     }
     let load_factor = blocks.iter().filter_map(|b| b.1).reduce(f64::min);
-    let b2 = rod.energy.stiffness(0.0, &Vector3::zeros())[(1, 1)];
-    let l = rod.length;
-    let scale = if rod.loads.tip_force.norm() > 0.0 {
-        rod.loads.tip_force.norm() * l * l / b2
+    let b2 = rod.energy().stiffness(0.0, &Vector3::zeros())[(1, 1)];
+    let l = rod.length();
+    let scale = if rod.loads().tip_force.norm() > 0.0 {
+        rod.loads().tip_force.norm() * l * l / b2
     } else {
-        rod.loads.distributed_force.norm() * l * l * l / b2
+        rod.loads().distributed_force.norm() * l * l * l / b2
     };
     Ok(CriticalLoad {
         load_factor,

@@ -123,9 +123,9 @@ pub fn coefficients(rod: &Rod, samples: &[RodSample]) -> Vec<FormCoefficients> {
         .map(|p| {
             let frame = nalgebra::Matrix3::from_columns(&p.directors);
             let body_force = frame.transpose() * p.force;
-            let h = rod.energy.stiffness(p.s, &p.curvature);
+            let h = rod.energy().stiffness(p.s, &p.curvature);
             let compliance = rod
-                .energy
+                .energy()
                 .shear_stiffness(p.s)
                 .map_or_else(Vector3::zeros, |s| s.map(|v| 1.0 / v));
             FormCoefficients::sheared(&h, &p.curvature, &p.moment, &body_force, &compliance)
@@ -165,8 +165,8 @@ pub fn block_spectrum(
 /// Rejects, too, the shear-strain elimination under a held position (the
 /// constraint would couple the strain across the rod).
 pub fn check_conservative(rod: &Rod) -> Result<(), StabilityError> {
-    let couple = rod.loads.tip_couple;
-    let held = match rod.support.as_ref().map(|s| s.rotation) {
+    let couple = rod.loads().tip_couple;
+    let held = match rod.support().as_ref().map(|s| s.rotation) {
         Some(Freedom::Fixed) => true,
         Some(Freedom::Axial(a)) => (couple - a * couple.dot(&a)).norm() <= 1e-12 * couple.norm(),
         _ => false,
@@ -179,8 +179,8 @@ pub fn check_conservative(rod: &Rod) -> Result<(), StabilityError> {
                 .into(),
         ));
     }
-    let shear = rod.energy.shear_stiffness(0.0).is_some();
-    if shear && rod.support.as_ref().is_some_and(|s| s.holds_position()) {
+    let shear = rod.energy().shear_stiffness(0.0).is_some();
+    if shear && rod.support().as_ref().is_some_and(|s| s.holds_position()) {
         return Err(StabilityError::Unsupported(
             "the stability of a shearable rod with a held tip position is not implemented \
              (the shear strain can no longer be minimized out pointwise)"
@@ -199,7 +199,7 @@ pub fn support_constraints(
     samples: &[RodSample],
     tip: &RodSample,
 ) -> Constraints {
-    match &rod.support {
+    match &rod.support() {
         Some(support) => fe.support_constraints(block, support, samples, tip),
         None => Constraints::none(fe.size(block)),
     }
@@ -214,10 +214,10 @@ pub fn analyze(
 ) -> Result<Stability, StabilityError> {
     check_conservative(rod)?;
     opts.check()?;
-    let fe = FiniteElements::new(rod.length, opts.elements, opts.order)
-        .with_hinged_base(rod.clamp.hinge);
+    let fe = FiniteElements::new(rod.length(), opts.elements, opts.order)
+        .with_hinged_base(rod.clamp().hinge);
     let mut points = fe.quadrature_points();
-    points.push(rod.length);
+    points.push(rod.length());
     let mut samples = eq.resample(rod, solver, &points)?;
     let tip = samples.pop().expect("the tip sample");
     let coeffs = coefficients(rod, &samples);

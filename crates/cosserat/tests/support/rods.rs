@@ -10,13 +10,8 @@ use nalgebra::Vector3;
 /// A rod of `length` with the uniform stiffnesses `b` = (B1, B2, B3) under
 /// `loads`.
 pub fn uniform(length: f64, b: [f64; 3], loads: DeadLoads) -> Rod {
-    Rod {
-        length,
-        energy: Arc::new(LinearElastic::uniform(b, [0.0; 3])),
-        clamp: Clamp::paper(),
-        loads,
-        support: None,
-    }
+    let energy = LinearElastic::uniform(b, [0.0; 3]).expect("a positive stiffness");
+    Rod::new(length, Arc::new(energy), Clamp::paper(), loads, None).expect("a valid rod")
 }
 
 /// Dead loads of a tip force alone.

@@ -108,7 +108,7 @@ impl Problem {
         let file: ProblemFile = strict::parse(&text)?;
         let rod = build_rod(&file, catalog)?;
         let model = choose_model(&rod, &file.solver.model, file.energy.shear.is_some())?;
-        if rod.clamp.hinge && model.level != ModelLevel::Planar {
+        if rod.clamp().hinge && model.level != ModelLevel::Planar {
             return Err(invalid(
                 "clamp.hinge",
                 format!(

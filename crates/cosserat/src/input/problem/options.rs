@@ -48,7 +48,7 @@ pub(super) fn build_continuation(
         // A fixed shape's κ⁰ follows from the load; continuation needs a
         // rod with one κ⁰: only shapes on which the loads make no moment
         // (κ⁰ = φ', e.g. a straight column under an axial load) qualify.
-        let fe_points: Vec<f64> = (0..=64).map(|i| rod.length * i as f64 / 64.0).collect();
+        let fe_points: Vec<f64> = (0..=64).map(|i| rod.length() * i as f64 / 64.0).collect();
         let moment = shape
             .samples(rod, &fe_points)
             .map_err(|e| invalid("shape", e.to_string()))?
@@ -67,7 +67,13 @@ pub(super) fn build_continuation(
     let mut base = rod.clone();
     if parameter == Parameter::ClampAngle {
         // The parameter is the absolute angle: start from the unturned frame.
-        base.clamp.frame = rod.clamp.turned_frame(-file.clamp.angle);
+        let mut clamp = rod.clamp().clone();
+        clamp.frame = clamp
+            .turned_frame(-file.clamp.angle)
+            .map_err(|e| invalid("clamp.angle", e.to_string()))?;
+        base = base
+            .with_clamp(clamp)
+            .map_err(|e| invalid("clamp.angle", e.to_string()))?;
     }
     let family = match stages {
         None => Family::new(base, parameter, model.level, segments, options.integration),
@@ -125,7 +131,7 @@ pub(super) fn build_shape(file: &ProblemFile) -> Result<Option<FixedShape>, Prob
 /// (three held translations, three held rotations).
 pub(crate) fn fewest_block_unknowns(opts: &StabilityOptions, rod: &Rod) -> usize {
     let nodes = opts.elements.saturating_mul(opts.order);
-    if rod.support.is_some() {
+    if rod.support().is_some() {
         nodes.saturating_sub(6)
     } else {
         nodes
@@ -150,7 +156,7 @@ pub(super) fn eigenvalue_count(
                 opts.eigenvalues,
                 opts.elements,
                 opts.order,
-                if rod.support.is_some() {
+                if rod.support().is_some() {
                     " (elements × order, less six held by the support)"
                 } else {
                     " (elements × order)"

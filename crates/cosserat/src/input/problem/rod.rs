@@ -13,8 +13,8 @@ use super::checks::{finite, load_vector, magnitude, vector};
 use super::sections::{ClampSection, EnergySection, ProblemFile, ProfileSpec};
 use super::{invalid, ProblemError};
 use crate::model::{
-    Clamp, DeadLoads, EnergyCatalog, EnergySpec, ModelChoice, ModelLevel, Profile, Rod, Shearable,
-    StoredEnergy,
+    Clamp, DeadLoads, EnergyCatalog, EnergySpec, ModelChoice, ModelError, ModelLevel, Profile, Rod,
+    Shearable, StoredEnergy,
 };
 
 pub(super) fn profile(field: &str, spec: &ProfileSpec) -> Result<Profile, ProblemError> {
@@ -43,10 +43,9 @@ pub(super) fn profile(field: &str, spec: &ProfileSpec) -> Result<Profile, Proble
             if !s.windows(2).all(|w| w[1] > w[0]) {
                 return Err(invalid(format!("{field}.s"), "must be strictly increasing"));
             }
-            Profile::Table {
-                s: s.clone(),
-                values: values.clone(),
-            }
+            // Shape checked above with its keys; a refusal all the same is
+            // named by the profile's key.
+            Profile::table(s.clone(), values.clone()).map_err(|e| invalid(field, e.to_string()))?
         }
     };
     if !p.is_finite() {
@@ -94,10 +93,16 @@ pub(super) fn build_rod(file: &ProblemFile, catalog: &EnergyCatalog) -> Result<R
             file.solver.model.as_str(),
             "planar" | "kirchhoff" | "spatial"
         ) {
-            energy = Arc::new(Shearable {
-                bending: energy,
-                shear: shear_stiffness(shear)?,
-            });
+            // Checked by shear_stiffness with its keys; a refusal all the
+            // same names the component.
+            energy = Arc::new(Shearable::new(energy, shear_stiffness(shear)?).map_err(
+                |e| match e {
+                    ModelError::Stiffness { index, .. } => {
+                        invalid(format!("energy.shear[{index}]"), e.to_string())
+                    }
+                    _ => invalid("energy.shear", e.to_string()),
+                },
+            )?);
         }
     }
     let clamp = build_clamp(&file.clamp)?;
@@ -106,20 +111,33 @@ pub(super) fn build_rod(file: &ProblemFile, catalog: &EnergyCatalog) -> Result<R
         .as_ref()
         .map(|s| s.build(&clamp, length))
         .transpose()?;
-    Ok(Rod {
-        length,
-        energy,
-        clamp,
-        loads: DeadLoads {
-            tip_force: load_vector("loads.tip_force", file.loads.tip_force)?,
-            tip_couple: load_vector("loads.tip_couple", file.loads.tip_couple)?,
-            distributed_force: load_vector(
-                "loads.distributed_force",
-                file.loads.distributed_force,
-            )?,
+    let loads = DeadLoads {
+        tip_force: load_vector("loads.tip_force", file.loads.tip_force)?,
+        tip_couple: load_vector("loads.tip_couple", file.loads.tip_couple)?,
+        distributed_force: load_vector("loads.distributed_force", file.loads.distributed_force)?,
+    };
+    // Every value was checked above with its key and message; a refusal
+    // all the same is named by the key it comes from.
+    Rod::new(length, energy, clamp, loads, support)
+        .map_err(|e| invalid(model_key(&e), e.to_string()))
+}
+
+/// The problem-file key a refused model value comes from.
+fn model_key(e: &ModelError) -> &'static str {
+    match e {
+        ModelError::Length(_) => "rod.length",
+        ModelError::NotFinite { what, .. } => match *what {
+            "tip force" => "loads.tip_force",
+            "tip couple" => "loads.tip_couple",
+            "distributed force" => "loads.distributed_force",
+            "clamp position" => "clamp.position",
+            "support position" => "support.position",
+            _ => "support.axis",
         },
-        support,
-    })
+        ModelError::Axis { .. } => "support.axis",
+        ModelError::Frame { .. } => "clamp.d3",
+        _ => "energy",
+    }
 }
 
 /// S = (k G A, k G A, E A): positive and finite.
@@ -268,9 +286,13 @@ pub(super) fn build_clamp(c: &ClampSection) -> Result<Clamp, ProblemError> {
         ));
     }
     let angle = finite("clamp.angle", c.angle)?;
-    let clamp = Clamp::new(position, d1, d3);
+    // Unit and orthogonal to 1e-9 above, so within Frame::TOLERANCE; a
+    // frame refused all the same is named by its directors.
+    let clamp = Clamp::new(position, d1, d3).map_err(|e| invalid("clamp.d3", e.to_string()))?;
     Ok(Clamp {
-        frame: clamp.turned_frame(angle),
+        frame: clamp
+            .turned_frame(angle)
+            .map_err(|e| invalid("clamp.angle", e.to_string()))?,
         hinge: c.hinge,
         ..clamp
     })

@@ -48,7 +48,7 @@ pub fn control_path_until(
     points: usize,
     stop: &dyn Fn() -> bool,
 ) -> Result<Diagram, ContinuationError> {
-    let rod = designed_rod(problem, scene, design, points);
+    let rod = designed_rod(problem, scene, design, points).map_err(not_built)?;
     continue_to_design(problem, rod, Parameter::ControlScale, stop)
 }
 
@@ -72,7 +72,7 @@ pub fn loading_path_until(
     points: usize,
     stop: &dyn Fn() -> bool,
 ) -> Result<Diagram, ContinuationError> {
-    let rod = designed_rod(problem, scene, design, points);
+    let rod = designed_rod(problem, scene, design, points).map_err(not_built)?;
     continue_to_design(problem, rod, Parameter::LoadScale, stop)
 }
 
@@ -102,27 +102,36 @@ pub fn shape_holding_path_until(
     points: usize,
     stop: &dyn Fn() -> bool,
 ) -> Result<Diagram, ContinuationError> {
-    let target = designed_rod(problem, scene, design, points);
+    let target = designed_rod(problem, scene, design, points).map_err(not_built)?;
     let s: Vec<f64> = (0..points)
         .map(|i| i as f64 / (points - 1) as f64)
         .collect();
     let dphi = derivative(&design.shape_coefficients);
     let unloaded: Vec<f64> = s.iter().map(|t| polynomial(&dphi, *t)).collect();
-    let mut base = target.clone();
-    base.energy = Arc::new(LinearElastic {
-        stiffness: [problem.b1, 1.0, problem.b3].map(Profile::Constant),
-        intrinsic_curvature: [
+    let unloaded = LinearElastic::new(
+        [problem.b1, 1.0, problem.b3].map(Profile::Constant),
+        [
             Profile::Constant(0.0),
-            Profile::spline(s, unloaded),
+            Profile::spline(s, unloaded).map_err(not_built)?,
             Profile::Constant(0.0),
         ],
-    });
+    )
+    .map_err(not_built)?;
+    let base = target.clone().with_energy(Arc::new(unloaded));
     let family = Family::towards(
         base,
-        target.energy,
+        target.energy().clone(),
         ModelLevel::Planar,
         32,
         crate::numerics::integrator::Tolerances::default(),
     );
     continue_family(problem, &family, stop)
+}
+
+/// A designed rod that cannot be built: continuation cannot start.
+fn not_built(e: crate::model::ModelError) -> ContinuationError {
+    ContinuationError::Start {
+        p: 0.0,
+        message: format!("the designed rod cannot be built: {e}"),
+    }
 }

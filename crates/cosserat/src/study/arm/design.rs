@@ -9,6 +9,7 @@
 //! polynomial helpers and the unloaded shape of the intrinsic curvature
 //! κ̄⁰2 = φ' − γ m̄2 (paper (43)).
 
+use crate::model::ModelError;
 use std::sync::Arc;
 
 use crate::model::{Clamp, LinearElastic, Profile, Rod};
@@ -54,20 +55,22 @@ impl ArmProblem {
     }
 
     /// The non-dimensional rod: L = 1, B = (B̄1, 1, B̄3), a unit tip load
-    /// pulling down (e1), clamped at the origin with d3 horizontal.
-    pub fn rod(&self) -> Rod {
+    /// pulling down (e1), clamped at the origin with d3 horizontal; refused
+    /// as in [`Rod::new`].
+    pub fn rod(&self) -> Result<Rod, ModelError> {
         self.rod_in(&ArmScene::default())
     }
 
-    /// The non-dimensional rod under the scene's loads per unit λ.
-    pub fn rod_in(&self, scene: &ArmScene) -> Rod {
-        Rod {
-            length: 1.0,
-            energy: Arc::new(LinearElastic::uniform([self.b1, 1.0, self.b3], [0.0; 3])),
-            clamp: Clamp::paper(),
-            loads: scene.loads(),
-            support: None,
-        }
+    /// The non-dimensional rod under the scene's loads per unit λ; refused
+    /// as in [`Rod::new`] (a non-finite weight).
+    pub fn rod_in(&self, scene: &ArmScene) -> Result<Rod, ModelError> {
+        Rod::new(
+            1.0,
+            Arc::new(LinearElastic::uniform([self.b1, 1.0, self.b3], [0.0; 3])?),
+            Clamp::paper(),
+            scene.loads(),
+            None,
+        )
     }
 
     /// The full coefficients c1..cM: c1 turns the shape so that the tip
@@ -96,7 +99,7 @@ impl ArmProblem {
     /// can hold when |κ⁰| is limited; R̂ = L̂(λ) |r̄(1)|.
     pub fn design_in(&self, scene: &ArmScene, rest: &[f64]) -> Option<ArmDesign> {
         let (c, chord) = self.full_coefficients(rest);
-        let rod = self.rod_in(scene);
+        let rod = self.rod_in(scene).ok()?;
         let shape = FixedShape {
             turning_angle: Profile::Polynomial(c.clone()),
         };
@@ -147,8 +150,10 @@ pub(super) fn intrinsic_shape(phi0: f64, s: &[f64], kappa0: &[f64], scale: f64) 
 pub(super) fn least_squares_polynomial(s: &[f64], y: &[f64], m: usize) -> Vec<f64> {
     let a = nalgebra::DMatrix::from_fn(s.len(), m, |i, j| s[i].powi(j as i32));
     let b = nalgebra::DVector::from_column_slice(y);
+    // SVD::solve fails only when U or Vᵀ was not computed; both are, so
+    // no failure can turn into numbers here (it had been NaN coefficients).
     a.svd(true, true)
         .solve(&b, 1e-14)
         .map(|v| v.as_slice().to_vec())
-        .unwrap_or_else(|_| vec![f64::NAN; m])
+        .expect("the SVD was computed with U and Vᵀ")
 }

@@ -145,14 +145,15 @@ pub struct SearchProgress {
 /// The rod of a design at its design load: the intrinsic curvature κ̄⁰2 of
 /// (43) as a natural cubic spline through `points` nodes (exact at the
 /// nodes), the clamp turned by c1 (the design's tangent at s = 0), the
-/// scene's loads scaled by the design load.
+/// scene's loads scaled by the design load; refused as in [`Rod::new`]
+/// (a non-finite design load or weight).
 pub fn designed_rod(
     problem: &ArmProblem,
     scene: &ArmScene,
     design: &ArmDesign,
     points: usize,
-) -> Rod {
-    let rod0 = problem.rod_in(scene);
+) -> Result<Rod, crate::model::ModelError> {
+    let rod0 = problem.rod_in(scene)?;
     let shape = FixedShape {
         turning_angle: Profile::Polynomial(design.shape_coefficients.clone()),
     };
@@ -167,18 +168,19 @@ pub fn designed_rod(
         .iter()
         .map(|p| polynomial(&dphi, p.s) - design.gamma * p.moment[1])
         .collect();
-    let mut rod = rod0.clone();
-    rod.energy = Arc::new(LinearElastic {
-        stiffness: [problem.b1, 1.0, problem.b3].map(Profile::Constant),
-        intrinsic_curvature: [
+    let rod = rod0.clone();
+    let energy = Arc::new(LinearElastic::new(
+        [problem.b1, 1.0, problem.b3].map(Profile::Constant),
+        [
             Profile::Constant(0.0),
-            Profile::spline(s, kappa0),
+            Profile::spline(s, kappa0)?,
             Profile::Constant(0.0),
         ],
-    });
-    rod.clamp.frame = rod.clamp.turned_frame(c[0]);
-    rod.loads = rod.loads.scaled(design.gamma);
-    rod
+    )?);
+    let mut clamp = rod.clamp().clone();
+    clamp.frame = clamp.turned_frame(c[0])?;
+    let loads = rod.loads().scaled(design.gamma);
+    rod.with_energy(energy).with_clamp(clamp)?.with_loads(loads)
 }
 
 /// Continues the designed rod in `parameter` from nearly 0 to 1 (the

@@ -17,7 +17,9 @@ use super::{
 };
 
 impl ArmProblem {
-    /// Clamps a point into the bounds.
+    /// Clamps a point into the bounds: the projection of Nelder–Mead's
+    /// moves onto the search box `arm.bounds` (the domain of the search,
+    /// not a change of a value the user gave).
     pub(super) fn project(&self, p: &[f64]) -> Vec<f64> {
         p.iter()
             .zip(&self.bounds)
@@ -216,7 +218,7 @@ impl ArmProblem {
         design: ArmDesign,
         evaluations: usize,
     ) -> Option<ArmOptimum> {
-        let rod = self.rod_in(scene);
+        let rod = self.rod_in(scene).ok()?;
         let shape = FixedShape {
             turning_angle: Profile::Polynomial(design.shape_coefficients.clone()),
         };

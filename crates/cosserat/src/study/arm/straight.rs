@@ -58,11 +58,12 @@ impl StraightLimit {
 
 impl ArmProblem {
     /// The straight rod at load γ with the clamp turned by θ.
-    fn straight_rod(&self, gamma: f64, theta: f64) -> Rod {
-        let mut rod = self.rod();
-        rod.loads = rod.loads.scaled(gamma);
-        rod.clamp.frame = rod.clamp.turned_frame(theta);
-        rod
+    fn straight_rod(&self, gamma: f64, theta: f64) -> Option<Rod> {
+        let rod = self.rod().ok()?;
+        let loads = rod.loads().scaled(gamma);
+        let mut clamp = rod.clamp().clone();
+        clamp.frame = clamp.turned_frame(theta).ok()?;
+        rod.with_loads(loads).ok()?.with_clamp(clamp).ok()
     }
 
     /// The equilibrium at (γ, θ), warm-started from a neighbouring one's
@@ -75,7 +76,7 @@ impl ArmProblem {
         theta: f64,
         guess: Option<&[f64]>,
     ) -> Option<(crate::bvp::Equilibrium, f64)> {
-        let rod = self.straight_rod(gamma, theta);
+        let rod = self.straight_rod(gamma, theta)?;
         let choice = crate::model::ModelChoice::for_rod(&rod);
         let opts = crate::bvp::SolverOptions {
             method: crate::bvp::Method::Shooting,
@@ -158,7 +159,7 @@ impl ArmProblem {
             |gamma: f64, eq: &crate::bvp::Equilibrium| gamma.sqrt() * eq.tip().position.norm();
         let level = |gamma: f64, from: &Level| -> Option<(bool, Level, f64)> {
             let (theta, eq) = self.level_clamp(gamma, from.0, Some(&from.1))?;
-            let rod = self.straight_rod(gamma, theta);
+            let rod = self.straight_rod(gamma, theta)?;
             let st = crate::stability::analyze(&rod, &eq, &opts, &self.stability).ok()?;
             Some((
                 st.stable,
