@@ -10,7 +10,7 @@
 //! small Newton correction, each unknown measured against its own
 //! magnitude.
 
-use nalgebra::{DMatrix, DVector, Dyn, LU};
+use nalgebra::{DMatrix, DVector};
 
 use crate::numerics::integrator::IntegrationError;
 use crate::numerics::newton::{self as numerics_newton, Damping, NewtonError, Options, System};
@@ -110,7 +110,7 @@ struct Dense<'a, S: NonlinearSystem> {
     /// J of the last evaluation (at the iterate once Newton linearizes).
     jac: DMatrix<f64>,
     /// LU of J at the current iterate.
-    lu: Option<LU<f64, Dyn, Dyn>>,
+    lu: crate::numerics::dense::DenseLu,
 }
 
 impl<S: NonlinearSystem> System for Dense<'_, S> {
@@ -127,19 +127,12 @@ impl<S: NonlinearSystem> System for Dense<'_, S> {
     }
 
     fn linearize(&mut self, _x: &[f64]) -> bool {
-        self.lu = Some(self.jac.clone().lu());
+        self.lu.factor(&self.jac);
         true
     }
 
     fn solve(&mut self, f: &[f64], delta: &mut [f64]) -> bool {
-        let rhs = -DVector::from_column_slice(f);
-        match self.lu.as_ref().and_then(|lu| lu.solve(&rhs)) {
-            Some(d) => {
-                delta.copy_from_slice(d.as_slice());
-                true
-            }
-            None => false,
-        }
+        self.lu.newton_step(f, delta)
     }
 
     fn unknown_scales(&self) -> Vec<f64> {
@@ -158,7 +151,7 @@ pub fn solve<S: NonlinearSystem>(
         system,
         r: DVector::zeros(n),
         jac: DMatrix::zeros(n, n),
-        lu: None,
+        lu: crate::numerics::dense::DenseLu::default(),
     };
     let mut x = x0.to_vec();
     let report = numerics_newton::solve(&mut dense, &mut x, &opts.damped())?;

@@ -37,7 +37,7 @@ struct FixedParameter<'a> {
     p: f64,
     r: DVector<f64>,
     fx: DMatrix<f64>,
-    lu: Option<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>>,
+    lu: crate::numerics::dense::DenseLu,
 }
 
 impl<'a> FixedParameter<'a> {
@@ -47,7 +47,7 @@ impl<'a> FixedParameter<'a> {
             p,
             r: DVector::zeros(n),
             fx: DMatrix::zeros(n, n),
-            lu: None,
+            lu: crate::numerics::dense::DenseLu::default(),
         }
     }
 }
@@ -66,19 +66,12 @@ impl System for FixedParameter<'_> {
     }
 
     fn linearize(&mut self, _x: &[f64]) -> bool {
-        self.lu = Some(self.fx.clone().lu());
+        self.lu.factor(&self.fx);
         true
     }
 
     fn solve(&mut self, f: &[f64], delta: &mut [f64]) -> bool {
-        let rhs = -DVector::from_column_slice(f);
-        match self.lu.as_ref().and_then(|lu| lu.solve(&rhs)) {
-            Some(d) => {
-                delta.copy_from_slice(d.as_slice());
-                true
-            }
-            None => false,
-        }
+        self.lu.newton_step(f, delta)
     }
 }
 

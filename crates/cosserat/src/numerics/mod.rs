@@ -8,6 +8,7 @@
 //! `bvp::newton::Convergence` remain as re-exports.
 
 pub mod banded;
+pub mod dense;
 pub mod integrator;
 pub mod newton;
 pub mod quadrature;
