@@ -230,7 +230,7 @@ impl<'a> Run<'a> {
         // The point's own tip angle, measured against its clamp when the
         // point was made.
         match self.opts.tip_angle_limit {
-            Some(limit) if point.tip_angle >= limit => {
+            Some(limit) if point.tip_angle >= limit - super::landing::ANGLE_TOLERANCE => {
                 Some(BranchEnd::TipAngle(point.tip_angle.to_degrees()))
             }
             _ => None,
@@ -325,7 +325,7 @@ impl<'a> Run<'a> {
                 return end(specials, reason, false);
             }
             let (x, p, tangent, iterations) = match self.step(&last, sign, ds) {
-                Ok(Some(stepped)) => stepped,
+                Ok(Some(stepped)) => self.land_on_tip_angle(&last, sign, ds, stepped),
                 Ok(None) => {
                     ds *= 0.5;
                     if ds < self.opts.min_step {

@@ -27,6 +27,7 @@ mod diagram;
 mod driver;
 mod events;
 mod family;
+mod landing;
 mod options;
 mod resume;
 mod status;
