@@ -21,7 +21,7 @@ use cosserat::model::{ModelChoice, ModelLevel};
 use cosserat_cli::bench::scenes;
 
 fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(|a, b| a.total_cmp(b));
+    v.sort_by(f64::total_cmp);
     v[v.len() / 2]
 }
 

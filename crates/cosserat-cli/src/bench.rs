@@ -199,7 +199,7 @@ fn sweeps() -> Vec<(String, f64, SolverOptions)> {
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(|a, b| a.total_cmp(b));
+    v.sort_by(f64::total_cmp);
     v[v.len() / 2]
 }
 

@@ -92,31 +92,28 @@ pub fn run_stability(
         "mesh      {} elements of order {}",
         opts.elements, opts.order
     );
-    let result = match &problem.shape {
-        Some(shape) => match critical_load(&problem.rod, shape, opts) {
-            Ok(c) => {
-                report_critical(&c);
-                StabilityResult::FixedShape(c)
+    let result = if let Some(shape) = &problem.shape { match critical_load(&problem.rod, shape, opts) {
+        Ok(c) => {
+            report_critical(&c);
+            StabilityResult::FixedShape(c)
+        }
+        Err(e) => return fail(NO_RESULT, e),
+    } } else {
+        println!(
+            "model     {} ({})",
+            problem.model.level.name(),
+            problem.model.reason
+        );
+        let eq = match solve(&problem.rod, &problem.model, &problem.options) {
+            Ok(eq) => eq,
+            Err(e) => return solve_failed(&e),
+        };
+        match analyze(&problem.rod, &eq, &problem.options, opts) {
+            Ok(st) => {
+                report_spectrum(&st);
+                StabilityResult::Equilibrium(Box::new(eq), st)
             }
             Err(e) => return fail(NO_RESULT, e),
-        },
-        None => {
-            println!(
-                "model     {} ({})",
-                problem.model.level.name(),
-                problem.model.reason
-            );
-            let eq = match solve(&problem.rod, &problem.model, &problem.options) {
-                Ok(eq) => eq,
-                Err(e) => return solve_failed(&e),
-            };
-            match analyze(&problem.rod, &eq, &problem.options, opts) {
-                Ok(st) => {
-                    report_spectrum(&st);
-                    StabilityResult::Equilibrium(Box::new(eq), st)
-                }
-                Err(e) => return fail(NO_RESULT, e),
-            }
         }
     };
     if let Some(out) = output {

@@ -118,7 +118,7 @@ fn prepare(args: &SweepArgs) -> Result<Option<Setup>, ExitCode> {
 
 /// The worker threads asked for (0: one per core), at most four per core.
 fn threads(asked: Option<u16>) -> Result<usize, ExitCode> {
-    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let cores = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
     match asked.map(usize::from) {
         None => Ok(0),
         Some(n) if n <= 4 * cores => Ok(n),
@@ -346,7 +346,7 @@ fn rayon_threads(asked: usize) -> usize {
     if asked > 0 {
         asked
     } else {
-        std::thread::available_parallelism().map_or(1, |n| n.get())
+        std::thread::available_parallelism().map_or(1, std::num::NonZero::get)
     }
 }
 

@@ -395,10 +395,10 @@ fn compare(
             if let Some(c) = row.computed {
                 let abs = (c - reference).abs();
                 row.absolute_error = Some(abs);
-                row.relative_error = Some(if reference != 0.0 {
-                    abs / reference.abs()
-                } else {
+                row.relative_error = Some(if reference == 0.0 {
                     abs
+                } else {
+                    abs / reference.abs()
                 });
                 row.status = match check.tolerance {
                     Some(t) => {

@@ -190,7 +190,7 @@ pub(crate) fn hostile_output(rng: &mut Rng, ext: &str) -> (String, Vec<Prepared>
         5 => (format!("with space and ünïcode.{ext}"), vec![], true),
         6 => (format!("new\nline.{ext}"), vec![], true),
         7 => (format!("{}.{ext}", "x".repeat(4000)), vec![], false),
-        8 => ("".into(), vec![], false),
+        8 => (String::new(), vec![], false),
         9 => (
             format!("exists.{ext}"),
             vec![Prepared::File(
@@ -273,7 +273,7 @@ pub(crate) fn case(id: usize, seed: u64, seeds: &[(String, String)], fx: &Fixtur
             "-o".into(),
             "out.h5".into(),
         ];
-        args.extend(set.iter().map(|s| s.to_string()));
+        args.extend(set.iter().map(std::string::ToString::to_string));
         return Case {
             id,
             what: format!("{} {file} {}", verb.name(), set.join(" ")),

@@ -42,7 +42,7 @@ fn inconsistent_result_files_are_named_errors() {
         (
             "d.h5",
             Box::new(|p: &Path| {
-                replace_dataset(p, "branches/0/tip_position", &[1.0f64, 2.0, 3.0, 4.0])
+                replace_dataset(p, "branches/0/tip_position", &[1.0f64, 2.0, 3.0, 4.0]);
             }),
             vec!["plot", "d.h5", "-o", "f.png"],
         ),

@@ -168,7 +168,7 @@ pub(crate) fn mutate(rng: &mut Rng, text: &str) -> (Vec<u8>, String) {
     let lines: Vec<&str> = text.lines().collect();
     let assigned = assignments(&lines);
     let rebuild = |lines: &[String]| lines.join("\n").into_bytes();
-    let mut owned: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
+    let mut owned: Vec<String> = lines.iter().map(std::string::ToString::to_string).collect();
     match rng.below(10) {
         0 | 1 => {
             // A number replaced by an extreme.
@@ -212,7 +212,7 @@ pub(crate) fn mutate(rng: &mut Rng, text: &str) -> (Vec<u8>, String) {
             } else {
                 match l[..close].rfind(',') {
                     Some(c) => format!("{}{}", &l[..c], &l[close..]),
-                    None => format!("{}[]", &l[..l.find('=').unwrap() + 1]),
+                    None => format!("{}[]", &l[..=l.find('=').unwrap()]),
                 }
             };
             let how = if longer { "longer" } else { "shorter" };
@@ -284,7 +284,7 @@ pub(crate) fn overrides(rng: &mut Rng, text: &str) -> Vec<String> {
     if keys.is_empty() {
         return out;
     }
-    for _ in 0..1 + rng.below(2) {
+    for _ in 0..=rng.below(2) {
         let key = rng.pick(&keys);
         let value = if rng.chance(0.75) {
             rng.pick(&EXTREMES).to_string()

@@ -197,7 +197,7 @@ mod tests {
     #[test]
     fn solve_matches_dense() {
         let a = sample(40, 3, 0.5);
-        let x: Vec<f64> = (0..40).map(|i| (i as f64).cos()).collect();
+        let x: Vec<f64> = (0..40).map(|i| f64::from(i).cos()).collect();
         let mut b = vec![0.0; 40];
         a.matvec(&x, &mut b);
         let dense = a.to_dense() * nalgebra::DVector::from_vec(x.clone());

@@ -172,26 +172,23 @@ pub fn lowest_eigenpairs_near(
             .ok()
             .filter(|f| f.negative_pivots() == 0)
     };
-    let (sigma, shifted) = match guess.and_then(|s| positive(s).map(|f| (s, f))) {
-        Some(found) => found,
-        None => {
-            // Sturm bisection; should σ sit on an eigenvalue to round-off,
-            // step further down.
-            let mut sigma = shift_below_spectrum(k, g);
-            let step = FLOOR * diagonal_ratio(k, g);
-            let mut factored = positive(sigma);
-            for _ in 0..8 {
-                if factored.is_some() {
-                    break;
-                }
-                sigma -= step;
-                factored = positive(sigma);
+    let (sigma, shifted) = if let Some(found) = guess.and_then(|s| positive(s).map(|f| (s, f))) { found } else {
+        // Sturm bisection; should σ sit on an eigenvalue to round-off,
+        // step further down.
+        let mut sigma = shift_below_spectrum(k, g);
+        let step = FLOOR * diagonal_ratio(k, g);
+        let mut factored = positive(sigma);
+        for _ in 0..8 {
+            if factored.is_some() {
+                break;
             }
-            let f = factored.ok_or_else(|| {
-                EigenError::NotDefinite(format!("K − σG is not positive definite near σ = {sigma}"))
-            })?;
-            (sigma, f)
+            sigma -= step;
+            factored = positive(sigma);
         }
+        let f = factored.ok_or_else(|| {
+            EigenError::NotDefinite(format!("K − σG is not positive definite near σ = {sigma}"))
+        })?;
+        (sigma, f)
     };
     let apply = |x: &[f64], y: &mut [f64]| {
         g.matvec(x, y);

@@ -194,11 +194,7 @@ impl FiniteElements {
     /// The first node carrying unknowns of a block: 0 where the base lets
     /// the block's rotation free, 1 at a clamp.
     fn first_node(&self, block: Block) -> usize {
-        if self.hinged && block == Block::InPlane {
-            0
-        } else {
-            1
-        }
+        usize::from(!(self.hinged && block == Block::InPlane))
     }
 
     /// Element size.

@@ -41,7 +41,7 @@ fn lu_sized<const D: usize>(a: &mut [f64], piv: &mut [usize]) -> bool {
 
 /// [`dense_solve`] for a dimension known at compile time.
 fn solve_sized<const D: usize>(a: &[f64], piv: &[usize], b: &mut [f64]) {
-    solve_any(&a[..D * D], D, &piv[..D], &mut b[..D])
+    solve_any(&a[..D * D], D, &piv[..D], &mut b[..D]);
 }
 
 /// [`dense_lu`] for any dimension.

@@ -85,7 +85,7 @@ impl ArmProblem {
             } else {
                 crate::bvp::Strategy::Auto
             },
-            initial_guess: guess.map(|g| g.to_vec()),
+            initial_guess: guess.map(<[f64]>::to_vec),
             output_points: 101,
             // The elevation must be met to 1e-12 by the secant in θ, also
             // near Euler's load where the column amplifies residuals.
