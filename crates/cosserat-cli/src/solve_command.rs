@@ -92,13 +92,15 @@ pub fn run_stability(
         "mesh      {} elements of order {}",
         opts.elements, opts.order
     );
-    let result = if let Some(shape) = &problem.shape { match critical_load(&problem.rod, shape, opts) {
-        Ok(c) => {
-            report_critical(&c);
-            StabilityResult::FixedShape(c)
+    let result = if let Some(shape) = &problem.shape {
+        match critical_load(&problem.rod, shape, opts) {
+            Ok(c) => {
+                report_critical(&c);
+                StabilityResult::FixedShape(c)
+            }
+            Err(e) => return fail(NO_RESULT, e),
         }
-        Err(e) => return fail(NO_RESULT, e),
-    } } else {
+    } else {
         println!(
             "model     {} ({})",
             problem.model.level.name(),

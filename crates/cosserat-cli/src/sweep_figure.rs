@@ -132,7 +132,9 @@ fn curves(header: &SweepHeader, records: &[Record], a: usize, column: &str) -> V
         let mut key = idx.clone();
         key[a] = 0;
         let point = (reach * alpha.cos(), reach * alpha.sin());
-        if let Some((_, (_, pts))) = out.iter_mut().find(|(k, _)| *k == key) { pts.push(point) } else {
+        if let Some((_, (_, pts))) = out.iter_mut().find(|(k, _)| *k == key) {
+            pts.push(point)
+        } else {
             let label = (0..idx.len())
                 .filter(|&j| j != a)
                 .map(|j| format!("{} = {:.3}", header.keys[j], header.axes[j][idx[j]]))

@@ -481,7 +481,9 @@ fn solve_at(
         return Ok(Solved::Collocation(sol));
     }
     let mut sys = ShootingSystem::new(eq.as_ref(), opts.method.segments(), opts.integration);
-    let x0 = if let Some(Solved::Shooting { x, .. }) = warm { x.clone() } else {
+    let x0 = if let Some(Solved::Shooting { x, .. }) = warm {
+        x.clone()
+    } else {
         let u = guess(eq.as_ref())?;
         sys.initial_unknowns(&u)
     };

@@ -108,7 +108,9 @@ impl Tracker {
         // One integration for the quadrature points and the 21 shape points
         // (the last is the tip).
         let quadrature = fe.quadrature_points();
-        let grid: Vec<f64> = (0..21).map(|i| rod.length() * f64::from(i) / 20.0).collect();
+        let grid: Vec<f64> = (0..21)
+            .map(|i| rod.length() * f64::from(i) / 20.0)
+            .collect();
         let mut all: Vec<(f64, bool)> = quadrature
             .iter()
             .map(|&s| (s, true))

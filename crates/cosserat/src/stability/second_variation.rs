@@ -187,6 +187,7 @@ impl FiniteElements {
     /// The same elements for a base that is a hinge about d2(0) (true) or a
     /// clamp (false): with a hinge the in-plane rotation ω2 at s = 0 is an
     /// unknown too.
+    #[must_use]
     pub fn with_hinged_base(self, hinged: bool) -> Self {
         FiniteElements { hinged, ..self }
     }

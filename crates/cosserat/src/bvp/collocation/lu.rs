@@ -45,7 +45,7 @@ fn solve_sized<const D: usize>(a: &[f64], piv: &[usize], b: &mut [f64]) {
 }
 
 /// [`dense_lu`] for any dimension.
-#[inline(always)]
+#[inline]
 fn lu_any(a: &mut [f64], d: usize, piv: &mut [usize]) -> bool {
     for k in 0..d {
         let (mut p, mut best) = (k, a[k * d + k].abs());
@@ -82,7 +82,7 @@ fn lu_any(a: &mut [f64], d: usize, piv: &mut [usize]) -> bool {
 }
 
 /// [`dense_solve`] for any dimension.
-#[inline(always)]
+#[inline]
 fn solve_any(a: &[f64], d: usize, piv: &[usize], b: &mut [f64]) {
     for (k, &p) in piv.iter().enumerate() {
         b.swap(k, p);

@@ -153,8 +153,8 @@ impl ArmProblem {
     /// (checked before every load step): the result is then the farthest
     /// stable level equilibrium found so far, marked interrupted.
     pub fn straight_until(&self, stop: &dyn Fn() -> bool) -> Option<StraightArm> {
-        let opts = crate::bvp::SolverOptions::default();
         type Level = (f64, Vec<f64>);
+        let opts = crate::bvp::SolverOptions::default();
         let reach =
             |gamma: f64, eq: &crate::bvp::Equilibrium| gamma.sqrt() * eq.tip().position.norm();
         let level = |gamma: f64, from: &Level| -> Option<(bool, Level, f64)> {
