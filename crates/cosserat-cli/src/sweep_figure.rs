@@ -133,7 +133,7 @@ fn curves(header: &SweepHeader, records: &[Record], a: usize, column: &str) -> V
         key[a] = 0;
         let point = (reach * alpha.cos(), reach * alpha.sin());
         if let Some((_, (_, pts))) = out.iter_mut().find(|(k, _)| *k == key) {
-            pts.push(point)
+            pts.push(point);
         } else {
             let label = (0..idx.len())
                 .filter(|&j| j != a)
