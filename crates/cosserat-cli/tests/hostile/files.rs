@@ -30,9 +30,9 @@ pub(crate) fn replace_dataset<T: hdf5::H5Type>(path: &Path, name: &str, data: &[
 /// and `--resume`, never a panic or a silently truncated result.
 #[test]
 fn inconsistent_result_files_are_named_errors() {
+    type Damage = Box<dyn Fn(&Path)>;
     let dir = common::run::scratch("hostile", "files");
     let fx = fixtures(&dir);
-    type Damage = Box<dyn Fn(&Path)>;
     let cases: Vec<(&str, Damage, Vec<&str>)> = vec![
         (
             "d.h5",
