@@ -18,16 +18,24 @@ use cosserat::bvp::{
     equations, solve, solve_collocation, CollocationOptions, Discretization, Method, SolverOptions,
 };
 use cosserat::model::{ModelChoice, ModelLevel};
-use cosserat_cli::bench::scenes;
+use cosserat_cli::bench::{scenes, Scene};
 
 fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(|a, b| a.total_cmp(b));
+    v.sort_by(f64::total_cmp);
     v[v.len() / 2]
 }
 
 fn main() {
     let scene = &scenes()[0];
     let choice = ModelChoice::forced(&scene.rod, ModelLevel::Planar).unwrap();
+    time_per_equilibrium(scene, &choice);
+    println!();
+    time_per_newton_step(scene);
+}
+
+/// Every method's time per equilibrium at its loosest setting that
+/// reaches tip error 1e-8.
+fn time_per_equilibrium(scene: &Scene, choice: &ModelChoice) {
     println!("time per equilibrium at tip error <= 1e-8, planar cantilever k = 3");
     let runs: Vec<(&str, SolverOptions)> = vec![
         ("shooting", Method::Shooting),
@@ -73,7 +81,7 @@ fn main() {
                 .collect(),
         };
         for opts in candidates {
-            let Ok(eq) = solve(&scene.rod, &choice, &opts) else {
+            let Ok(eq) = solve(&scene.rod, choice, &opts) else {
                 continue;
             };
             let err = (eq.tip().position - scene.tip).amax();
@@ -83,7 +91,7 @@ fn main() {
             let times: Vec<f64> = (0..51)
                 .map(|_| {
                     let t = Instant::now();
-                    let _ = solve(&scene.rod, &choice, &opts);
+                    let _ = solve(&scene.rod, choice, &opts);
                     t.elapsed().as_secs_f64()
                 })
                 .collect();
@@ -98,8 +106,12 @@ fn main() {
             break;
         }
     }
+}
 
-    println!("\ncollocation time per Newton step against N (planar cantilever k = 3, warm start)");
+/// Collocation's time per Newton step against N, with the fitted log-log
+/// slope.
+fn time_per_newton_step(scene: &Scene) {
+    println!("collocation time per Newton step against N (planar cantilever k = 3, warm start)");
     for stages in [2, 3] {
         let eq = equations(&scene.rod, ModelLevel::Planar);
         let (mut xs, mut ys) = (vec![], vec![]);

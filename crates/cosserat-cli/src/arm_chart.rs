@@ -9,6 +9,7 @@
 //!    shapes; d) Q's shapes and the loaded shape of the true straight
 //!    optimum R̂0. Shapes are in the reach's units, height −x against z.
 
+use std::fmt::Write as _;
 use std::path::Path;
 
 use plotters::coord::Shift;
@@ -47,9 +48,9 @@ pub fn draw_arm(chart: &ArmChart, out: &Path) -> Result<(), Failure> {
         .unwrap_or_default();
     let tmp = out.with_file_name(format!(".{stem}.{}.tmp.{extension}", std::process::id()));
     let drawn = if extension == "svg" {
-        panels(SVGBackend::new(&tmp, size).into_drawing_area(), chart)
+        panels(&SVGBackend::new(&tmp, size).into_drawing_area(), chart)
     } else {
-        panels(BitMapBackend::new(&tmp, size).into_drawing_area(), chart)
+        panels(&BitMapBackend::new(&tmp, size).into_drawing_area(), chart)
     };
     let renamed = drawn.and_then(|()| std::fs::rename(&tmp, out).map_err(Failure::from));
     if renamed.is_err() {
@@ -58,7 +59,7 @@ pub fn draw_arm(chart: &ArmChart, out: &Path) -> Result<(), Failure> {
     renamed
 }
 
-fn panels<DB: DrawingBackend>(root: Area<DB>, chart: &ArmChart) -> Result<(), Failure>
+fn panels<DB: DrawingBackend>(root: &Area<DB>, chart: &ArmChart) -> Result<(), Failure>
 where
     DB::ErrorType: 'static,
 {
@@ -79,7 +80,7 @@ where
             (1, 2),
             p,
             q,
-            marks,
+            &marks,
         )?;
     }
     if p.curvature_coefficients.len() >= 2 {
@@ -93,7 +94,7 @@ where
             (0, 1),
             p,
             q,
-            marks,
+            &marks,
         )?;
     }
     let title = format!(
@@ -105,12 +106,13 @@ where
     shapes.clear();
     let mut title = String::from("d)");
     if let Some(q) = q {
-        title += &format!(" Q: R = {:.4}", q.design.reach);
+        write!(title, " Q: R = {:.4}", q.design.reach).expect("writing to a String cannot fail");
         shapes.push((&q.loaded_shape, 1, false));
         shapes.push((&q.unloaded_shape, 1, true));
     }
     if let Some(s) = chart.straight {
-        title += &format!("; true straight optimum R0 = {:.4} (green)", s.reach);
+        write!(title, "; true straight optimum R0 = {:.4} (green)", s.reach)
+            .expect("writing to a String cannot fail");
         shapes.push((&s.loaded_shape, 2, false));
     }
     shapes_panel(&areas[3], &title, &shapes)?;
@@ -153,7 +155,7 @@ fn scatter<DB: DrawingBackend>(
     columns: (usize, usize),
     p: &ArmOptimum,
     q: Option<&ArmOptimum>,
-    mark: (impl Fn(&ArmOptimum) -> f64, impl Fn(&ArmOptimum) -> f64),
+    mark: &(impl Fn(&ArmOptimum) -> f64, impl Fn(&ArmOptimum) -> f64),
 ) -> Result<(), Failure>
 where
     DB::ErrorType: 'static,

@@ -14,6 +14,7 @@
 //! the mesh size (integration steps for shooting, intervals for
 //! collocation). Output: `work_precision.csv`, `.png`, `.svg`.
 
+use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
@@ -199,7 +200,7 @@ fn sweeps() -> Vec<(String, f64, SolverOptions)> {
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(|a, b| a.total_cmp(b));
+    v.sort_by(f64::total_cmp);
     v[v.len() / 2]
 }
 
@@ -256,21 +257,23 @@ fn work_precision(dir: &Path) -> Result<(), Box<dyn std::error::Error>> {
     let points = measure();
     let mut csv = String::from("scene,method,parameter,tip_error,time_s,newton_steps,mesh_size\n");
     for p in &points {
-        csv += &format!(
-            "{},{},{:e},{:e},{:e},{},{}\n",
+        writeln!(
+            csv,
+            "{},{},{:e},{:e},{:e},{},{}",
             p.scene, p.method, p.parameter, p.error, p.time, p.newton_steps, p.mesh
-        );
+        )
+        .expect("writing to a String cannot fail");
     }
     std::fs::write(dir.join("work_precision.csv"), csv)?;
     crate::plot::register_font();
     let png = dir.join("work_precision.png");
     let svg = dir.join("work_precision.svg");
     chart(
-        BitMapBackend::new(&png, (1800, 620)).into_drawing_area(),
+        &BitMapBackend::new(&png, (1800, 620)).into_drawing_area(),
         &points,
     )?;
     chart(
-        SVGBackend::new(&svg, (1800, 620)).into_drawing_area(),
+        &SVGBackend::new(&svg, (1800, 620)).into_drawing_area(),
         &points,
     )?;
     println!(
@@ -285,7 +288,7 @@ fn work_precision(dir: &Path) -> Result<(), Box<dyn std::error::Error>> {
 const FLOOR: f64 = 1e-16;
 
 fn chart<DB: DrawingBackend>(
-    root: DrawingArea<DB, plotters::coord::Shift>,
+    root: &DrawingArea<DB, plotters::coord::Shift>,
     points: &[Point],
 ) -> Result<(), Box<dyn std::error::Error>>
 where

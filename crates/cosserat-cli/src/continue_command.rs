@@ -2,12 +2,15 @@
 //! problem file's `[continuation]` table, saved as they grow.
 
 use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
 use crate::plot::{draw, read_diagram};
-use cosserat::continuation::{continuation, Diagram, Progress, RunState};
+use cosserat::continuation::{
+    continuation, ContinuationError, ContinuationOptions, Diagram, Family, Progress, RunState,
+    SavedDiagram,
+};
 use cosserat::input::{Problem, MEASURES};
 use cosserat::output::target::replace_atomically;
 use cosserat::output::{read_saved, write_diagram};
@@ -28,14 +31,14 @@ fn section_key(text: &str, key: &str) -> Option<String> {
 
 /// Runs the continuation of a problem file.
 pub fn run_continue(
-    path: PathBuf,
-    output: PathBuf,
-    plot: Option<PathBuf>,
+    path: &Path,
+    output: &Path,
+    plot: Option<&Path>,
     set: &[String],
     force: bool,
     resume: bool,
 ) -> ExitCode {
-    let problem = match Problem::from_path(&path, set) {
+    let problem = match Problem::from_path(path, set) {
         Ok(p) => p,
         Err(e) => return fail(BAD_INPUT, format!("{}: {e}", path.display())),
     };
@@ -48,43 +51,15 @@ pub fn run_continue(
             ),
         );
     };
-    let mut outputs: Vec<&Path> = vec![&output];
-    outputs.extend(plot.as_deref());
-    let _claims = match crate::solve_command::claim_outputs(&outputs, &[&path], force || resume) {
+    let mut outputs: Vec<&Path> = vec![output];
+    outputs.extend(plot);
+    let _claims = match crate::solve_command::claim_outputs(&outputs, &[path], force || resume) {
         Ok(c) => c,
         Err(code) => return code,
     };
-    let saved = if resume && output.exists() {
-        match read_saved(&output) {
-            Ok((text, _)) if text != problem.text => {
-                return fail(
-                    BAD_INPUT,
-                    format!(
-                        "{}: made from a different problem (or other --set values); cannot resume",
-                        output.display()
-                    ),
-                )
-            }
-            Ok((_, saved)) if !saved.stop_reason.resumable() => {
-                println!("nothing to resume: {} is complete", output.display());
-                return ExitCode::SUCCESS;
-            }
-            Ok((_, saved)) => Some(saved),
-            Err(e) => {
-                return fail(
-                    BAD_INPUT,
-                    format!("{}: cannot resume: {e}", output.display()),
-                )
-            }
-        }
-    } else {
-        if resume && !force {
-            println!(
-                "nothing to resume: {} does not exist; starting",
-                output.display()
-            );
-        }
-        None
+    let saved = match saved_diagram(&problem.text, output, force, resume) {
+        Ok(saved) => saved,
+        Err(code) => return code,
     };
     let parameter_name = section_key(&problem.text, "parameter")
         .unwrap_or_else(|| format!("{:?}", family.parameter()));
@@ -100,43 +75,14 @@ pub fn run_continue(
     );
     let bar = spinner();
     let start = Instant::now();
-    let mut last_save = Instant::now();
-    let mut checkpoint_error = None;
-    let mut monitor = |progress: Progress, diagram: &Diagram| {
-        // From the first point on there is work to keep: a signal stops at
-        // the next point. Before it (the start solve, a resumed run's
-        // replay) it stops at once, losing nothing.
-        signals::set_mode(signals::Mode::NextPoint);
-        bar.set_message(format!(
-            "{} points, branch {}, parameter {:.6}",
-            progress.points, progress.branch, progress.parameter
-        ));
-        bar.tick();
-        if last_save.elapsed() >= CHECKPOINT {
-            if let Err(e) = write_diagram(&output, &problem.text, &parameter_name, diagram, true) {
-                checkpoint_error.get_or_insert_with(|| e.to_string());
-            }
-            last_save = Instant::now();
-        }
-        !signals::requested()
+    let run = Run {
+        family,
+        opts,
+        output,
+        text: &problem.text,
+        parameter_name: &parameter_name,
     };
-    if let Some(saved) = &saved {
-        let points: usize = saved.branches.iter().map(|b| b.parameter.len()).sum();
-        println!(
-            "resume    {} branches, {points} points from {}",
-            saved.branches.len(),
-            output.display()
-        );
-    }
-    let outcome = match &saved {
-        Some(saved) => cosserat::continuation::resume(family, opts, saved, &mut monitor),
-        None => continuation(family, opts, &mut monitor),
-    };
-    bar.finish_and_clear();
-    signals::set_mode(signals::Mode::Immediate);
-    if let Some(e) = checkpoint_error {
-        eprintln!("warning: a checkpoint was not written: {e}");
-    }
+    let outcome = run.follow(&bar, saved.as_ref());
     let diagram = match outcome {
         Ok(d) => d,
         Err(e) => return fail(NO_RESULT, e),
@@ -144,24 +90,130 @@ pub fn run_continue(
     let elapsed = start.elapsed();
     report(&diagram);
     println!("time      {:.1} ms", elapsed.as_secs_f64() * 1e3);
-    if let Err(e) = write_diagram(&output, &problem.text, &parameter_name, &diagram, true) {
-        return fail(OUTPUT, e);
+    run.finish(&diagram, plot)
+}
+
+/// The diagram to resume from: none without `--resume` or when `output`
+/// does not exist yet; the exit code when it cannot or need not be
+/// resumed.
+fn saved_diagram(
+    text: &str,
+    output: &Path,
+    force: bool,
+    resume: bool,
+) -> Result<Option<SavedDiagram>, ExitCode> {
+    if resume && output.exists() {
+        match read_saved(output) {
+            Ok((saved_text, _)) if saved_text != text => Err(fail(
+                BAD_INPUT,
+                format!(
+                    "{}: made from a different problem (or other --set values); cannot resume",
+                    output.display()
+                ),
+            )),
+            Ok((_, saved)) if !saved.stop_reason.resumable() => {
+                println!("nothing to resume: {} is complete", output.display());
+                Err(ExitCode::SUCCESS)
+            }
+            Ok((_, saved)) => Ok(Some(saved)),
+            Err(e) => Err(fail(
+                BAD_INPUT,
+                format!("{}: cannot resume: {e}", output.display()),
+            )),
+        }
+    } else {
+        if resume && !force {
+            println!(
+                "nothing to resume: {} does not exist; starting",
+                output.display()
+            );
+        }
+        Ok(None)
     }
-    println!("written   {}", output.display());
-    if diagram.stop_reason == RunState::Interrupted {
-        eprintln!(
-            "interrupted: every point computed so far is in {}; go on with --resume",
-            output.display()
-        );
-        return ExitCode::from(INTERRUPTED);
+}
+
+/// One continuation run: what it follows and where its diagram goes.
+struct Run<'a> {
+    family: &'a Family,
+    opts: &'a ContinuationOptions,
+    output: &'a Path,
+    text: &'a str,
+    parameter_name: &'a str,
+}
+
+impl Run<'_> {
+    /// Follows the branches (from `saved` when resuming), showing progress
+    /// on `bar` and writing a checkpoint every [`CHECKPOINT`].
+    fn follow(
+        &self,
+        bar: &ProgressBar,
+        saved: Option<&SavedDiagram>,
+    ) -> Result<Diagram, ContinuationError> {
+        let mut last_save = Instant::now();
+        let mut checkpoint_error = None;
+        let mut monitor = |progress: Progress, diagram: &Diagram| {
+            // From the first point on there is work to keep: a signal stops at
+            // the next point. Before it (the start solve, a resumed run's
+            // replay) it stops at once, losing nothing.
+            signals::set_mode(signals::Mode::NextPoint);
+            bar.set_message(format!(
+                "{} points, branch {}, parameter {:.6}",
+                progress.points, progress.branch, progress.parameter
+            ));
+            bar.tick();
+            if last_save.elapsed() >= CHECKPOINT {
+                if let Err(e) =
+                    write_diagram(self.output, self.text, self.parameter_name, diagram, true)
+                {
+                    checkpoint_error.get_or_insert_with(|| e.to_string());
+                }
+                last_save = Instant::now();
+            }
+            !signals::requested()
+        };
+        if let Some(saved) = saved {
+            let points: usize = saved.branches.iter().map(|b| b.parameter.len()).sum();
+            println!(
+                "resume    {} branches, {points} points from {}",
+                saved.branches.len(),
+                self.output.display()
+            );
+        }
+        let outcome = match saved {
+            Some(saved) => {
+                cosserat::continuation::resume(self.family, self.opts, saved, &mut monitor)
+            }
+            None => continuation(self.family, self.opts, &mut monitor),
+        };
+        bar.finish_and_clear();
+        signals::set_mode(signals::Mode::Immediate);
+        if let Some(e) = checkpoint_error {
+            eprintln!("warning: a checkpoint was not written: {e}");
+        }
+        outcome
     }
-    if let Some(png) = plot {
-        let measure = section_key(&problem.text, "measure").unwrap_or_else(|| "tip_x".into());
-        if let Err(e) = plot_file(&output, &measure, &png) {
+
+    /// Writes the finished (or interrupted) diagram and its chart.
+    fn finish(&self, diagram: &Diagram, plot: Option<&Path>) -> ExitCode {
+        if let Err(e) = write_diagram(self.output, self.text, self.parameter_name, diagram, true) {
             return fail(OUTPUT, e);
         }
+        println!("written   {}", self.output.display());
+        if diagram.stop_reason == RunState::Interrupted {
+            eprintln!(
+                "interrupted: every point computed so far is in {}; go on with --resume",
+                self.output.display()
+            );
+            return ExitCode::from(INTERRUPTED);
+        }
+        if let Some(png) = plot {
+            let measure = section_key(self.text, "measure").unwrap_or_else(|| "tip_x".into());
+            if let Err(e) = plot_file(self.output, &measure, png) {
+                return fail(OUTPUT, e);
+            }
+        }
+        ExitCode::SUCCESS
     }
-    ExitCode::SUCCESS
 }
 
 /// A spinner on a terminal; plain lines every few seconds elsewhere are

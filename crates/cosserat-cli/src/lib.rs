@@ -62,14 +62,14 @@ pub fn run(cli: Cli) -> ExitCode {
             if let Some(m) = method {
                 set.push(format!("solver.method=\"{m}\""));
             }
-            solve_command::run_solve(problem, output, &set, force)
+            solve_command::run_solve(&problem, output.as_deref(), &set, force)
         }
         Command::Stability {
             problem,
             output,
             set,
             force,
-        } => solve_command::run_stability(problem, output, &set, force),
+        } => solve_command::run_stability(&problem, output.as_deref(), &set, force),
         Command::Continue {
             problem,
             output,
@@ -77,7 +77,9 @@ pub fn run(cli: Cli) -> ExitCode {
             resume,
             set,
             force,
-        } => continue_command::run_continue(problem, output, plot, &set, force, resume),
+        } => {
+            continue_command::run_continue(&problem, &output, plot.as_deref(), &set, force, resume)
+        }
         Command::Optimize {
             problem,
             output,
@@ -88,7 +90,7 @@ pub fn run(cli: Cli) -> ExitCode {
             resume,
             set,
             force,
-        } => optimize_command::run_optimize(optimize_command::OptimizeRun {
+        } => optimize_command::run_optimize(&optimize_command::OptimizeRun {
             path: problem,
             output,
             loading_path,
@@ -108,7 +110,7 @@ pub fn run(cli: Cli) -> ExitCode {
             plot,
             set,
             force,
-        } => sweep_command::run_sweep(sweep_command::SweepArgs {
+        } => sweep_command::run_sweep(&sweep_command::SweepArgs {
             path: problem,
             output,
             shard,
@@ -131,6 +133,6 @@ pub fn run(cli: Cli) -> ExitCode {
             force,
         } => continue_command::run_plot(&diagram, &measure, &output, force),
         Command::Bench { which } => bench::run(which),
-        Command::Validate(args) => validate::run_cli(args),
+        Command::Validate(args) => validate::run_cli(&args),
     }
 }

@@ -59,13 +59,13 @@ pub struct OptimizeRun {
 }
 
 /// Optimizes the arm and writes the results.
-pub fn run_optimize(run: OptimizeRun) -> ExitCode {
+pub fn run_optimize(run: &OptimizeRun) -> ExitCode {
     let path = &run.path;
     let problem = match Problem::from_path(path, &run.set) {
         Ok(p) => p,
         Err(e) => return fail(BAD_INPUT, format!("{}: {e}", path.display())),
     };
-    let _claims = match claim_outputs(&run) {
+    let _claims = match claim_outputs(run) {
         Ok(c) => c,
         Err(code) => return code,
     };
@@ -77,14 +77,14 @@ pub fn run_optimize(run: OptimizeRun) -> ExitCode {
             format!("{}: arm: the problem has no [arm] table", path.display()),
         );
     };
-    let progress = match start_from(&run, &problem, arm, scene) {
+    let progress = match start_from(run, &problem, arm, scene) {
         Ok(p) => p,
         Err(code) => return code,
     };
     report_problem(path, arm, scene);
     let t = Instant::now();
     let (optimum, progress, was_interrupted) =
-        run_search(&run, &problem.text, arm, search, scene, progress);
+        run_search(run, &problem.text, arm, search, scene, progress);
     let Some(opt) = optimum else {
         let limit = scene.max_curvature.map_or(String::new(), |k| {
             format!(" that the actuator limit arm.max_curvature = {k} can hold")
@@ -97,7 +97,7 @@ pub fn run_optimize(run: OptimizeRun) -> ExitCode {
         );
     };
     if was_interrupted {
-        return keep_interrupted(&run, &problem.text, &opt, &progress);
+        return keep_interrupted(run, &problem.text, &opt, &progress);
     }
     // The finished search is kept before the maps and paths that follow it
     // (they stop at once on a signal): `--resume` starts from the optimum.
@@ -121,7 +121,7 @@ pub fn run_optimize(run: OptimizeRun) -> ExitCode {
         .flatten();
     let extras = map_extras(arm, search, scene, *map_samples, &opt);
     if signals::requested() {
-        return keep_interrupted(&run, &problem.text, &opt, &progress);
+        return keep_interrupted(run, &problem.text, &opt, &progress);
     }
     let paths = [
         (&run.loading_path, Route::LOADING),
@@ -137,11 +137,11 @@ pub fn run_optimize(run: OptimizeRun) -> ExitCode {
         }
     }
     if signals::requested() {
-        return keep_interrupted(&run, &problem.text, &opt, &progress);
+        return keep_interrupted(run, &problem.text, &opt, &progress);
     }
     signals::set_mode(signals::Mode::Immediate);
     if let Err(code) = write_study(
-        &run,
+        run,
         &problem.text,
         &opt,
         straight.as_ref(),

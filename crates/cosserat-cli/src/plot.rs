@@ -53,7 +53,7 @@ pub struct DiagramData {
 }
 
 /// Rows of three; a length that is not a multiple of three is an error.
-fn rows3(v: Vec<f64>) -> hdf5::Result<Vec<[f64; 3]>> {
+fn rows3(v: &[f64]) -> hdf5::Result<Vec<[f64; 3]>> {
     if !v.len().is_multiple_of(3) {
         return Err("a dataset of 3-vectors has a length that is not a multiple of 3".into());
     }
@@ -80,7 +80,7 @@ pub fn read_diagram(path: &Path) -> hdf5::Result<DiagramData> {
         let shapes = shapes_ds.read_raw::<f64>()?;
         branches.push(BranchData {
             parameter: read("parameter")?,
-            tip: rows3(read("tip_position")?)?,
+            tip: rows3(&read("tip_position")?)?,
             tip_angle: read("tip_angle")?,
             norm: read("norm")?,
             stable: g
@@ -91,7 +91,7 @@ pub fn read_diagram(path: &Path) -> hdf5::Result<DiagramData> {
                 .collect(),
             shapes: shapes
                 .chunks((per * 3).max(1))
-                .map(|c| rows3(c.to_vec()))
+                .map(rows3)
                 .collect::<hdf5::Result<_>>()?,
         });
     }
@@ -102,7 +102,7 @@ pub fn read_diagram(path: &Path) -> hdf5::Result<DiagramData> {
     let branch = sp.dataset("branch")?.read_raw::<u64>()?;
     let index = sp.dataset("index")?.read_raw::<u64>()?;
     let parameter = sp.dataset("parameter")?.read_raw::<f64>()?;
-    let tip = rows3(sp.dataset("tip_position")?.read_raw::<f64>()?)?;
+    let tip = rows3(&sp.dataset("tip_position")?.read_raw::<f64>()?)?;
     let n = kinds.len();
     if [branch.len(), index.len(), parameter.len(), tip.len()] != [n; 4] {
         return Err("the special-point datasets have different lengths".into());
@@ -197,13 +197,13 @@ pub fn draw(
         .is_some_and(|e| e.eq_ignore_ascii_case("svg"));
     if svg {
         panels(
-            SVGBackend::new(out, (1400, 600)).into_drawing_area(),
+            &SVGBackend::new(out, (1400, 600)).into_drawing_area(),
             data,
             measure,
         )
     } else {
         panels(
-            BitMapBackend::new(out, (1400, 600)).into_drawing_area(),
+            &BitMapBackend::new(out, (1400, 600)).into_drawing_area(),
             data,
             measure,
         )
@@ -241,7 +241,7 @@ fn label(s: &SpecialData, counts: &mut [usize; 2]) -> String {
 }
 
 fn panels<DB: DrawingBackend>(
-    root: DrawingArea<DB, plotters::coord::Shift>,
+    root: &DrawingArea<DB, plotters::coord::Shift>,
     data: &DiagramData,
     measure: &str,
 ) -> Result<(), Box<dyn std::error::Error>>

@@ -1,7 +1,7 @@
 //! `cosserat solve` and `cosserat stability`: one equilibrium (or a fixed
 //! loaded shape) and its stability verdict.
 
-use std::path::PathBuf;
+use std::path::Path;
 use std::process::ExitCode;
 
 use cosserat::bvp::{solve, Equilibrium};
@@ -15,15 +15,14 @@ use crate::signals;
 
 /// Reads the problem and claims the output before any work.
 fn prepare(
-    path: &std::path::Path,
-    output: &Option<PathBuf>,
+    path: &Path,
+    output: Option<&Path>,
     set: &[String],
     force: bool,
 ) -> Result<(Problem, Option<Claim>), ExitCode> {
     let problem = Problem::from_path(path, set)
         .map_err(|e| fail(BAD_INPUT, format!("{}: {e}", path.display())))?;
     let claimed = output
-        .as_ref()
         .map(|out| claim(out, &[path], force).map(hold))
         .transpose()
         .map_err(|e| fail(BAD_INPUT, e))?;
@@ -65,8 +64,8 @@ pub fn hold(claim: Claim) -> Claim {
 
 /// Claims every output of a command (none named twice, none an input).
 pub fn claim_outputs(
-    outputs: &[&std::path::Path],
-    inputs: &[&std::path::Path],
+    outputs: &[&Path],
+    inputs: &[&Path],
     replace: bool,
 ) -> Result<Vec<Claim>, ExitCode> {
     cosserat::output::target::claim_all(outputs, inputs, replace)
@@ -77,13 +76,8 @@ pub fn claim_outputs(
 /// `cosserat stability`: the stability of the problem's equilibrium
 /// (spectra, Morse index) or the critical load of its `[shape]`, printed
 /// and written to `output`; returns the exit code.
-pub fn run_stability(
-    path: PathBuf,
-    output: Option<PathBuf>,
-    set: &[String],
-    force: bool,
-) -> ExitCode {
-    let (problem, _claim) = match prepare(&path, &output, set, force) {
+pub fn run_stability(path: &Path, output: Option<&Path>, set: &[String], force: bool) -> ExitCode {
+    let (problem, _claim) = match prepare(path, output, set, force) {
         Ok(p) => p,
         Err(code) => return code,
     };
@@ -92,35 +86,34 @@ pub fn run_stability(
         "mesh      {} elements of order {}",
         opts.elements, opts.order
     );
-    let result = match &problem.shape {
-        Some(shape) => match critical_load(&problem.rod, shape, opts) {
+    let result = if let Some(shape) = &problem.shape {
+        match critical_load(&problem.rod, shape, opts) {
             Ok(c) => {
                 report_critical(&c);
                 StabilityResult::FixedShape(c)
             }
             Err(e) => return fail(NO_RESULT, e),
-        },
-        None => {
-            println!(
-                "model     {} ({})",
-                problem.model.level.name(),
-                problem.model.reason
-            );
-            let eq = match solve(&problem.rod, &problem.model, &problem.options) {
-                Ok(eq) => eq,
-                Err(e) => return solve_failed(&e),
-            };
-            match analyze(&problem.rod, &eq, &problem.options, opts) {
-                Ok(st) => {
-                    report_spectrum(&st);
-                    StabilityResult::Equilibrium(Box::new(eq), st)
-                }
-                Err(e) => return fail(NO_RESULT, e),
+        }
+    } else {
+        println!(
+            "model     {} ({})",
+            problem.model.level.name(),
+            problem.model.reason
+        );
+        let eq = match solve(&problem.rod, &problem.model, &problem.options) {
+            Ok(eq) => eq,
+            Err(e) => return solve_failed(&e),
+        };
+        match analyze(&problem.rod, &eq, &problem.options, opts) {
+            Ok(st) => {
+                report_spectrum(&st);
+                StabilityResult::Equilibrium(Box::new(eq), st)
             }
+            Err(e) => return fail(NO_RESULT, e),
         }
     };
     if let Some(out) = output {
-        if let Err(e) = write_stability(&out, &problem.text, &result, true) {
+        if let Err(e) = write_stability(out, &problem.text, &result, true) {
             return fail(OUTPUT, e);
         }
         println!("written   {}", out.display());
@@ -163,8 +156,8 @@ fn report_critical(c: &CriticalLoad) {
 
 /// `cosserat solve`: the problem's equilibrium, printed and written to
 /// `output`; returns the exit code.
-pub fn run_solve(path: PathBuf, output: Option<PathBuf>, set: &[String], force: bool) -> ExitCode {
-    let (problem, _claim) = match prepare(&path, &output, set, force) {
+pub fn run_solve(path: &Path, output: Option<&Path>, set: &[String], force: bool) -> ExitCode {
+    let (problem, _claim) = match prepare(path, output, set, force) {
         Ok(p) => p,
         Err(code) => return code,
     };
@@ -200,7 +193,7 @@ pub fn run_solve(path: PathBuf, output: Option<PathBuf>, set: &[String], force: 
         );
     }
     if let Some(out) = output {
-        if let Err(e) = write_equilibrium(&out, &eq, &problem.text, true) {
+        if let Err(e) = write_equilibrium(out, &eq, &problem.text, true) {
             return fail(OUTPUT, e);
         }
         println!("written   {}", out.display());

@@ -161,7 +161,7 @@ where
     if let Some(fit) = panel.fit {
         for omega in fit.contours.iter().map(|c| c.omega) {
             let pts: Vec<(f64, f64)> = (0..=100)
-                .map(|k| x0 + (x1 - x0) * k as f64 / 100.0)
+                .map(|k| x0 + (x1 - x0) * f64::from(k) / 100.0)
                 .map(|x| (x, omega * x.powf(-fit.iota)))
                 .filter(|(_, y)| (y0..=y1).contains(y))
                 .collect();

@@ -55,9 +55,9 @@ struct Setup {
 }
 
 /// Runs a sweep.
-pub fn run_sweep(args: SweepArgs) -> ExitCode {
-    match prepare(&args) {
-        Ok(Some(setup)) => execute(&args, setup),
+pub fn run_sweep(args: &SweepArgs) -> ExitCode {
+    match prepare(args) {
+        Ok(Some(setup)) => execute(args, &setup),
         Ok(None) => ExitCode::SUCCESS,
         Err(code) => code,
     }
@@ -118,7 +118,7 @@ fn prepare(args: &SweepArgs) -> Result<Option<Setup>, ExitCode> {
 
 /// The worker threads asked for (0: one per core), at most four per core.
 fn threads(asked: Option<u16>) -> Result<usize, ExitCode> {
-    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let cores = std::thread::available_parallelism().map_or(1, std::num::NonZero::get);
     match asked.map(usize::from) {
         None => Ok(0),
         Some(n) if n <= 4 * cores => Ok(n),
@@ -246,7 +246,7 @@ fn announce(args: &SweepArgs, setup: &Setup, members: usize) {
 }
 
 /// Runs the points, checkpointing every second; writes the final file.
-fn execute(args: &SweepArgs, setup: Setup) -> ExitCode {
+fn execute(args: &SweepArgs, setup: &Setup) -> ExitCode {
     let points = point_problems(&setup.problem.text, &setup.sweep);
     let plan = SweepPlan {
         problem_at: &points,
@@ -254,7 +254,7 @@ fn execute(args: &SweepArgs, setup: Setup) -> ExitCode {
         shard: setup.shard,
     };
     let members = plan.members().len();
-    announce(args, &setup, members);
+    announce(args, setup, members);
     let before = setup.done.len();
     let bar = progress_bar(members, before);
     let kind = setup.job.kind();
@@ -346,7 +346,7 @@ fn rayon_threads(asked: usize) -> usize {
     if asked > 0 {
         asked
     } else {
-        std::thread::available_parallelism().map_or(1, |n| n.get())
+        std::thread::available_parallelism().map_or(1, std::num::NonZero::get)
     }
 }
 
@@ -354,7 +354,7 @@ fn rayon_threads(asked: usize) -> usize {
 /// fit on two-axis arm sweeps; convergence counts of solve sweeps.
 fn summarize(header: &SweepHeader, records: &[Record]) {
     let mut statuses: std::collections::BTreeMap<&str, std::collections::BTreeMap<&str, usize>> =
-        Default::default();
+        std::collections::BTreeMap::new();
     for r in records {
         for (name, value) in &r.labels {
             *statuses

@@ -132,16 +132,15 @@ fn curves(header: &SweepHeader, records: &[Record], a: usize, column: &str) -> V
         let mut key = idx.clone();
         key[a] = 0;
         let point = (reach * alpha.cos(), reach * alpha.sin());
-        match out.iter_mut().find(|(k, _)| *k == key) {
-            Some((_, (_, pts))) => pts.push(point),
-            None => {
-                let label = (0..idx.len())
-                    .filter(|&j| j != a)
-                    .map(|j| format!("{} = {:.3}", header.keys[j], header.axes[j][idx[j]]))
-                    .collect::<Vec<_>>()
-                    .join(", ");
-                out.push((key, (label, vec![point])));
-            }
+        if let Some((_, (_, pts))) = out.iter_mut().find(|(k, _)| *k == key) {
+            pts.push(point);
+        } else {
+            let label = (0..idx.len())
+                .filter(|&j| j != a)
+                .map(|j| format!("{} = {:.3}", header.keys[j], header.axes[j][idx[j]]))
+                .collect::<Vec<_>>()
+                .join(", ");
+            out.push((key, (label, vec![point])));
         }
     }
     out.into_iter().map(|(_, e)| e).collect()

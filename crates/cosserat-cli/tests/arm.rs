@@ -5,7 +5,7 @@ mod common;
 mod support;
 
 use cosserat::stability::StabilityOptions;
-use cosserat::study::arm::{ArmOptimum, ArmProblem, SearchOptions};
+use cosserat::study::arm::{ArmOptimum, ArmProblem, SearchOptions, SearchProgress};
 use support::quadrature::simpson;
 
 fn problem(b1: f64, b3: f64, bounds: Vec<(f64, f64)>) -> ArmProblem {
@@ -336,7 +336,7 @@ fn actuator_limit_constrains_the_optimum() {
         let (o, _, _) = p.search(
             &scene,
             &SearchOptions::default(),
-            Default::default(),
+            SearchProgress::default(),
             &|| false,
             &mut |_| {},
         );

@@ -90,7 +90,7 @@ fn hostile_inputs_get_named_errors_and_leave_nothing_behind() {
     let failures = Mutex::new(Vec::<String>::new());
     let codes = Mutex::new(BTreeMap::<String, usize>::new());
     let workers = std::thread::available_parallelism()
-        .map_or(2, |n| n.get())
+        .map_or(2, std::num::NonZero::get)
         .min(4);
     let t = Instant::now();
     std::thread::scope(|s| {

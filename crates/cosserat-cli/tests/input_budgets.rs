@@ -159,13 +159,14 @@ fn the_memory_budget_comes_from_the_environment() {
 /// never ended; opening a FIFO blocks) — each quickly, naming the path.
 #[test]
 fn problem_files_are_bounded_regular_files() {
+    use std::fmt::Write as _;
     use std::path::Path;
     use std::time::Instant;
     let dir = std::env::temp_dir().join(format!("cosserat-files-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let big = dir.join("big.toml");
     let mut text = CANTILEVER.to_string();
-    text.push_str(&format!("# {}\n", "x".repeat(1 << 20)));
+    writeln!(text, "# {}", "x".repeat(1 << 20)).expect("writing to a String cannot fail");
     std::fs::write(&big, text).unwrap();
     let fifo = dir.join("fifo.toml");
     let made = std::process::Command::new("mkfifo").arg(&fifo).status();

@@ -386,7 +386,7 @@ fn stiffness_dipping_between_samples_is_refused() {
     let (s0, delta): (f64, f64) = (0.43215, 1e-9);
     let sampled = (0..=1000)
         .map(|i| {
-            let s = i as f64 / 1000.0;
+            let s = f64::from(i) / 1000.0;
             (s - s0).powi(2) - delta
         })
         .fold(f64::INFINITY, f64::min);

@@ -121,7 +121,7 @@ fn sobol_t_bound(i: usize, j: usize) -> u32 {
             (18, 6),
         ];
         let mut d = d;
-        for (count, e) in counts.iter_mut() {
+        for (count, e) in &mut counts {
             if d < *count {
                 return *e;
             }

@@ -16,7 +16,7 @@ fn problem(name: &str, set: &[&str]) -> Problem {
         "{}/problems/{name}.toml",
         concat!(env!("CARGO_MANIFEST_DIR"), "/../..")
     );
-    let set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
+    let set: Vec<String> = set.iter().map(std::string::ToString::to_string).collect();
     Problem::from_path(Path::new(&path), &set).unwrap()
 }
 

@@ -43,7 +43,7 @@ fn main() {
                     .map_or(f64::NAN, |s| s.point.parameter)
             );
         }
-        times.sort_by(|a, b| a.total_cmp(b));
+        times.sort_by(f64::total_cmp);
         println!(
             "{name:<28} {:>8.1} ms   {summary}",
             times[times.len() / 2] * 1e3

@@ -20,7 +20,7 @@ use cosserat::stability::{
 use support::rods::{cantilever, tip_force, uniform};
 
 fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(|a, b| a.total_cmp(b));
+    v.sort_by(f64::total_cmp);
     v[v.len() / 2]
 }
 

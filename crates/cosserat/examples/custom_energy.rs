@@ -96,7 +96,7 @@ impl StoredEnergy for HyperbolicStiffening {
         self.linear.admits_planar_bending()
     }
 
-    fn name(&self) -> &str {
+    fn name(&self) -> &'static str {
         "hyperbolic"
     }
 }

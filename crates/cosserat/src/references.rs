@@ -83,7 +83,7 @@ pub fn bessel_first_zero(nu: f64, lo: f64, hi: f64) -> f64 {
         let q = -x * x / 4.0;
         let (mut term, mut sum) = (1.0, 1.0);
         for m in 1..200 {
-            term *= q / (m as f64 * (nu + m as f64));
+            term *= q / (f64::from(m) * (nu + f64::from(m)));
             sum += term;
             if term.abs() < 1e-18 * sum.abs().max(1e-300) {
                 break;
@@ -251,7 +251,7 @@ pub fn greenhill_clamped(tau: f64) -> f64 {
     use nalgebra::{Complex, Matrix4};
     let f = |p: f64| {
         let r = (tau * tau + 4.0 * p).sqrt();
-        let (k1, k2) = ((tau + r) / 2.0, (tau - r) / 2.0);
+        let (k1, k2) = (f64::midpoint(tau, r), (tau - r) / 2.0);
         let i = Complex::new(0.0, 1.0);
         let (one, zero) = (Complex::new(1.0, 0.0), Complex::new(0.0, 0.0));
         let (e1, e2) = ((i * k1).exp(), (i * k2).exp());

@@ -88,7 +88,10 @@ fn roll_up_matches_closed_form_from_the_problem_file() {
 fn catalog_errors_name_the_field() {
     let text = std::fs::read_to_string(FILE).unwrap();
     let err = |overrides: &[&str], with_catalog: bool| {
-        let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+        let o: Vec<String> = overrides
+            .iter()
+            .map(std::string::ToString::to_string)
+            .collect();
         let r = if with_catalog {
             Problem::from_str_in(&text, &o, &catalog())
         } else {

@@ -52,7 +52,7 @@ fn cantilever_tip_matches_elliptic_integrals() {
                     tip.position[1].abs(),
                     (angle - reference.angle).abs(),
                 ];
-                let worst = errors.iter().cloned().fold(0.0, f64::max);
+                let worst = errors.iter().copied().fold(0.0, f64::max);
                 assert!(
                     worst <= 1e-9,
                     "k = {k}, {level:?}, {method:?}: errors {errors:?}"

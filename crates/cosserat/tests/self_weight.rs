@@ -18,8 +18,8 @@ fn hanging(q: f64) -> Rod {
     support::rods::uniform(1.0, [10.0, 1.0, 10.0], loads)
 }
 
-fn solve_with(rod: &Rod, opts: SolverOptions) -> Equilibrium {
-    solve(rod, &ModelChoice::for_rod(rod), &opts).unwrap()
+fn solve_with(rod: &Rod, opts: &SolverOptions) -> Equilibrium {
+    solve(rod, &ModelChoice::for_rod(rod), opts).unwrap()
 }
 
 /// Euler–Bernoulli: tip deflection q L⁴/(8B), tip rotation q L³/(6B),
@@ -33,7 +33,7 @@ fn small_deflection_matches_beam_theory() {
             method,
             ..Default::default()
         };
-        let tip = solve_with(&rod, opts).tip().clone();
+        let tip = solve_with(&rod, &opts).tip().clone();
         let deflection = tip.position[0];
         let rotation = tip.directors[2][0].atan2(tip.directors[2][2]);
         assert!(
@@ -65,7 +65,7 @@ fn large_deflection_converges_at_the_method_order() {
             },
             ..Default::default()
         };
-        solve_with(&rod, opts).tip().position[0]
+        solve_with(&rod, &opts).tip().position[0]
     };
     let meshes = [4, 8, 16, 32, 64];
     let x: Vec<f64> = meshes.iter().map(|&n| tip_x(n)).collect();
@@ -80,7 +80,7 @@ fn large_deflection_converges_at_the_method_order() {
             method,
             ..Default::default()
         };
-        let other = solve_with(&rod, opts).tip().position[0];
+        let other = solve_with(&rod, &opts).tip().position[0];
         assert!(
             (other - converged).abs() < 1e-8,
             "{method:?}: {other} vs {converged}"

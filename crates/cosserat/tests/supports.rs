@@ -21,7 +21,10 @@ const COLUMN: &str = "[rod]\nlength = 1.0\n[energy]\nstiffness = [1.0, 1.0, 1.0]
                       [support]\naxis = [0.0, 0.0, 1.0]\n";
 
 fn problem(overrides: &[&str]) -> Problem {
-    let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    let o: Vec<String> = overrides
+        .iter()
+        .map(std::string::ToString::to_string)
+        .collect();
     Problem::from_str_with(COLUMN, &o).unwrap()
 }
 
@@ -179,7 +182,7 @@ fn twisted_column_buckles_at_greenhill_load() {
 #[test]
 fn bad_supports_name_the_field() {
     let err = |o: &[&str]| {
-        let o: Vec<String> = o.iter().map(|s| s.to_string()).collect();
+        let o: Vec<String> = o.iter().map(std::string::ToString::to_string).collect();
         Problem::from_str_with(COLUMN, &o).unwrap_err().to_string()
     };
     assert!(err(&["support.translation=\"sideways\""]).contains("support.translation"));
@@ -218,7 +221,10 @@ fn hinged_base_columns_buckle_at_their_classical_loads() {
         );
     }
     let spatial = ["clamp.hinge=true", "loads.tip_couple=[0.0, 0.0, 1.0]"];
-    let o: Vec<String> = spatial.iter().map(|s| s.to_string()).collect();
+    let o: Vec<String> = spatial
+        .iter()
+        .map(std::string::ToString::to_string)
+        .collect();
     let e = Problem::from_str_with(COLUMN, &o).unwrap_err().to_string();
     assert!(e.contains("clamp.hinge"), "{e}");
 }

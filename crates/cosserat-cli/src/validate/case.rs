@@ -181,10 +181,6 @@ pub fn load_cases(dir: &Path) -> Result<Vec<Case>, InputError> {
 
 /// Reads and checks one case file.
 pub fn load_case(path: &Path) -> Result<Case, InputError> {
-    let bad = |m: String| InputError(format!("{}: {m}", path.display()));
-    let text = std::fs::read_to_string(path).map_err(|e| bad(e.to_string()))?;
-    let file: CaseFile = toml::from_str(&text).map_err(|e| bad(e.to_string()))?;
-    let analysis = file.analysis.as_str();
     const ANALYSES: [&str; 5] = [
         "solve",
         "critical-load",
@@ -192,6 +188,10 @@ pub fn load_case(path: &Path) -> Result<Case, InputError> {
         "stability-loss",
         "optimize",
     ];
+    let bad = |m: String| InputError(format!("{}: {m}", path.display()));
+    let text = std::fs::read_to_string(path).map_err(|e| bad(e.to_string()))?;
+    let file: CaseFile = toml::from_str(&text).map_err(|e| bad(e.to_string()))?;
+    let analysis = file.analysis.as_str();
     if !ANALYSES.contains(&analysis) {
         return Err(bad(format!(
             "analysis `{analysis}`: expected one of {}",

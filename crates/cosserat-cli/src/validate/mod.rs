@@ -66,7 +66,7 @@ pub struct ValidateArgs {
 /// `cosserat validate`: exit 0 when every row passes (or is informational
 /// or skipped), 3 when one fails (a result below the asked quality), 2 on
 /// bad input, 1 when the report cannot be written.
-pub fn run_cli(args: ValidateArgs) -> ExitCode {
+pub fn run_cli(args: &ValidateArgs) -> ExitCode {
     let dir = args.cases.clone().unwrap_or_else(default_dir);
     let cases = match load_cases(&dir) {
         Ok(c) => c,

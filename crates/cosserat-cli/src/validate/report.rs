@@ -171,7 +171,10 @@ pub fn text_table(rows: &[Row]) -> String {
         s.trim_end().to_string()
     };
     let mut out = String::new();
-    let head: Vec<String> = HEADER.iter().map(|h| h.to_string()).collect();
+    let head: Vec<String> = HEADER
+        .iter()
+        .map(std::string::ToString::to_string)
+        .collect();
     let _ = writeln!(out, "{}", line(&head));
     for (r, c) in rows.iter().zip(&all) {
         let _ = writeln!(out, "{}", line(c));

@@ -62,8 +62,8 @@ fn method_overrides(method: &str) -> Vec<String> {
     }
 }
 
-fn method_selected(method: &str, filter: &Option<String>) -> bool {
-    match filter.as_deref() {
+fn method_selected(method: &str, filter: Option<&str>) -> bool {
+    match filter {
         None => true,
         Some("collocation") => method.starts_with("collocation"),
         Some(f) => f == method,
@@ -153,78 +153,9 @@ fn run_analysis(
     let start = Instant::now();
     let problem = build(&params)?;
     let outcome = match case.file.analysis.as_str() {
-        "solve" => match solve(&problem.rod, &problem.model, &problem.options) {
-            Ok(eq) => Ok(Outcome {
-                values: tip_quantities(&eq, &problem, case.file.length_scale),
-                time: 0.0,
-                message: format!(
-                    "{} model, {} Newton steps{}",
-                    problem.model.level.name(),
-                    eq.iterations,
-                    if eq.load_steps > 0 {
-                        format!(", {} ramp steps", eq.load_steps)
-                    } else {
-                        String::new()
-                    }
-                ),
-            }),
-            Err(e) => Err(e.to_string()),
-        },
-        "critical-load" => {
-            let Some(shape) = &problem.shape else {
-                return Err(InputError(format!(
-                    "{}: critical-load needs a [shape] in the problem",
-                    case.name
-                )));
-            };
-            match critical_load(&problem.rod, shape, &problem.stability) {
-                Ok(c) => Ok(Outcome {
-                    values: [
-                        ("critical_load".to_string(), c.gamma),
-                        ("chi".to_string(), c.gamma.map(f64::sqrt)),
-                    ]
-                    .into_iter()
-                    .collect(),
-                    time: 0.0,
-                    message: format!(
-                        "{} elements of order {}",
-                        problem.stability.elements, problem.stability.order
-                    ),
-                }),
-                Err(e) => Err(e.to_string()),
-            }
-        }
-        "optimize" => {
-            let Some((arm, search, straight)) = &problem.arm else {
-                return Err(InputError(format!(
-                    "{}: optimize needs an [arm] in the problem",
-                    case.name
-                )));
-            };
-            match arm.optimize(search) {
-                None => Err(format!(
-                    "{}: no design with a finite critical load",
-                    case.name
-                )),
-                Some(optimum) => {
-                    let straight_reach = if *straight {
-                        arm.straight().map(|s| s.reach)
-                    } else {
-                        None
-                    };
-                    Ok(Outcome {
-                        values: [
-                            ("reach".to_string(), Some(optimum.design.reach)),
-                            ("straight_reach".to_string(), straight_reach),
-                        ]
-                        .into_iter()
-                        .collect(),
-                        time: 0.0,
-                        message: format!("{} evaluations", optimum.evaluations),
-                    })
-                }
-            }
-        }
+        "solve" => solve_outcome(&problem, case),
+        "critical-load" => critical_load_outcome(&problem, case)?,
+        "optimize" => optimize_outcome(&problem, case)?,
         "stability-loss" => {
             let scan = case.file.scan.as_ref().expect("checked on load");
             let lowest = |x: f64| -> Result<f64, String> {
@@ -258,6 +189,90 @@ fn run_analysis(
     };
     let time = start.elapsed().as_secs_f64();
     Ok(outcome.map(|o| Outcome { time, ..o }))
+}
+
+/// The tip quantities of the problem's equilibrium.
+fn solve_outcome(problem: &Problem, case: &Case) -> Result<Outcome, String> {
+    match solve(&problem.rod, &problem.model, &problem.options) {
+        Ok(eq) => Ok(Outcome {
+            values: tip_quantities(&eq, problem, case.file.length_scale),
+            time: 0.0,
+            message: format!(
+                "{} model, {} Newton steps{}",
+                problem.model.level.name(),
+                eq.iterations,
+                if eq.load_steps > 0 {
+                    format!(", {} ramp steps", eq.load_steps)
+                } else {
+                    String::new()
+                }
+            ),
+        }),
+        Err(e) => Err(e.to_string()),
+    }
+}
+
+/// The critical load of the problem's `[shape]`.
+fn critical_load_outcome(
+    problem: &Problem,
+    case: &Case,
+) -> Result<Result<Outcome, String>, InputError> {
+    let Some(shape) = &problem.shape else {
+        return Err(InputError(format!(
+            "{}: critical-load needs a [shape] in the problem",
+            case.name
+        )));
+    };
+    let outcome = match critical_load(&problem.rod, shape, &problem.stability) {
+        Ok(c) => Ok(Outcome {
+            values: [
+                ("critical_load".to_string(), c.gamma),
+                ("chi".to_string(), c.gamma.map(f64::sqrt)),
+            ]
+            .into_iter()
+            .collect(),
+            time: 0.0,
+            message: format!(
+                "{} elements of order {}",
+                problem.stability.elements, problem.stability.order
+            ),
+        }),
+        Err(e) => Err(e.to_string()),
+    };
+    Ok(outcome)
+}
+
+/// The optimal arm's reach (and the straight arm's, when asked).
+fn optimize_outcome(problem: &Problem, case: &Case) -> Result<Result<Outcome, String>, InputError> {
+    let Some((arm, search, straight)) = &problem.arm else {
+        return Err(InputError(format!(
+            "{}: optimize needs an [arm] in the problem",
+            case.name
+        )));
+    };
+    Ok(match arm.optimize(search) {
+        None => Err(format!(
+            "{}: no design with a finite critical load",
+            case.name
+        )),
+        Some(optimum) => {
+            let straight_reach = if *straight {
+                arm.straight().map(|s| s.reach)
+            } else {
+                None
+            };
+            Ok(Outcome {
+                values: [
+                    ("reach".to_string(), Some(optimum.design.reach)),
+                    ("straight_reach".to_string(), straight_reach),
+                ]
+                .into_iter()
+                .collect(),
+                time: 0.0,
+                message: format!("{} evaluations", optimum.evaluations),
+            })
+        }
+    })
 }
 
 /// The lowest eigenvalue of the second variation (every block, on the
@@ -338,7 +353,7 @@ pub fn run(cases: &[Case], opts: &RunOptions) -> Result<Vec<Row>, InputError> {
                 continue;
             }
             for method in &case.file.methods {
-                if !method_selected(method, &opts.method) {
+                if !method_selected(method, opts.method.as_deref()) {
                     continue;
                 }
                 let outcome = run_analysis(case, point, method)?;
@@ -387,18 +402,18 @@ fn compare(
         message: String::new(),
     };
     match outcome {
-        Err(e) => row.message = e.clone(),
+        Err(e) => row.message.clone_from(e),
         Ok(o) => {
             row.time = o.time;
-            row.message = o.message.clone();
+            row.message.clone_from(&o.message);
             row.computed = o.values.get(&check.quantity).copied().flatten();
             if let Some(c) = row.computed {
                 let abs = (c - reference).abs();
                 row.absolute_error = Some(abs);
-                row.relative_error = Some(if reference != 0.0 {
-                    abs / reference.abs()
-                } else {
+                row.relative_error = Some(if reference == 0.0 {
                     abs
+                } else {
+                    abs / reference.abs()
                 });
                 row.status = match check.tolerance {
                     Some(t) => {

@@ -36,7 +36,10 @@ tip_force = [1.0, 0.0, 0.0]
 
 /// The error text of `text` with `overrides`; panics when accepted.
 pub fn refusal(text: &str, overrides: &[&str]) -> String {
-    let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    let overrides: Vec<String> = overrides
+        .iter()
+        .map(std::string::ToString::to_string)
+        .collect();
     match Problem::from_str_with(text, &overrides) {
         Ok(_) => panic!("accepted: {overrides:?}"),
         Err(e) => e.to_string(),
@@ -45,6 +48,9 @@ pub fn refusal(text: &str, overrides: &[&str]) -> String {
 
 /// The problem `text` with `overrides`; panics when refused.
 pub fn accepted(text: &str, overrides: &[&str]) -> Problem {
-    let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    let overrides: Vec<String> = overrides
+        .iter()
+        .map(std::string::ToString::to_string)
+        .collect();
     Problem::from_str_with(text, &overrides).unwrap_or_else(|e| panic!("{overrides:?}: {e}"))
 }

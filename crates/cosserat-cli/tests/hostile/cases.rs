@@ -1,6 +1,8 @@
 //! The cases: the commands, what a case prepares in its directory, the
 //! known-bad regressions, hostile output paths, and the case of an id.
 
+use std::fmt::Write as _;
+
 use super::*;
 
 /// The commands and what they read.
@@ -190,7 +192,7 @@ pub(crate) fn hostile_output(rng: &mut Rng, ext: &str) -> (String, Vec<Prepared>
         5 => (format!("with space and ünïcode.{ext}"), vec![], true),
         6 => (format!("new\nline.{ext}"), vec![], true),
         7 => (format!("{}.{ext}", "x".repeat(4000)), vec![], false),
-        8 => ("".into(), vec![], false),
+        8 => (String::new(), vec![], false),
         9 => (
             format!("exists.{ext}"),
             vec![Prepared::File(
@@ -273,7 +275,7 @@ pub(crate) fn case(id: usize, seed: u64, seeds: &[(String, String)], fx: &Fixtur
             "-o".into(),
             "out.h5".into(),
         ];
-        args.extend(set.iter().map(|s| s.to_string()));
+        args.extend(set.iter().map(std::string::ToString::to_string));
         return Case {
             id,
             what: format!("{} {file} {}", verb.name(), set.join(" ")),
@@ -335,7 +337,7 @@ pub(crate) fn problem_case(
             } else {
                 (text.as_bytes().to_vec(), "as shipped".into())
             };
-            what += &format!(" ({how})");
+            write!(what, " ({how})").expect("writing to a String cannot fail");
             prepared.push(Prepared::File("p.toml".into(), bytes));
             args.push("p.toml".into());
         }
@@ -350,7 +352,7 @@ pub(crate) fn problem_case(
             what += " -o p.toml";
         } else {
             args.extend(["-o".into(), out.clone()]);
-            what += &format!(" -o {out:?}");
+            write!(what, " -o {out:?}").expect("writing to a String cannot fail");
             if writable {
                 outputs.push(out);
             }
@@ -363,7 +365,8 @@ pub(crate) fn problem_case(
     }
     if rng.chance(0.3) {
         args.extend(overrides(rng, text));
-        what += &format!(" {}", args[args.len().saturating_sub(2)..].join(" "));
+        write!(what, " {}", args[args.len().saturating_sub(2)..].join(" "))
+            .expect("writing to a String cannot fail");
     }
     if rng.chance(0.3) {
         args.push("--force".into());
@@ -424,7 +427,7 @@ pub(crate) fn merge_case(id: usize, rng: &mut Rng, fx: &Fixtures) -> Case {
         prepared.push(Prepared::File(name.clone(), source));
         args.push(name);
     }
-    what += &format!(" of {n} files");
+    write!(what, " of {n} files").expect("writing to a String cannot fail");
     let (out, more, writable) = output(rng, 0.3, "h5", "all.h5");
     prepared.extend(more);
     args.extend(["-o".into(), out.clone()]);

@@ -30,9 +30,9 @@ pub(crate) fn replace_dataset<T: hdf5::H5Type>(path: &Path, name: &str, data: &[
 /// and `--resume`, never a panic or a silently truncated result.
 #[test]
 fn inconsistent_result_files_are_named_errors() {
+    type Damage = Box<dyn Fn(&Path)>;
     let dir = common::run::scratch("hostile", "files");
     let fx = fixtures(&dir);
-    type Damage = Box<dyn Fn(&Path)>;
     let cases: Vec<(&str, Damage, Vec<&str>)> = vec![
         (
             "d.h5",
@@ -42,7 +42,7 @@ fn inconsistent_result_files_are_named_errors() {
         (
             "d.h5",
             Box::new(|p: &Path| {
-                replace_dataset(p, "branches/0/tip_position", &[1.0f64, 2.0, 3.0, 4.0])
+                replace_dataset(p, "branches/0/tip_position", &[1.0f64, 2.0, 3.0, 4.0]);
             }),
             vec!["plot", "d.h5", "-o", "f.png"],
         ),

@@ -167,57 +167,11 @@ pub(crate) fn number_spans(s: &str) -> Vec<(usize, usize)> {
 pub(crate) fn mutate(rng: &mut Rng, text: &str) -> (Vec<u8>, String) {
     let lines: Vec<&str> = text.lines().collect();
     let assigned = assignments(&lines);
-    let rebuild = |lines: &[String]| lines.join("\n").into_bytes();
-    let mut owned: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
+    let mut owned: Vec<String> = lines.iter().map(std::string::ToString::to_string).collect();
     match rng.below(10) {
-        0 | 1 => {
-            // A number replaced by an extreme.
-            let candidates: Vec<(usize, (usize, usize))> = assigned
-                .iter()
-                .flat_map(|&i| number_spans(lines[i]).into_iter().map(move |s| (i, s)))
-                .collect();
-            if candidates.is_empty() {
-                return (text.as_bytes().to_vec(), "unchanged".into());
-            }
-            let (i, (a, b)) = *rng.pick(&candidates);
-            let v = rng.pick(&EXTREMES);
-            owned[i] = format!("{}{v}{}", &lines[i][..a], &lines[i][b..]);
-            (rebuild(&owned), format!("line {} number → {v}", i + 1))
-        }
-        2 => {
-            // A value of the wrong type.
-            let Some(&i) = (!assigned.is_empty()).then(|| rng.pick(&assigned)) else {
-                return (text.as_bytes().to_vec(), "unchanged".into());
-            };
-            let key = lines[i].split('=').next().unwrap_or("");
-            let v = rng.pick(&WRONG_TYPES);
-            owned[i] = format!("{key}= {v}");
-            (rebuild(&owned), format!("line {} → {v}", i + 1))
-        }
-        3 => {
-            // An array one longer or one shorter.
-            let arrays: Vec<usize> = assigned
-                .iter()
-                .copied()
-                .filter(|&i| lines[i].contains('[') && lines[i].contains(']'))
-                .collect();
-            let Some(&i) = (!arrays.is_empty()).then(|| rng.pick(&arrays)) else {
-                return (text.as_bytes().to_vec(), "unchanged".into());
-            };
-            let l = lines[i];
-            let close = l.rfind(']').unwrap();
-            let longer = rng.chance(0.5);
-            owned[i] = if longer {
-                format!("{}, 1.0{}", &l[..close], &l[close..])
-            } else {
-                match l[..close].rfind(',') {
-                    Some(c) => format!("{}{}", &l[..c], &l[close..]),
-                    None => format!("{}[]", &l[..l.find('=').unwrap() + 1]),
-                }
-            };
-            let how = if longer { "longer" } else { "shorter" };
-            (rebuild(&owned), format!("line {} array {how}", i + 1))
-        }
+        0 | 1 => extreme_number(rng, text, &lines, &assigned, owned),
+        2 => wrong_type(rng, text, &lines, &assigned, owned),
+        3 => array_resized(rng, text, &lines, &assigned, owned),
         4 => {
             // A line deleted (a key, or a table header).
             let i = rng.below(lines.len());
@@ -249,31 +203,112 @@ pub(crate) fn mutate(rng: &mut Rng, text: &str) -> (Vec<u8>, String) {
             }
             (b, format!("{n} bytes changed"))
         }
-        8 => {
-            // A table header renamed or repeated.
-            let headers: Vec<usize> = lines
-                .iter()
-                .enumerate()
-                .filter(|(_, l)| l.trim_start().starts_with('['))
-                .map(|(i, _)| i)
-                .collect();
-            let Some(&i) = (!headers.is_empty()).then(|| rng.pick(&headers)) else {
-                return (text.as_bytes().to_vec(), "unchanged".into());
-            };
-            if rng.chance(0.5) {
-                owned.push(lines[i].to_string());
-                (rebuild(&owned), format!("table of line {} repeated", i + 1))
-            } else {
-                owned[i] = "[nonsense]".into();
-                (rebuild(&owned), format!("table of line {} renamed", i + 1))
-            }
-        }
+        8 => table_header_changed(rng, text, &lines, owned),
         _ => {
             // A huge comment: a file over any sane size.
             let mut b = text.as_bytes().to_vec();
             b.extend(std::iter::repeat_n(b'#', 3 << 20));
             (b, "3 MiB file".into())
         }
+    }
+}
+
+/// The text of edited lines.
+fn rebuild(lines: &[String]) -> Vec<u8> {
+    lines.join("\n").into_bytes()
+}
+
+/// A number replaced by an extreme.
+fn extreme_number(
+    rng: &mut Rng,
+    text: &str,
+    lines: &[&str],
+    assigned: &[usize],
+    mut owned: Vec<String>,
+) -> (Vec<u8>, String) {
+    let candidates: Vec<(usize, (usize, usize))> = assigned
+        .iter()
+        .flat_map(|&i| number_spans(lines[i]).into_iter().map(move |s| (i, s)))
+        .collect();
+    if candidates.is_empty() {
+        return (text.as_bytes().to_vec(), "unchanged".into());
+    }
+    let (i, (a, b)) = *rng.pick(&candidates);
+    let v = rng.pick(&EXTREMES);
+    owned[i] = format!("{}{v}{}", &lines[i][..a], &lines[i][b..]);
+    (rebuild(&owned), format!("line {} number → {v}", i + 1))
+}
+
+/// A value of the wrong type.
+fn wrong_type(
+    rng: &mut Rng,
+    text: &str,
+    lines: &[&str],
+    assigned: &[usize],
+    mut owned: Vec<String>,
+) -> (Vec<u8>, String) {
+    let Some(&i) = (!assigned.is_empty()).then(|| rng.pick(assigned)) else {
+        return (text.as_bytes().to_vec(), "unchanged".into());
+    };
+    let key = lines[i].split('=').next().unwrap_or("");
+    let v = rng.pick(&WRONG_TYPES);
+    owned[i] = format!("{key}= {v}");
+    (rebuild(&owned), format!("line {} → {v}", i + 1))
+}
+
+/// An array one longer or one shorter.
+fn array_resized(
+    rng: &mut Rng,
+    text: &str,
+    lines: &[&str],
+    assigned: &[usize],
+    mut owned: Vec<String>,
+) -> (Vec<u8>, String) {
+    let arrays: Vec<usize> = assigned
+        .iter()
+        .copied()
+        .filter(|&i| lines[i].contains('[') && lines[i].contains(']'))
+        .collect();
+    let Some(&i) = (!arrays.is_empty()).then(|| rng.pick(&arrays)) else {
+        return (text.as_bytes().to_vec(), "unchanged".into());
+    };
+    let l = lines[i];
+    let close = l.rfind(']').unwrap();
+    let longer = rng.chance(0.5);
+    owned[i] = if longer {
+        format!("{}, 1.0{}", &l[..close], &l[close..])
+    } else {
+        match l[..close].rfind(',') {
+            Some(c) => format!("{}{}", &l[..c], &l[close..]),
+            None => format!("{}[]", &l[..=l.find('=').unwrap()]),
+        }
+    };
+    let how = if longer { "longer" } else { "shorter" };
+    (rebuild(&owned), format!("line {} array {how}", i + 1))
+}
+
+/// A table header renamed or repeated.
+fn table_header_changed(
+    rng: &mut Rng,
+    text: &str,
+    lines: &[&str],
+    mut owned: Vec<String>,
+) -> (Vec<u8>, String) {
+    let headers: Vec<usize> = lines
+        .iter()
+        .enumerate()
+        .filter(|(_, l)| l.trim_start().starts_with('['))
+        .map(|(i, _)| i)
+        .collect();
+    let Some(&i) = (!headers.is_empty()).then(|| rng.pick(&headers)) else {
+        return (text.as_bytes().to_vec(), "unchanged".into());
+    };
+    if rng.chance(0.5) {
+        owned.push(lines[i].to_string());
+        (rebuild(&owned), format!("table of line {} repeated", i + 1))
+    } else {
+        owned[i] = "[nonsense]".into();
+        (rebuild(&owned), format!("table of line {} renamed", i + 1))
     }
 }
 
@@ -284,7 +319,7 @@ pub(crate) fn overrides(rng: &mut Rng, text: &str) -> Vec<String> {
     if keys.is_empty() {
         return out;
     }
-    for _ in 0..1 + rng.below(2) {
+    for _ in 0..=rng.below(2) {
         let key = rng.pick(&keys);
         let value = if rng.chance(0.75) {
             rng.pick(&EXTREMES).to_string()

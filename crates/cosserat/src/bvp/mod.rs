@@ -408,7 +408,7 @@ impl Solved {
 fn check_energy(rod: &Rod) -> Result<(), SolveError> {
     let kappa = nalgebra::Vector3::zeros();
     for i in 0..=64 {
-        let s = rod.length() * i as f64 / 64.0;
+        let s = rod.length() * f64::from(i) / 64.0;
         let h = rod.energy().stiffness(s, &kappa);
         let finite = h.iter().all(|v| v.is_finite());
         if !finite || h.cholesky().is_none() {
@@ -481,12 +481,11 @@ fn solve_at(
         return Ok(Solved::Collocation(sol));
     }
     let mut sys = ShootingSystem::new(eq.as_ref(), opts.method.segments(), opts.integration);
-    let x0 = match warm {
-        Some(Solved::Shooting { x, .. }) => x.clone(),
-        _ => {
-            let u = guess(eq.as_ref())?;
-            sys.initial_unknowns(&u)
-        }
+    let x0 = if let Some(Solved::Shooting { x, .. }) = warm {
+        x.clone()
+    } else {
+        let u = guess(eq.as_ref())?;
+        sys.initial_unknowns(&u)
     };
     let outcome = newton::solve(&mut sys, &x0, &opts.newton);
     *stats += sys.stats;

@@ -130,7 +130,7 @@ impl<'a> ShootingSystem<'a> {
                 // inconsistent with the flow. The exact flow preserves
                 // d_i·d_j, so nothing drifts that the clamp did not set.
                 if j == 0 {
-                    eq.project(&mut y[..n])
+                    eq.project(&mut y[..n]);
                 }
             },
         )?;

@@ -78,7 +78,7 @@ pub(super) fn drain(
         if let Some(sp) = parent {
             diagram.special_points[sp].children.push(index);
         }
-        let outcome = run.follow(start, sign, index, diagram, monitor);
+        let outcome = run.follow(&start, sign, index, diagram, monitor);
         diagram.branches[index].stop_reason = outcome.stop_reason.clone();
         if outcome.interrupted {
             diagram.stop_reason = RunState::Interrupted;
@@ -276,7 +276,7 @@ impl<'a> Run<'a> {
     /// saves the diagram keeps every point).
     pub(super) fn follow(
         &mut self,
-        start: Point,
+        start: &Point,
         sign: f64,
         branch: usize,
         diagram: &mut Diagram,

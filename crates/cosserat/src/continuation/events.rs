@@ -215,7 +215,7 @@ impl Run<'_> {
         // eigenvalues; the new direction is the part orthogonal to τ.
         let ete = e.transpose() * &e;
         let eig = ete.symmetric_eigen();
-        let mut idx: Vec<usize> = (0..n + 1).collect();
+        let mut idx: Vec<usize> = (0..=n).collect();
         idx.sort_by(|&a, &b| eig.eigenvalues[a].total_cmp(&eig.eigenvalues[b]));
         let (mut rn, mut jn) = (DVector::zeros(n), DMatrix::zeros(n, n));
         if self

@@ -253,7 +253,7 @@ impl Family {
             Parameter::LoadScale => {
                 rod = rod
                     .with_loads(self.base.loads().scaled(p))
-                    .map_err(|_| bad())?
+                    .map_err(|_| bad())?;
             }
             Parameter::ControlScale => {
                 rod = rod

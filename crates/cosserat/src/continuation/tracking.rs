@@ -108,7 +108,9 @@ impl Tracker {
         // One integration for the quadrature points and the 21 shape points
         // (the last is the tip).
         let quadrature = fe.quadrature_points();
-        let grid: Vec<f64> = (0..21).map(|i| rod.length() * i as f64 / 20.0).collect();
+        let grid: Vec<f64> = (0..21)
+            .map(|i| rod.length() * f64::from(i) / 20.0)
+            .collect();
         let mut all: Vec<(f64, bool)> = quadrature
             .iter()
             .map(|&s| (s, true))
@@ -157,7 +159,7 @@ impl Tracker {
                 .filter(|b| !b.is_empty())
                 .map(|b| {
                     let mut b: Vec<f64> = b.clone();
-                    b.sort_by(|x, y| x.total_cmp(y));
+                    b.sort_by(f64::total_cmp);
                     // One tracked eigenvalue: it is both of the lowest two.
                     (b[0], *b.get(1).unwrap_or(&b[0]))
                 });
@@ -202,7 +204,7 @@ impl Tracker {
         }
         self.previous = Some(vectors.clone());
         let k = self.opts.eigenvalues;
-        self.previous_values = Some(values.chunks(k).map(|c| c.to_vec()).collect());
+        self.previous_values = Some(values.chunks(k).map(<[f64]>::to_vec).collect());
         let shape = shape_samples.iter().map(|s| s.position).collect();
         Ok(Spectrum {
             tip: shape_samples.last().expect("21 shape points").clone(),

@@ -101,6 +101,15 @@ pub fn estimate(problem: &Problem) -> MemoryEstimate {
     let mut e = MemoryEstimate::default();
     let eq = equations(&problem.rod, problem.model.level);
     let (n, u) = (eq.dim() as f64, eq.unknowns() as f64);
+    add_solver(&mut e, problem, n, u);
+    add_stability(&mut e, problem);
+    add_continuation(&mut e, problem);
+    add_arm(&mut e, problem);
+    e
+}
+
+/// The BVP solver's items: the output samples and the method's Jacobian.
+fn add_solver(e: &mut MemoryEstimate, problem: &Problem, n: f64, u: f64) {
     let points = problem.options.output_points as f64;
     e.add(
         "solver.output_points",
@@ -128,6 +137,10 @@ pub fn estimate(problem: &Problem) -> MemoryEstimate {
             );
         }
     }
+}
+
+/// The stability verdict's finest mesh.
+fn add_stability(e: &mut MemoryEstimate, problem: &Problem) {
     let st = &problem.stability;
     let finest = st.elements as f64 * 2f64.powi(REFINEMENTS as i32);
     e.add(
@@ -138,6 +151,10 @@ pub fn estimate(problem: &Problem) -> MemoryEstimate {
             st.order
         ),
     );
+}
+
+/// Continuation's bordered systems, points and finite elements.
+fn add_continuation(e: &mut MemoryEstimate, problem: &Problem) {
     if let Some((family, opts)) = &problem.continuation {
         let size = family.size() as f64 + 1.0;
         let field = if matches!(problem.options.method, Method::Collocation { .. }) {
@@ -167,6 +184,10 @@ pub fn estimate(problem: &Problem) -> MemoryEstimate {
             format!("{elements} elements of order {order}, {k} eigenvalues per block"),
         );
     }
+}
+
+/// The arm optimization's finite elements, map samples and sweep grid.
+fn add_arm(e: &mut MemoryEstimate, problem: &Problem) {
     if let Some((arm, _, _)) = &problem.arm {
         let elements = 4.0 * arm.stability.elements as f64;
         e.add(
@@ -199,7 +220,6 @@ pub fn estimate(problem: &Problem) -> MemoryEstimate {
             format!("{points} grid points × {per} bytes"),
         );
     }
-    e
 }
 
 /// The budget: `COSSERAT_MEMORY_BUDGET` or [`DEFAULT_BUDGET`].

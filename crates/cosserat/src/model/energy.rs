@@ -227,7 +227,7 @@ impl StoredEnergy for LinearElastic {
         self.intrinsic_curvature[0].is_zero() && self.intrinsic_curvature[2].is_zero()
     }
 
-    fn name(&self) -> &str {
+    fn name(&self) -> &'static str {
         "linear"
     }
 
@@ -374,7 +374,7 @@ impl StoredEnergy for QuarticStiffening {
         self.linear.admits_planar_bending()
     }
 
-    fn name(&self) -> &str {
+    fn name(&self) -> &'static str {
         "quartic"
     }
 }

@@ -34,6 +34,7 @@ impl DeadLoads {
     }
 
     /// The same loads multiplied by a factor (load ramps, continuation).
+    #[must_use]
     pub fn scaled(&self, factor: f64) -> DeadLoads {
         DeadLoads {
             tip_force: self.tip_force * factor,

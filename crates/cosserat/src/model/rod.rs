@@ -125,7 +125,7 @@ fn check_loads(loads: &DeadLoads) -> Result<(), ModelError> {
 
 /// A support's position is finite and its axes are unit vectors (to
 /// [`Frame::TOLERANCE`]); its frame is a [`Frame`] already.
-fn check_support(support: &Option<TipSupport>) -> Result<(), ModelError> {
+fn check_support(support: Option<&TipSupport>) -> Result<(), ModelError> {
     let Some(s) = support else {
         return Ok(());
     };
@@ -159,7 +159,7 @@ impl Rod {
         check_length(length)?;
         check_clamp(&clamp)?;
         check_loads(&loads)?;
-        check_support(&support)?;
+        check_support(support.as_ref())?;
         Ok(Rod {
             length,
             energy,
@@ -203,6 +203,7 @@ impl Rod {
 
     /// The same rod with another stored energy (nothing to check here: see
     /// [`Rod::new`]).
+    #[must_use]
     pub fn with_energy(mut self, energy: Arc<dyn StoredEnergy>) -> Rod {
         self.energy = energy;
         self
@@ -224,7 +225,7 @@ impl Rod {
 
     /// The same rod with another tip support, checked as in [`Rod::new`].
     pub fn with_support(mut self, support: Option<TipSupport>) -> Result<Rod, ModelError> {
-        check_support(&support)?;
+        check_support(support.as_ref())?;
         self.support = support;
         Ok(self)
     }

@@ -70,7 +70,9 @@ impl SymmetricBanded {
 
     /// y = A x.
     pub fn matvec(&self, x: &[f64], y: &mut [f64]) {
-        y.iter_mut().for_each(|v| *v = 0.0);
+        for v in y.iter_mut() {
+            *v = 0.0;
+        }
         for i in 0..self.n {
             let row = &self.data[i * (self.bw + 1)..(i + 1) * (self.bw + 1)];
             y[i] += row[0] * x[i];
@@ -89,6 +91,7 @@ impl SymmetricBanded {
     }
 
     /// a·self + b·other (same size; the wider band is kept).
+    #[must_use]
     pub fn combine(&self, a: f64, other: &SymmetricBanded, b: f64) -> SymmetricBanded {
         assert_eq!(self.n, other.n, "sizes differ");
         let bw = self.bw.max(other.bw);
@@ -197,7 +200,7 @@ mod tests {
     #[test]
     fn solve_matches_dense() {
         let a = sample(40, 3, 0.5);
-        let x: Vec<f64> = (0..40).map(|i| (i as f64).cos()).collect();
+        let x: Vec<f64> = (0..40).map(|i| f64::from(i).cos()).collect();
         let mut b = vec![0.0; 40];
         a.matvec(&x, &mut b);
         let dense = a.to_dense() * nalgebra::DVector::from_vec(x.clone());

@@ -128,6 +128,7 @@ impl Convergence {
 
     /// The same test with the residual rows measured in units ρ_i (each
     /// > 0): row i counts |F_i| / ρ_i.
+    #[must_use]
     pub fn with_residual_scales(mut self, scales: Vec<f64>) -> Self {
         self.residual_scales = if scales.iter().all(|&s| s == 1.0) {
             vec![]

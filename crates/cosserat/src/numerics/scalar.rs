@@ -108,10 +108,10 @@ impl Illinois {
     /// strictly inside the bracket.
     pub fn next_point(&self) -> f64 {
         let (lo, hi, f_lo, f_hi) = (self.lo, self.hi, self.f_lo, self.f_hi);
-        let x = if f_hi != f_lo {
-            (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
-        } else {
+        let x = if f_hi == f_lo {
             0.5 * (lo + hi)
+        } else {
+            (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
         };
         if x <= lo || x >= hi {
             0.5 * (lo + hi)

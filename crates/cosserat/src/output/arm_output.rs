@@ -62,7 +62,7 @@ fn points(g: &hdf5::Group, name: &str, v: &[[f64; 3]]) -> hdf5::Result<()> {
 }
 
 fn rows(g: &hdf5::Group, name: &str, v: &[Vec<f64>]) -> hdf5::Result<()> {
-    let width = v.first().map_or(0, |r| r.len());
+    let width = v.first().map_or(0, std::vec::Vec::len);
     let flat: Vec<f64> = v.iter().flatten().copied().collect();
     array(g, name, &[v.len(), width], &flat)
 }

@@ -87,7 +87,7 @@ fn write_branches(file: &hdf5::File, d: &Diagram) -> hdf5::Result<()> {
             .flat_map(|p| p.eigenvalues.clone())
             .collect();
         array(&g, "eigenvalues", &[m, k], &eig)?;
-        let stable: Vec<u64> = b.points.iter().map(|p| p.stable as u64).collect();
+        let stable: Vec<u64> = b.points.iter().map(|p| u64::from(p.stable)).collect();
         integers(&g, "stable", &stable)?;
         let morse: Vec<u64> = b.points.iter().map(|p| p.morse_index as u64).collect();
         integers(&g, "morse_index", &morse)?;
@@ -141,7 +141,7 @@ fn write_special_points(file: &hdf5::File, d: &Diagram) -> hdf5::Result<()> {
         &g,
         "symmetry_breaking",
         &sp.iter()
-            .map(|s| s.symmetry_breaking as u64)
+            .map(|s| u64::from(s.symmetry_breaking))
             .collect::<Vec<_>>(),
     )?;
     array(

@@ -29,7 +29,7 @@ pub enum Seal {
 /// FNV-1a over a stream of `len` bytes.
 fn hash(reader: &mut impl Read, mut len: u64) -> std::io::Result<u64> {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    let mut buf = [0u8; 1 << 16];
+    let mut buf = vec![0u8; 1 << 16];
     while len > 0 {
         let n = (len.min(buf.len() as u64)) as usize;
         reader.read_exact(&mut buf[..n])?;

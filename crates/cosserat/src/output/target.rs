@@ -260,7 +260,7 @@ fn lock(path: &Path) -> Result<(PathBuf, File), ClaimError> {
             Ok(now) if now.ino() == held.ino() && now.dev() == held.dev() => {
                 return Ok((lock_path, file))
             }
-            _ => continue,
+            _ => {}
         }
     }
     Err(ClaimError::Locked {

@@ -43,7 +43,7 @@ impl Constraints {
     /// orthonormal basis of their span (rows below 1e-10 of the largest
     /// are dropped).
     pub fn from_rows(rows: &[DVector<f64>], n: usize) -> Self {
-        let scale = rows.iter().map(|r| r.norm()).fold(0.0, f64::max);
+        let scale = rows.iter().map(nalgebra::Matrix::norm).fold(0.0, f64::max);
         let mut basis: Vec<DVector<f64>> = Vec::new();
         for r in rows {
             let mut v = r.clone();

@@ -187,6 +187,7 @@ impl FiniteElements {
     /// The same elements for a base that is a hinge about d2(0) (true) or a
     /// clamp (false): with a hinge the in-plane rotation ω2 at s = 0 is an
     /// unknown too.
+    #[must_use]
     pub fn with_hinged_base(self, hinged: bool) -> Self {
         FiniteElements { hinged, ..self }
     }
@@ -194,11 +195,7 @@ impl FiniteElements {
     /// The first node carrying unknowns of a block: 0 where the base lets
     /// the block's rotation free, 1 at a clamp.
     fn first_node(&self, block: Block) -> usize {
-        if self.hinged && block == Block::InPlane {
-            0
-        } else {
-            1
-        }
+        usize::from(!(self.hinged && block == Block::InPlane))
     }
 
     /// Element size.

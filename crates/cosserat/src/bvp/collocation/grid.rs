@@ -540,7 +540,7 @@ impl<'a> Grid<'a> {
         let mut sol = self.solution_parts(&out.x);
         sol.iterations = out.iterations;
         sol.residual = *out.history.last().unwrap_or(&f64::NAN);
-        sol.residual_history = out.history.clone();
+        sol.residual_history.clone_from(&out.history);
         sol.error_estimate = errors.iter().sum();
         if self.n == 12 {
             sol.director_drift = sol

@@ -380,7 +380,9 @@ pub fn solve_collocation_from(
             .collect();
         let added: usize = pieces.iter().map(|&(_, q)| q - 1).sum();
         if grid.intervals() + added > opts.max_intervals {
-            pieces.iter_mut().for_each(|p| p.1 = 2);
+            for p in &mut pieces {
+                p.1 = 2;
+            }
         }
         mesh = refine_into(&grid.mesh, &pieces);
         warm = Some(sol);

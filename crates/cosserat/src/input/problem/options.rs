@@ -48,7 +48,9 @@ pub(super) fn build_continuation(
         // A fixed shape's κ⁰ follows from the load; continuation needs a
         // rod with one κ⁰: only shapes on which the loads make no moment
         // (κ⁰ = φ', e.g. a straight column under an axial load) qualify.
-        let fe_points: Vec<f64> = (0..=64).map(|i| rod.length() * i as f64 / 64.0).collect();
+        let fe_points: Vec<f64> = (0..=64)
+            .map(|i| rod.length() * f64::from(i) / 64.0)
+            .collect();
         let moment = shape
             .samples(rod, &fe_points)
             .map_err(|e| invalid("shape", e.to_string()))?

@@ -7,6 +7,7 @@
 //! 1e-9 (|d1| = |d3| = 1, d1·d3 = 0) and turned by `clamp.angle` about
 //! d2, d3 towards d1.
 
+use std::collections::BTreeMap;
 use std::sync::Arc;
 
 use super::checks::{finite, load_vector, magnitude, vector};
@@ -163,7 +164,7 @@ pub(super) fn build_energy(
     let mut spec = EnergySpec {
         stiffness: Default::default(),
         intrinsic_curvature: Default::default(),
-        parameters: Default::default(),
+        parameters: BTreeMap::default(),
     };
     let mut softest: Option<(f64, String)> = None;
     let mut stiffest: Option<(f64, String)> = None;

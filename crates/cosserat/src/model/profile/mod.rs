@@ -150,6 +150,7 @@ impl Profile {
 
     /// The profile times a constant factor (a control raising an
     /// intrinsic curvature in proportion, paper Sec. 5).
+    #[must_use]
     pub fn scaled(&self, factor: f64) -> Profile {
         let times = |v: &[f64]| v.iter().map(|x| x * factor).collect::<Vec<_>>();
         match self {

@@ -6,7 +6,7 @@ use super::*;
 /// values and derivatives everywhere.
 #[test]
 fn scaled_and_blended_splines_are_the_splines_of_the_values() {
-    let s: Vec<f64> = (0..9).map(|i| i as f64 / 8.0).collect();
+    let s: Vec<f64> = (0..9).map(|i| f64::from(i) / 8.0).collect();
     let a: Vec<f64> = s.iter().map(|x| (3.0 * x).sin()).collect();
     let b: Vec<f64> = s.iter().map(|x| x * x - 2.0 * x).collect();
     let (sa, sb) = (
@@ -35,7 +35,7 @@ fn polynomial_minimum_is_the_root_of_the_derivative() {
     let (s0, delta) = (0.43215, 1e-9);
     let p = Profile::Polynomial(vec![s0 * s0 - delta, -2.0 * s0, 1.0]);
     let sampled = (0..=1000)
-        .map(|i| p.value(i as f64 / 1000.0))
+        .map(|i| p.value(f64::from(i) / 1000.0))
         .fold(f64::INFINITY, f64::min);
     assert!(sampled > 0.0, "{sampled}");
     let e = p.extremes_on(1.0);
@@ -67,11 +67,11 @@ fn polynomial_minimum_is_the_root_of_the_derivative() {
 /// A spline's piecewise cubic extremes against dense sampling.
 #[test]
 fn spline_extremes_match_dense_sampling() {
-    let s: Vec<f64> = (0..7).map(|i| i as f64 / 6.0).collect();
+    let s: Vec<f64> = (0..7).map(|i| f64::from(i) / 6.0).collect();
     let v: Vec<f64> = s.iter().map(|x| (7.0 * x).sin()).collect();
     let p = Profile::spline(s, v).unwrap();
     let e = p.extremes_on(1.0);
-    let dense = (0..=200_000).map(|i| p.value(i as f64 / 200_000.0));
+    let dense = (0..=200_000).map(|i| p.value(f64::from(i) / 200_000.0));
     let (lo, hi) = dense.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
         (a.min(x), b.max(x))
     });
@@ -91,7 +91,7 @@ fn polynomial_value_and_derivative() {
 #[test]
 fn spline_interpolates_smoothly() {
     let f = |x: f64| (2.0 * x).sin();
-    let s: Vec<f64> = (0..=200).map(|i| i as f64 / 200.0).collect();
+    let s: Vec<f64> = (0..=200).map(|i| f64::from(i) / 200.0).collect();
     let p = Profile::spline(s.clone(), s.iter().map(|&x| f(x)).collect()).unwrap();
     for x in [0.3, 0.5123, 0.77] {
         assert!((p.value(x) - f(x)).abs() < 1e-7, "{x}");

@@ -80,18 +80,27 @@ fn full(tolerance: f64) -> Options {
     }
 }
 
+/// A residual that always evaluates, as the fallible kind [`Dense`] takes.
+fn infallible(
+    f: fn(&[f64], &mut [f64], &mut DMatrix<f64>),
+) -> impl FnMut(&[f64], &mut [f64], &mut DMatrix<f64>) -> Result<(), &'static str> {
+    move |x, r, j| {
+        f(x, r, j);
+        Ok(())
+    }
+}
+
 /// F(x) = x² − 2.
-fn sqrt2(x: &[f64], r: &mut [f64], j: &mut DMatrix<f64>) -> Result<(), &'static str> {
+fn sqrt2(x: &[f64], r: &mut [f64], j: &mut DMatrix<f64>) {
     r[0] = x[0] * x[0] - 2.0;
     j[(0, 0)] = 2.0 * x[0];
-    Ok(())
 }
 
 #[test]
 fn sqrt2_to_machine_precision_with_quadratic_convergence() {
     let root = 2f64.sqrt();
     let mut x = [1.0];
-    let rep = solve(&mut Dense::new(1, sqrt2), &mut x, &full(1e-15)).unwrap();
+    let rep = solve(&mut Dense::new(1, infallible(sqrt2)), &mut x, &full(1e-15)).unwrap();
     assert!((x[0] - root).abs() <= f64::EPSILON * root, "{}", x[0]);
     // F_{k+1} = δ_k² = (F_k / 2x_k)², so F_{k+1}/F_k² → 1/(4·2) = 1/8:
     // quadratic convergence, read off the residual history while it is
@@ -133,7 +142,12 @@ fn damping_brings_newton_home_from_far_away() {
 #[test]
 fn singular_jacobian_is_named_not_a_value() {
     let mut x = [0.0];
-    let err = solve(&mut Dense::new(1, sqrt2), &mut x, &damped(1e-12)).unwrap_err();
+    let err = solve(
+        &mut Dense::new(1, infallible(sqrt2)),
+        &mut x,
+        &damped(1e-12),
+    )
+    .unwrap_err();
     assert!(
         matches!(err, NewtonError::SingularJacobian { iteration: 0, .. }),
         "{err}"
@@ -201,7 +215,7 @@ fn line_search_and_iteration_limit_are_named() {
         ..damped(1e-12)
     };
     let mut x = [100.0];
-    let err = solve(&mut Dense::new(1, sqrt2), &mut x, &opts).unwrap_err();
+    let err = solve(&mut Dense::new(1, infallible(sqrt2)), &mut x, &opts).unwrap_err();
     assert!(
         matches!(err, NewtonError::IterationLimit { iterations: 1, ref history } if history.len() == 2),
         "{err}"
@@ -209,18 +223,17 @@ fn line_search_and_iteration_limit_are_named() {
 }
 
 /// Row 0 in units of 1e9 (a stiffness), row 1 in units of 1e−9.
-fn badly_scaled(x: &[f64], r: &mut [f64], j: &mut DMatrix<f64>) -> Result<(), &'static str> {
+fn badly_scaled(x: &[f64], r: &mut [f64], j: &mut DMatrix<f64>) {
     r[0] = 1e9 * (x[0] * x[0] - 2.0);
     r[1] = 1e-9 * (x[1] * x[1] * x[1] - 8.0);
     j.fill(0.0);
     j[(0, 0)] = 2e9 * x[0];
     j[(1, 1)] = 3e-9 * x[1] * x[1];
-    Ok(())
 }
 
 #[test]
 fn a_badly_scaled_system_converges_under_the_scaled_test() {
-    let mut sys = Dense::new(2, badly_scaled);
+    let mut sys = Dense::new(2, infallible(badly_scaled));
     sys.rows = vec![1e9, 1e-9];
     let mut x = [1.0, 1.0];
     let rep = solve(&mut sys, &mut x, &damped(1e-14)).unwrap();
@@ -230,7 +243,12 @@ fn a_badly_scaled_system_converges_under_the_scaled_test() {
     // Unscaled, row 0 cannot get below its round-off 1e9 · 4e−16 = 4e−7:
     // Newton runs into round-off without ever meeting the test.
     let mut x = [1.0, 1.0];
-    let err = solve(&mut Dense::new(2, badly_scaled), &mut x, &damped(1e-14)).unwrap_err();
+    let err = solve(
+        &mut Dense::new(2, infallible(badly_scaled)),
+        &mut x,
+        &damped(1e-14),
+    )
+    .unwrap_err();
     assert!(
         matches!(
             err,
@@ -246,7 +264,7 @@ fn the_correction_test_is_not_fooled_by_a_tiny_residual() {
     // Row 1 alone is below τ at x₀ = (√2, 1), yet x₁ is far from 2: the
     // correction test keeps Newton going.
     let mut x = [2f64.sqrt(), 1.0];
-    let mut sys = Dense::new(2, badly_scaled);
+    let mut sys = Dense::new(2, infallible(badly_scaled));
     sys.rows = vec![1e9, 1.0];
     let tolerance: f64 = 1e-7;
     let rep = solve(&mut sys, &mut x, &damped(tolerance)).unwrap();

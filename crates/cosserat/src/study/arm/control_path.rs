@@ -48,7 +48,7 @@ pub fn control_path_until(
     points: usize,
     stop: &dyn Fn() -> bool,
 ) -> Result<Diagram, ContinuationError> {
-    let rod = designed_rod(problem, scene, design, points).map_err(not_built)?;
+    let rod = designed_rod(problem, scene, design, points).map_err(|e| not_built(&e))?;
     continue_to_design(problem, rod, Parameter::ControlScale, stop)
 }
 
@@ -72,7 +72,7 @@ pub fn loading_path_until(
     points: usize,
     stop: &dyn Fn() -> bool,
 ) -> Result<Diagram, ContinuationError> {
-    let rod = designed_rod(problem, scene, design, points).map_err(not_built)?;
+    let rod = designed_rod(problem, scene, design, points).map_err(|e| not_built(&e))?;
     continue_to_design(problem, rod, Parameter::LoadScale, stop)
 }
 
@@ -102,7 +102,7 @@ pub fn shape_holding_path_until(
     points: usize,
     stop: &dyn Fn() -> bool,
 ) -> Result<Diagram, ContinuationError> {
-    let target = designed_rod(problem, scene, design, points).map_err(not_built)?;
+    let target = designed_rod(problem, scene, design, points).map_err(|e| not_built(&e))?;
     let s: Vec<f64> = (0..points)
         .map(|i| i as f64 / (points - 1) as f64)
         .collect();
@@ -112,11 +112,11 @@ pub fn shape_holding_path_until(
         [problem.b1, 1.0, problem.b3].map(Profile::Constant),
         [
             Profile::Constant(0.0),
-            Profile::spline(s, unloaded).map_err(not_built)?,
+            Profile::spline(s, unloaded).map_err(|e| not_built(&e))?,
             Profile::Constant(0.0),
         ],
     )
-    .map_err(not_built)?;
+    .map_err(|e| not_built(&e))?;
     let base = target.clone().with_energy(Arc::new(unloaded));
     let family = Family::towards(
         base,
@@ -129,7 +129,7 @@ pub fn shape_holding_path_until(
 }
 
 /// A designed rod that cannot be built: continuation cannot start.
-fn not_built(e: crate::model::ModelError) -> ContinuationError {
+fn not_built(e: &crate::model::ModelError) -> ContinuationError {
     ContinuationError::Start {
         p: 0.0,
         message: format!("the designed rod cannot be built: {e}"),

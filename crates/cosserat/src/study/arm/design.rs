@@ -34,12 +34,12 @@ pub(super) fn quadrature() -> Vec<(f64, f64)> {
         0.236_926_885_056_189_1,
     ];
     let panels = 32;
-    let h = 1.0 / panels as f64;
+    let h = 1.0 / f64::from(panels);
     (0..panels)
         .flat_map(|p| {
             X.iter()
                 .zip(W)
-                .map(move |(x, w)| ((p as f64 + 0.5 * (x + 1.0)) * h, 0.5 * w * h))
+                .map(move |(x, w)| ((f64::from(p) + 0.5 * (x + 1.0)) * h, 0.5 * w * h))
         })
         .collect()
 }
@@ -106,7 +106,7 @@ impl ArmProblem {
         let crit = critical_load(&rod, &shape, &self.stability).ok()?;
         let mut gamma = crit.load_factor?;
         if scene.max_curvature.is_some() {
-            let points: Vec<f64> = (0..=200).map(|i| i as f64 / 200.0).collect();
+            let points: Vec<f64> = (0..=200).map(|i| f64::from(i) / 200.0).collect();
             let samples = shape.samples(&rod, &points).ok()?;
             let dphi = derivative(&c);
             let phi1: Vec<f64> = points.iter().map(|s| polynomial(&dphi, *s)).collect();

@@ -226,7 +226,7 @@ impl ArmProblem {
             .ok()?
             .load_factor?;
         let n = 101;
-        let points: Vec<f64> = (0..n).map(|i| i as f64 / (n - 1) as f64).collect();
+        let points: Vec<f64> = (0..n).map(|i| f64::from(i) / f64::from(n - 1)).collect();
         let samples = shape.samples(&rod, &points).ok()?;
         let c = &design.shape_coefficients;
         let dphi = derivative(c);

@@ -85,7 +85,7 @@ impl ArmProblem {
             } else {
                 crate::bvp::Strategy::Auto
             },
-            initial_guess: guess.map(|g| g.to_vec()),
+            initial_guess: guess.map(<[f64]>::to_vec),
             output_points: 101,
             // The elevation must be met to 1e-12 by the secant in θ, also
             // near Euler's load where the column amplifies residuals.
@@ -153,8 +153,8 @@ impl ArmProblem {
     /// (checked before every load step): the result is then the farthest
     /// stable level equilibrium found so far, marked interrupted.
     pub fn straight_until(&self, stop: &dyn Fn() -> bool) -> Option<StraightArm> {
-        let opts = crate::bvp::SolverOptions::default();
         type Level = (f64, Vec<f64>);
+        let opts = crate::bvp::SolverOptions::default();
         let reach =
             |gamma: f64, eq: &crate::bvp::Equilibrium| gamma.sqrt() * eq.tip().position.norm();
         let level = |gamma: f64, from: &Level| -> Option<(bool, Level, f64)> {

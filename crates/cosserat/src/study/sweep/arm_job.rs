@@ -52,11 +52,11 @@ pub fn shape_distance(a: &[f64], b: &[f64]) -> f64 {
     let n = 41;
     let sum: f64 = (0..n)
         .map(|i| {
-            let s = i as f64 / (n - 1) as f64;
+            let s = f64::from(i) / f64::from(n - 1);
             (phi(a, s) - phi(b, s)).powi(2)
         })
         .sum();
-    (sum / n as f64).sqrt()
+    (sum / f64::from(n)).sqrt()
 }
 
 /// Two designs are one local optimum unless their loaded shapes differ
