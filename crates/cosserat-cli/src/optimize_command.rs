@@ -342,8 +342,8 @@ fn report_problem(path: &Path, arm: &ArmProblem, scene: &ArmScene) {
         arm.b3,
         arm.alpha.to_degrees(),
         arm.coefficients(),
-        arm.stability.elements,
-        arm.stability.order
+        arm.stability.elements(),
+        arm.stability.order()
     );
     match scene.weight {
         ArmWeight::Weightless => {}

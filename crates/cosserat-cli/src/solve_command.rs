@@ -84,7 +84,8 @@ pub fn run_stability(path: &Path, output: Option<&Path>, set: &[String], force: 
     let opts = &problem.stability;
     println!(
         "mesh      {} elements of order {}",
-        opts.elements, opts.order
+        opts.elements(),
+        opts.order()
     );
     let result = if let Some(shape) = &problem.shape {
         match critical_load(&problem.rod, shape, opts) {

@@ -14,11 +14,7 @@ fn problem(b1: f64, b3: f64, bounds: Vec<(f64, f64)>) -> ArmProblem {
         b3,
         alpha: 0.0,
         bounds,
-        stability: StabilityOptions {
-            elements: 100,
-            order: 2,
-            eigenvalues: 1,
-        },
+        stability: StabilityOptions::new(100, 2, 1).unwrap(),
     }
 }
 
@@ -240,11 +236,7 @@ fn straight_rod(b: [f64; 3], phi: f64) -> (cosserat::model::Rod, cosserat::stabi
 }
 
 fn fine() -> StabilityOptions {
-    StabilityOptions {
-        elements: 200,
-        order: 2,
-        eigenvalues: 1,
-    }
+    StabilityOptions::new(200, 2, 1).unwrap()
 }
 
 /// Greenhill's standing column under its own weight (the fixed shape

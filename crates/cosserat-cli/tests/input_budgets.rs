@@ -44,7 +44,7 @@ fn eigenvalue_counts_beyond_the_mesh_are_refused_not_a_panic() {
     // Past the reader: the computation says why.
     let p = accepted(&text, &[]);
     let (family, mut opts) = p.continuation.clone().unwrap();
-    opts.stability.eigenvalues = 100;
+    opts.stability = opts.stability.with_eigenvalues(100).unwrap();
     opts.max_points = 3;
     let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         continuation(&family, &opts, &mut |_, _| true)
@@ -215,15 +215,14 @@ fn stability_options_out_of_range_are_errors_not_clamps() {
     let shape = FixedShape {
         turning_angle: Profile::Constant(0.0),
     };
+    // Options no mesh can honour cannot be built at all, so no analysis
+    // can receive them.
     for (elements, order) in [(10, 5), (0, 2), (10, 0)] {
-        let opts = StabilityOptions {
-            elements,
-            order,
-            eigenvalues: 1,
-        };
-        let e = critical_load(&rod, &shape, &opts)
+        let e = StabilityOptions::new(elements, order, 1)
             .expect_err("refused")
             .to_string();
         assert!(e.contains("order 1, 2 or 3"), "{e}");
     }
+    let opts = StabilityOptions::new(10, 2, 1).unwrap();
+    assert!(critical_load(&rod, &shape, &opts).is_ok());
 }

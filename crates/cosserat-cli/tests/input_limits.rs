@@ -232,11 +232,7 @@ fn a_hanging_arm_has_no_critical_load() {
         let shape = FixedShape {
             turning_angle: Profile::Constant(std::f64::consts::FRAC_PI_2),
         };
-        let opts = StabilityOptions {
-            elements: 100,
-            order: 1,
-            eigenvalues: 1,
-        };
+        let opts = StabilityOptions::new(100, 1, 1).unwrap();
         let crit = critical_load(&rod, &shape, &opts).unwrap();
         assert_eq!(
             crit.load_factor, None,

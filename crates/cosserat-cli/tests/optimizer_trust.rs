@@ -253,7 +253,7 @@ fn shipped_optima_carry_their_discretization_error() {
         assert!((order - 2.0).abs() < 0.1, "{file}: order {order}");
         let error = r.study.error().unwrap();
         let mut fine = arm.clone();
-        fine.stability.elements = 800;
+        fine.stability = fine.stability.with_elements(800).unwrap();
         let reference = fine
             .design(&o.design.shape_coefficients[1..])
             .unwrap()
@@ -292,7 +292,7 @@ fn optimizer_does_not_exploit_the_mesh() {
     let rest = &o.design.shape_coefficients[1..];
     for elements in [1600, 3200] {
         let mut check = arm.clone();
-        check.stability.elements = elements;
+        check.stability = check.stability.with_elements(elements).unwrap();
         let reach = check.design(rest).unwrap().reach;
         assert!(
             (o.design.reach - reach).abs() <= REACH_TOLERANCE * reach,
@@ -302,7 +302,7 @@ fn optimizer_does_not_exploit_the_mesh() {
     }
     let (paper, _) = arm_from_file("longest_arm_fig5.toml", &[]);
     let mut paper400 = paper.clone();
-    paper400.stability.elements = 400;
+    paper400.stability = paper400.stability.with_elements(400).unwrap();
     let paper_optimum = paper.optimize(&search).unwrap();
     let inside = paper400
         .design(&paper_optimum.design.shape_coefficients[1..])

@@ -81,11 +81,7 @@ fn main() {
         turning_angle: Profile::Constant(0.0),
     };
     for order in [1, 2] {
-        let so = StabilityOptions {
-            elements: 100,
-            order,
-            eigenvalues: 1,
-        };
+        let so = StabilityOptions::new(100, order, 1).unwrap();
         let t = time(51, || {
             std::hint::black_box(critical_load(&straight, &shape, &so).unwrap());
         });

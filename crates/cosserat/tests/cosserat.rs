@@ -91,11 +91,7 @@ fn shearable_column_buckles_at_haringx_load() {
     let p_euler = PI * PI / 4.0;
     let haringx = 0.5 * s1 * ((1.0 + 4.0 * p_euler / s1).sqrt() - 1.0);
     let column = |p: f64| rod([s1, 1e3, 1e12], Vector3::new(0.0, 0.0, -p));
-    let opts = StabilityOptions {
-        elements: 40,
-        order: 3,
-        eigenvalues: 2,
-    };
+    let opts = StabilityOptions::new(40, 3, 2).unwrap();
     let lowest = |p: f64| {
         let r = column(p);
         let eq = solve_cosserat(&r, Method::Shooting);

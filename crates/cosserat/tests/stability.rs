@@ -360,11 +360,7 @@ fn eigenvalues_converge_at_order_two_p() {
         let errors: Vec<f64> = meshes
             .iter()
             .map(|&elements| {
-                let opts = StabilityOptions {
-                    elements,
-                    order,
-                    eigenvalues: 1,
-                };
+                let opts = StabilityOptions::new(elements, order, 1).unwrap();
                 let st = analyze(&rod, &eq, &SolverOptions::default(), &opts).unwrap();
                 (st.blocks[0].eigenvalues[0] - exact).abs()
             })

@@ -89,11 +89,7 @@ impl Column {
     fn lowest(&self, thrust: f64) -> (f64, f64) {
         let p = self.at(thrust);
         let eq = solve_with(&p, Method::Shooting);
-        let opts = StabilityOptions {
-            elements: 40,
-            order: 3,
-            eigenvalues: 2,
-        };
+        let opts = StabilityOptions::new(40, 3, 2).unwrap();
         let st = analyze(&p.rod, &eq, &p.options, &opts).unwrap();
         let lowest = st
             .blocks

@@ -154,11 +154,7 @@ fn verdict_comes_from_a_resolved_mesh() {
         &rod,
         &eq,
         &opts,
-        &StabilityOptions {
-            elements: 3200,
-            order: 3,
-            eigenvalues: 12,
-        },
+        &StabilityOptions::new(3200, 3, 12).unwrap(),
     )
     .unwrap();
     assert!(fine.morse_index > 0, "the looped shape is unstable");
@@ -180,16 +176,6 @@ fn verdict_comes_from_a_resolved_mesh() {
 fn coarse_verdict_is_never_a_default() {
     use cosserat::stability::{decide, StabilityOptions, Verdict};
     let (rod, opts, eq) = looped_equilibrium();
-    let decision = decide(
-        &rod,
-        &eq,
-        &opts,
-        &StabilityOptions {
-            elements: 4,
-            order: 1,
-            eigenvalues: 1,
-        },
-    )
-    .unwrap();
+    let decision = decide(&rod, &eq, &opts, &StabilityOptions::new(4, 1, 1).unwrap()).unwrap();
     assert_ne!(decision.verdict, Verdict::Stable);
 }

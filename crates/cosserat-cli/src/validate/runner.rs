@@ -234,7 +234,8 @@ fn critical_load_outcome(
             time: 0.0,
             message: format!(
                 "{} elements of order {}",
-                problem.stability.elements, problem.stability.order
+                problem.stability.elements(),
+                problem.stability.order()
             ),
         }),
         Err(e) => Err(e.to_string()),

@@ -68,7 +68,7 @@ impl Run<'_> {
         // The per-block Morse indices are recomputed from the stored
         // eigenvalues: tracked values below zero, plus any beyond the
         // computed ones is impossible (they are the lowest).
-        let k = self.opts.stability.eigenvalues;
+        let k = self.opts.stability.eigenvalues();
         p.eigenvalues
             .chunks(k)
             .map(|c| c.iter().filter(|v| **v < 0.0).count())

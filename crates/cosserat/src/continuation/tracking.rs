@@ -73,17 +73,13 @@ impl Tracker {
     pub fn names(&self) -> Vec<String> {
         self.blocks
             .iter()
-            .flat_map(|b| (0..self.opts.eigenvalues).map(move |i| format!("{}[{i}]", b.name())))
+            .flat_map(|b| (0..self.opts.eigenvalues()).map(move |i| format!("{}[{i}]", b.name())))
             .collect()
     }
 
     /// Finite-element nodes of the modes (at the base length).
     pub fn nodes(&self) -> Vec<f64> {
-        if self.opts.check().is_err() {
-            // Options no mesh can honour: measure() reports why.
-            return vec![];
-        }
-        FiniteElements::new(self.base_length, self.opts.elements, self.opts.order).nodes()
+        FiniteElements::new(self.base_length, self.opts.elements(), self.opts.order()).nodes()
     }
 
     /// Forget the previous eigenvectors (a new branch starts).
@@ -100,10 +96,7 @@ impl Tracker {
         p: f64,
     ) -> Result<(FiniteElements, Vec<BlockMatrices>, f64, Vec<RodSample>), PointError> {
         let rod = family.rod_at(p)?;
-        self.opts
-            .check()
-            .map_err(|e| PointError::Eigen(e.to_string()))?;
-        let fe = FiniteElements::new(rod.length(), self.opts.elements, self.opts.order)
+        let fe = FiniteElements::new(rod.length(), self.opts.elements(), self.opts.order())
             .with_hinged_base(rod.clamp().hinge);
         // One integration for the quadrature points and the 21 shape points
         // (the last is the tip).
@@ -164,20 +157,20 @@ impl Tracker {
                     (b[0], *b.get(1).unwrap_or(&b[0]))
                 });
             let pairs =
-                lowest_eigenpairs_constrained(k, g, constraints, self.opts.eigenvalues, near)
+                lowest_eigenpairs_constrained(k, g, constraints, self.opts.eigenvalues(), near)
                     .map_err(|e| PointError::Eigen(e.to_string()))?;
             // Every block fills its `eigenvalues` columns of the diagram; a
             // mesh with fewer unknowns than that cannot (the eigensolver
             // returns at most the block's dimension).
-            if pairs.values.len() != self.opts.eigenvalues {
+            if pairs.values.len() != self.opts.eigenvalues() {
                 return Err(PointError::Eigen(format!(
                     "the {} block has only {} eigenvalues on {} elements of order {}, \
                      {} are tracked: lower continuation.eigenvalues or raise continuation.elements",
                     self.blocks[bi].name(),
                     pairs.values.len(),
-                    self.opts.elements,
-                    self.opts.order,
-                    self.opts.eigenvalues
+                    self.opts.elements(),
+                    self.opts.order(),
+                    self.opts.eigenvalues()
                 )));
             }
             let order = match &self.previous {
@@ -203,7 +196,7 @@ impl Tracker {
             );
         }
         self.previous = Some(vectors.clone());
-        let k = self.opts.eigenvalues;
+        let k = self.opts.eigenvalues();
         self.previous_values = Some(values.chunks(k).map(<[f64]>::to_vec).collect());
         let shape = shape_samples.iter().map(|s| s.position).collect();
         Ok(Spectrum {
@@ -233,7 +226,7 @@ impl Tracker {
             .position(|&b| b == block)
             .expect("a tracked block");
         let (k, g, constraints) = &mats[bi];
-        let pairs = lowest_eigenpairs_constrained(k, g, constraints, self.opts.eigenvalues, None)
+        let pairs = lowest_eigenpairs_constrained(k, g, constraints, self.opts.eigenvalues(), None)
             .map_err(|e| PointError::Eigen(e.to_string()))?;
         let i = (0..pairs.values.len())
             .min_by(|&a, &b| pairs.values[a].abs().total_cmp(&pairs.values[b].abs()))

@@ -220,7 +220,7 @@ impl ArmSection {
                 "must be at least 1 (Nelder–Mead polishes and their iterations; e.g. 4 and 400)",
             ));
         }
-        reach_direction(self.alpha, stability.elements)?;
+        reach_direction(self.alpha, stability.elements())?;
         let b2 = h[(1, 1)];
         Ok((
             ArmProblem {

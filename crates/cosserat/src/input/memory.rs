@@ -142,13 +142,13 @@ fn add_solver(e: &mut MemoryEstimate, problem: &Problem, n: f64, u: f64) {
 /// The stability verdict's finest mesh.
 fn add_stability(e: &mut MemoryEstimate, problem: &Problem) {
     let st = &problem.stability;
-    let finest = st.elements as f64 * 2f64.powi(REFINEMENTS as i32);
+    let finest = st.elements() as f64 * 2f64.powi(REFINEMENTS as i32);
     e.add(
         "stability.elements",
-        finite_elements(finest, st.order as f64, st.eigenvalues as f64 + 1.0),
+        finite_elements(finest, st.order() as f64, st.eigenvalues() as f64 + 1.0),
         format!(
             "the verdict's finest mesh, {finest} elements of order {}",
-            st.order
+            st.order()
         ),
     );
 }
@@ -167,7 +167,7 @@ fn add_continuation(e: &mut MemoryEstimate, problem: &Problem) {
             6.0 * 8.0 * size * size,
             format!("dense bordered systems of {size} unknowns, 6 × 8 × {size}²"),
         );
-        let k = opts.stability.eigenvalues as f64;
+        let k = opts.stability.eigenvalues() as f64;
         let branches = (1.0 + f64::from(u8::from(opts.both_directions)))
             * (1.0 + 6.0 * k * opts.switch_depth as f64);
         let per_point = 8.0 * (2.0 * size + 1.0 + 3.0 * k + 63.0) + SAMPLE + 256.0;
@@ -177,7 +177,10 @@ fn add_continuation(e: &mut MemoryEstimate, problem: &Problem) {
             max_points * branches * per_point,
             format!("{max_points} points × {branches} branches × {per_point} bytes"),
         );
-        let (elements, order) = (opts.stability.elements as f64, opts.stability.order as f64);
+        let (elements, order) = (
+            opts.stability.elements() as f64,
+            opts.stability.order() as f64,
+        );
         e.add(
             "continuation.elements",
             finite_elements(elements, order, k) + 8.0 * 3.0 * k * 3.0 * elements * order,
@@ -189,13 +192,13 @@ fn add_continuation(e: &mut MemoryEstimate, problem: &Problem) {
 /// The arm optimization's finite elements, map samples and sweep grid.
 fn add_arm(e: &mut MemoryEstimate, problem: &Problem) {
     if let Some((arm, _, _)) = &problem.arm {
-        let elements = 4.0 * arm.stability.elements as f64;
+        let elements = 4.0 * arm.stability.elements() as f64;
         e.add(
             "arm.elements",
-            finite_elements(elements, arm.stability.order as f64, 1.0),
+            finite_elements(elements, arm.stability.order() as f64, 1.0),
             format!(
                 "4 × arm.elements = {elements} elements of order {}",
-                arm.stability.order
+                arm.stability.order()
             ),
         );
     }

@@ -32,29 +32,26 @@ impl MeshKeys<'_> {
     pub(crate) fn build(&self) -> Result<StabilityOptions, ProblemError> {
         let default = StabilityOptions::default();
         let key = |k: &str| format!("{}.{k}", self.table);
-        let elements = self.elements.unwrap_or(default.elements);
+        let elements = self.elements.unwrap_or(default.elements());
         if elements < self.min_elements {
             return Err(invalid(
                 key("elements"),
                 format!("must be at least {}, got {elements}", self.min_elements),
             ));
         }
-        let order = self.order.unwrap_or(default.order);
+        let order = self.order.unwrap_or(default.order());
         if !(1..=3).contains(&order) {
             return Err(invalid(
                 key("order"),
                 format!("must be 1, 2 or 3, got {order}"),
             ));
         }
-        let eigenvalues = self.eigenvalues.unwrap_or(default.eigenvalues);
+        let eigenvalues = self.eigenvalues.unwrap_or(default.eigenvalues());
         if eigenvalues < 1 {
             return Err(invalid(key("eigenvalues"), "must be at least 1"));
         }
-        Ok(StabilityOptions {
-            elements,
-            order,
-            eigenvalues,
-        })
+        StabilityOptions::new(elements, order, eigenvalues)
+            .map_err(|e| invalid(self.table, e.to_string()))
     }
 }
 

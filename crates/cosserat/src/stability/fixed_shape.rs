@@ -166,7 +166,6 @@ pub fn critical_load(
             "the loads must lie in the plane of d1(0), d3(0)".into(),
         ));
     }
-    opts.check()?;
     let fe = FiniteElements::new(rod.length(), opts.elements, opts.order);
     let samples = shape.samples(rod, &fe.quadrature_points())?;
     let (c0, c1) = split_coefficients(rod, &samples);

@@ -23,31 +23,57 @@ use constrained::{count_below_constrained, lowest_eigenpairs_constrained, Constr
 use eigen::{EigenError, Inertia, UndecidedInertia};
 
 /// How the second variation is discretized and how much of its spectrum is
-/// computed.
+/// computed: `elements` Lagrange elements of order `order` (1 to 3;
+/// eigenvalues converge at order 2p), the `eigenvalues` lowest per block.
+/// Checked when built, so that no analysis can receive options it would
+/// have to clamp (an order 5 once ran silently at order 3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct StabilityOptions {
-    /// Number of finite elements.
-    pub elements: usize,
-    /// Lagrange order of the elements (1 to 3); eigenvalues converge at
-    /// order 2p.
-    pub order: usize,
-    /// Number of lowest eigenvalues reported per block.
-    pub eigenvalues: usize,
+    elements: usize,
+    order: usize,
+    eigenvalues: usize,
 }
 
 impl StabilityOptions {
-    /// The options a finite-element discretization can honour: at least
-    /// one element, order 1 to 3, at least one eigenvalue. (The elements
-    /// used to clamp other values silently: an order 5 ran at order 3.)
-    pub fn check(&self) -> Result<(), StabilityError> {
-        if self.elements < 1 || !(1..=3).contains(&self.order) || self.eigenvalues < 1 {
+    /// At least one element, order 1, 2 or 3, at least one eigenvalue;
+    /// otherwise [`StabilityError::Options`] saying which.
+    pub fn new(elements: usize, order: usize, eigenvalues: usize) -> Result<Self, StabilityError> {
+        if elements < 1 || !(1..=3).contains(&order) || eigenvalues < 1 {
             return Err(StabilityError::Options(format!(
-                "{} elements of order {} with {} eigenvalues: the elements need at least one \
-                 element, order 1, 2 or 3 and at least one eigenvalue",
-                self.elements, self.order, self.eigenvalues
+                "{elements} elements of order {order} with {eigenvalues} eigenvalues: the \
+                 elements need at least one element, order 1, 2 or 3 and at least one eigenvalue"
             )));
         }
-        Ok(())
+        Ok(StabilityOptions {
+            elements,
+            order,
+            eigenvalues,
+        })
+    }
+
+    /// Number of finite elements.
+    pub fn elements(&self) -> usize {
+        self.elements
+    }
+
+    /// Lagrange order of the elements (1 to 3).
+    pub fn order(&self) -> usize {
+        self.order
+    }
+
+    /// Number of lowest eigenvalues reported per block.
+    pub fn eigenvalues(&self) -> usize {
+        self.eigenvalues
+    }
+
+    /// The same options on `elements` elements (checked as by [`Self::new`]).
+    pub fn with_elements(self, elements: usize) -> Result<Self, StabilityError> {
+        Self::new(elements, self.order, self.eigenvalues)
+    }
+
+    /// The same mesh with `eigenvalues` eigenvalues per block (checked).
+    pub fn with_eigenvalues(self, eigenvalues: usize) -> Result<Self, StabilityError> {
+        Self::new(self.elements, self.order, eigenvalues)
     }
 }
 
@@ -76,7 +102,7 @@ pub enum StabilityError {
     /// A fixed-shape scene the method does not cover.
     #[error("fixed shape: {0}")]
     FixedShape(String),
-    /// Options no discretization can honour ([`StabilityOptions::check`]).
+    /// Options no discretization can honour ([`StabilityOptions::new`]).
     #[error("stability options: {0}")]
     Options(String),
     /// A scene the second variation is not implemented for.
@@ -213,7 +239,6 @@ pub fn analyze(
     opts: &StabilityOptions,
 ) -> Result<Stability, StabilityError> {
     check_conservative(rod)?;
-    opts.check()?;
     let fe = FiniteElements::new(rod.length(), opts.elements, opts.order)
         .with_hinged_base(rod.clamp().hinge);
     let mut points = fe.quadrature_points();

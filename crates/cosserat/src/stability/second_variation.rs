@@ -169,7 +169,7 @@ fn gauss(m: usize) -> (Vec<f64>, Vec<f64>) {
 impl FiniteElements {
     /// `elements` ≥ 1 elements of order `order` (1 to 3) on [0, length].
     /// Other values are a caller's error (the analyses check their options,
-    /// [`super::StabilityOptions::check`]); they used to be clamped
+    /// [`super::StabilityOptions::new`]); they used to be clamped
     /// silently, so that an order 5 ran at order 3.
     pub fn new(length: f64, elements: usize, order: usize) -> Self {
         assert!(

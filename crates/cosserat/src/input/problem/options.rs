@@ -132,7 +132,7 @@ pub(super) fn build_shape(file: &ProblemFile) -> Result<Option<FixedShape>, Prob
 /// (elements × order), and a tip support removes up to six more
 /// (three held translations, three held rotations).
 pub(crate) fn fewest_block_unknowns(opts: &StabilityOptions, rod: &Rod) -> usize {
-    let nodes = opts.elements.saturating_mul(opts.order);
+    let nodes = opts.elements().saturating_mul(opts.order());
     if rod.support().is_some() {
         nodes.saturating_sub(6)
     } else {
@@ -148,16 +148,16 @@ pub(super) fn eigenvalue_count(
     rod: &Rod,
 ) -> Result<(), ProblemError> {
     let most = fewest_block_unknowns(opts, rod);
-    if opts.eigenvalues > most {
+    if opts.eigenvalues() > most {
         return Err(invalid(
             format!("{table}.eigenvalues"),
             format!(
                 "{} eigenvalues per block, but the smallest block of {} elements of order {} \
                  has {most} unknowns{}: lower {table}.eigenvalues to at most {most} or raise \
                  {table}.elements",
-                opts.eigenvalues,
-                opts.elements,
-                opts.order,
+                opts.eigenvalues(),
+                opts.elements(),
+                opts.order(),
                 if rod.support().is_some() {
                     " (elements × order, less six held by the support)"
                 } else {

@@ -218,10 +218,11 @@ pub(crate) fn continue_family(
         max_step: 0.05,
         switch_depth: 0,
         max_points: 4000,
-        stability: StabilityOptions {
-            eigenvalues: 2,
-            ..problem.stability
-        },
+        // Two eigenvalues: the lowest and the next, to see the crossing.
+        stability: problem
+            .stability
+            .with_eigenvalues(2)
+            .expect("two eigenvalues on a valid mesh"),
         ..Default::default()
     };
     continuation(family, &opts, &mut |_, _| !stop())

@@ -114,10 +114,14 @@ pub struct Resolution {
 }
 
 impl ArmProblem {
-    /// This problem on `elements` elements.
+    /// This problem on `elements` elements (a refinement of its valid
+    /// mesh: at least as many elements).
     fn on_mesh(&self, elements: usize) -> ArmProblem {
         let mut p = self.clone();
-        p.stability.elements = elements;
+        p.stability = p
+            .stability
+            .with_elements(elements)
+            .expect("a refined mesh of valid options is valid");
         p
     }
 
@@ -136,7 +140,7 @@ impl ArmProblem {
         design: &ArmDesign,
         iterations: u64,
     ) -> (MeshStudy, usize) {
-        let n = self.stability.elements;
+        let n = self.stability.elements();
         let rest = &design.shape_coefficients[1..];
         let reach = |m: usize| self.on_mesh(m).design_in(scene, rest).map(|d| d.reach);
         let (r2, r4) = (reach(2 * n), reach(4 * n));
@@ -208,7 +212,7 @@ impl ArmProblem {
         loop {
             let (study, used) = problem.mesh_study(scene, &optimum.design, opts.iterations);
             optimum.evaluations += used;
-            let fine = 4 * problem.stability.elements;
+            let fine = 4 * problem.stability.elements();
             let verdict = if study.resolved(tolerance) {
                 Some(if rejected.is_empty() {
                     Verdict::Resolved
