@@ -18,11 +18,11 @@
 //!
 //! | stage | module | takes | gives |
 //! |---|---|---|---|
-//! | numerics | [`numerics`] | numbers | the damped Newton method (a system's residual and linear solve) with its convergence test, Gauss–Legendre tables, scalar root finding and maximization, the banded LDLᵀ with inertia, the DOP853 integrator — nothing of rods |
+//! | numerics | [`numerics`] | numbers | the damped Newton method (a system's residual and linear solve) with its convergence test, Gauss–Legendre tables, scalar root finding and maximization, the banded LDLᵀ with inertia, the eigensolvers of banded pencils (inertia counts, shift-invert Lanczos, constrained pencils), the DOP853 integrator — nothing of rods |
 //! | model | [`model`] | lengths, stiffnesses, loads | [`model::Rod`]: length, `Arc<dyn` [`model::StoredEnergy`]`>`, clamp, [`model::DeadLoads`], an optional [`model::TipSupport`]; n(s) = P + R + ∫_s^L f is known up to the tip reaction R |
 //! | equations | [`equations`] | a rod and its [`model::ModelLevel`] | a [`equations::RodEquations`]: the first-order ODEs (planar 4, Kirchhoff 9, Cosserat 9 with ν = e3 + S⁻¹N), their linearization, clamp and tip residuals |
 //! | equilibrium | [`bvp`] | the equations | [`bvp::solve`] by shooting, multiple shooting or Gauss–Legendre collocation with damped Newton → [`bvp::Equilibrium`]: samples (s, r, d1, d2, d3, κ, M, n), unknowns, Jacobian |
-//! | stability | [`stability`] | an equilibrium | [`stability::analyze`]: per quadrature point the [`stability::FormCoefficients`] (A = H, B, C) of δ²V, finite elements, banded K and G, LDLᵀ inertia and Lanczos → [`stability::Stability`] (spectra, Morse index); [`stability::critical_load`] of a fixed shape |
+//! | stability | [`stability`] | an equilibrium | [`stability::analyze`]: per quadrature point the [`stability::FormCoefficients`] (A = H, B, C) of δ²V, finite elements, banded K and G, their inertia and lowest eigenpairs (numerics) → [`stability::Stability`] (spectra, Morse index); [`stability::critical_load`] of a fixed shape |
 //! | continuation | [`continuation`] | a [`continuation::Family`] F(x, p) = 0 | [`continuation::continuation`]: predictor–corrector, eigenvalue tracking, folds and branch points → [`continuation::Diagram`] |
 //! | study | [`study`] | a [`study::Problem`] | [`study::arm`]: fixed-shape critical loads over the shape coefficients, Sobol' + Nelder–Mead → [`study::arm::ArmOptimum`]; [`study::sweep`]: a job at every point of a grid in parallel → one [`study::sweep::Record`] per point |
 //!

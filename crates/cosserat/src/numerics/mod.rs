@@ -2,13 +2,19 @@
 //! quadrature tables ([`quadrature`]), scalar root finding and
 //! one-dimensional search ([`scalar`]), symmetric banded matrices with
 //! their LDLᵀ factorization and inertia ([`banded`]), the DOP853
-//! integrator ([`integrator`]), and the damped Newton method with its
-//! convergence test ([`newton`]). The stages above use them; nothing here
-//! imports a stage. `stability::banded`, `bvp::integrator` and
+//! integrator ([`integrator`]), the damped Newton method with its
+//! convergence test ([`newton`]) and a dense LU for its small systems
+//! ([`dense`]), and the eigensolvers of symmetric-definite banded pencils
+//! (K, G): inertia counts, shift-invert Lanczos ([`eigen`]), and the pencil
+//! restricted to the null space of a few constraints ([`constrained`]).
+//! The stages above use them; nothing here imports a stage.
+//! `stability::{banded, eigen, constrained}`, `bvp::integrator` and
 //! `bvp::newton::Convergence` remain as re-exports.
 
 pub mod banded;
+pub mod constrained;
 pub mod dense;
+pub mod eigen;
 pub mod integrator;
 pub mod newton;
 pub mod quadrature;

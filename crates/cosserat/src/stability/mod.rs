@@ -5,9 +5,7 @@
 //! load of a fixed loaded shape, where K(λ) = K0 + λK1 is linear in the load
 //! factor and λ_crit is a generalized eigenvalue (no root finder).
 
-pub use crate::numerics::banded;
-pub mod constrained;
-pub mod eigen;
+pub use crate::numerics::{banded, constrained, eigen};
 mod fixed_shape;
 mod second_variation;
 
