@@ -1,7 +1,7 @@
 //! The checked problem: everything a problem file asks for, as values of
 //! the stages (a rod, a model level, solver settings, and optionally a
 //! fixed shape, a continued family, an arm study and a sweep grid).
-//! [`crate::input`] builds it from TOML text; the commands and the sweep
+//! The `input` module builds it from TOML text; the commands and the sweep
 //! read it.
 
 use crate::bvp::SolverOptions;

@@ -4,14 +4,14 @@
 //! test.
 
 use super::*;
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 
 /// A dense test system: F and J from a closure, J factored by LU.
 struct Dense<F> {
     n: usize,
     f: F,
     jac: DMatrix<f64>,
-    lu: Option<nalgebra::LU<f64, nalgebra::Dyn, nalgebra::Dyn>>,
+    lu: crate::numerics::dense::DenseLu,
     rows: Vec<f64>,
     evaluations: usize,
 }
@@ -25,7 +25,7 @@ where
             n,
             f,
             jac: DMatrix::zeros(n, n),
-            lu: None,
+            lu: crate::numerics::dense::DenseLu::default(),
             rows: vec![1.0; n],
             evaluations: 0,
         }
@@ -45,18 +45,11 @@ where
         (self.f)(x, r, &mut self.jac)
     }
     fn linearize(&mut self, _x: &[f64]) -> bool {
-        self.lu = Some(self.jac.clone().lu());
+        self.lu.factor(&self.jac);
         true
     }
     fn solve(&mut self, f: &[f64], delta: &mut [f64]) -> bool {
-        let rhs = -DVector::from_column_slice(f);
-        match self.lu.as_ref().and_then(|lu| lu.solve(&rhs)) {
-            Some(d) => {
-                delta.copy_from_slice(d.as_slice());
-                true
-            }
-            None => false,
-        }
+        self.lu.newton_step(f, delta)
     }
     fn residual_scales(&self) -> Vec<f64> {
         self.rows.clone()
