@@ -98,10 +98,11 @@ fn prepare(args: &SweepArgs) -> Result<Option<Setup>, ExitCode> {
     let claims =
         crate::solve_command::claim_outputs(&outputs, &[&args.path], args.force || args.resume)?;
     let done = if args.resume && args.output.exists() {
-        match resumable(&args.output, &expected)? {
-            Some(done) => done,
-            None => return Ok(None),
-        }
+        let Some(done) = resumable(&args.output, &expected)? else {
+            redraw(&args.output, args.plot.as_deref())?;
+            return Ok(None);
+        };
+        done
     } else {
         vec![]
     };
@@ -397,6 +398,22 @@ fn summarize(header: &SweepHeader, records: &[Record]) {
                 c.level, c.omega, c.iota, c.points
             );
         }
+    }
+}
+
+/// The chart of a completed sweep file asked for by `--resume --plot`:
+/// nothing is left to compute, but the chart is drawn from the file.
+fn redraw(path: &Path, chart: Option<&Path>) -> Result<(), ExitCode> {
+    let Some(out) = chart else {
+        return Ok(());
+    };
+    let (header, records) = read_sweep(path)
+        .map_err(|e| fail(BAD_INPUT, format!("{}: cannot read: {e}", path.display())))?;
+    let code = plot(out, &header, &records);
+    if code == ExitCode::SUCCESS {
+        Ok(())
+    } else {
+        Err(code)
     }
 }
 

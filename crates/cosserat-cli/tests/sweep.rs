@@ -378,6 +378,17 @@ fn fig6_problem_on_a_small_grid() {
     ));
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(chart.exists());
+    // A completed file resumed with --plot computes nothing and draws the
+    // chart from the file.
+    std::fs::remove_file(&chart).unwrap();
+    let o = run(&mut sweep(
+        Path::new(&problem),
+        &out,
+        &["--set", axes, "--resume", "--plot", chart.to_str().unwrap()],
+    ));
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("nothing to resume"));
+    assert!(chart.exists(), "the chart of the completed sweep is drawn");
     let (header, records) = read_sweep(&out).unwrap();
     assert_eq!(header.points(), 9);
     let reach: Vec<f64> = records
