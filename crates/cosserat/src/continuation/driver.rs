@@ -153,8 +153,10 @@ impl<'a> Run<'a> {
         let model = ModelChoice::forced(&rod, self.family.level()).map_err(start_err)?;
         let solver = SolverOptions {
             method: self.family.method(),
-            strategy: Strategy::Auto,
-            ..Default::default()
+            ..self.opts.start_solver.clone().unwrap_or(SolverOptions {
+                strategy: Strategy::Auto,
+                ..Default::default()
+            })
         };
         let raw = solve(&rod, &model, &solver)
             .map_err(|e| start_err(e.to_string()))?

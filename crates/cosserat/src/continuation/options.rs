@@ -1,5 +1,6 @@
 //! The settings of a continuation run.
 
+use crate::bvp::SolverOptions;
 use crate::stability::StabilityOptions;
 
 /// Continuation settings (BifurcationKit's ContinuationPar, in spirit).
@@ -35,6 +36,11 @@ pub struct ContinuationOptions {
     pub tolerance: f64,
     /// Relative tolerance on the parameter when locating events.
     pub event_tolerance: f64,
+    /// How the start equilibrium is solved: the problem's `[solver]`
+    /// (strategy, initial curvature, Newton and integration settings),
+    /// with the family's own discretization as its method. None: the
+    /// default solver with the automatic load strategy.
+    pub start_solver: Option<SolverOptions>,
 }
 
 impl Default for ContinuationOptions {
@@ -52,6 +58,7 @@ impl Default for ContinuationOptions {
             stability: StabilityOptions::default(),
             tolerance: 1e-11,
             event_tolerance: 1e-11,
+            start_solver: None,
         }
     }
 }

@@ -192,6 +192,7 @@ impl ContinuationSection {
                 stability,
                 tolerance: within("continuation.tolerance", self.tolerance, NEWTON_TOLERANCE)?,
                 event_tolerance: 1e-11,
+                start_solver: None,
             },
         ))
     }

@@ -29,7 +29,9 @@ pub(super) fn build_continuation(
     let Some(section) = &file.continuation else {
         return Ok(None);
     };
-    let (parameter, opts) = section.build()?;
+    let (parameter, mut opts) = section.build()?;
+    // The start is solved as the problem's [solver] says.
+    opts.start_solver = Some(options.clone());
     eigenvalue_count("continuation", &opts.stability, rod)?;
     let (segments, stages) = match options.method {
         Method::Shooting => (1, None),
