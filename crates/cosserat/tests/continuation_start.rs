@@ -65,3 +65,26 @@ fn the_start_honours_the_newton_budget() {
     let e = continuation(&family, &opts, &mut |_, _| true).unwrap_err();
     assert!(e.to_string().contains("start"), "{e}");
 }
+
+/// The loads are checked for a potential at every point, not only at the
+/// start: continuing the helix in a dead tip couple from zero (a couple
+/// about d1 has no potential for spatial rotations), the branch ends at
+/// its first point — the only one whose stability means something — and
+/// says why, instead of reporting eigenvalues of a non-conservative
+/// problem.
+#[test]
+fn a_branch_ends_where_the_loads_lose_their_potential() {
+    const HELIX: &str = include_str!("../../../problems/helix_tip_load.toml");
+    let text = format!(
+        "{HELIX}\n[continuation]\nparameter = \"loads.tip_couple[0]\"\nstart = 0.0\n\
+         bounds = [-1.0, 1.0]\nstep = 0.05\nelements = 16\neigenvalues = 2\n"
+    );
+    let p = Problem::from_str_with(&text, &[]).unwrap();
+    let (family, opts) = p.continuation.clone().unwrap();
+    let d = continuation(&family, &opts, &mut |_, _| true).unwrap();
+    let b = &d.branches[0];
+    assert_eq!(b.points.len(), 1, "{}", b.stop_reason);
+    assert_eq!(b.points[0].parameter, 0.0);
+    let reason = b.stop_reason.to_string();
+    assert!(reason.contains("not conservative"), "{reason}");
+}

@@ -239,6 +239,20 @@ impl<'a> Run<'a> {
         }
     }
 
+    /// Why the loads at `p` have no potential (checked at every point, not
+    /// only at the start: a continued load may grow a dead couple), or
+    /// None when they have one. A rod that cannot be built at `p` is left
+    /// to the point's own evaluation, which names it.
+    fn not_conservative(&self, p: f64) -> Option<BranchEnd> {
+        let rod = self.family.rod_at(p).ok()?;
+        crate::stability::check_conservative(&rod)
+            .err()
+            .map(|e| BranchEnd::NotConservative {
+                parameter: p,
+                reason: e.to_string(),
+            })
+    }
+
     /// A step that leaves [min, max] is pulled back onto the bound it
     /// crossed (Newton at fixed p from the linear interpolant), so that a
     /// branch ends exactly at its bound — e.g. at the design load.
@@ -339,6 +353,9 @@ impl<'a> Run<'a> {
                 Err(e) => return end(specials, BranchEnd::Failed(e.to_string()), false),
             };
             let (x, p, tangent) = self.land_on_bound(&last, x, p, tangent);
+            if let Some(reason) = self.not_conservative(p) {
+                return end(specials, reason, false);
+            }
             let next = match self.point(x, p, tangent) {
                 Ok(pt) => pt,
                 Err(e) => return end(specials, BranchEnd::Failed(e.to_string()), false),

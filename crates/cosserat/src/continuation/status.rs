@@ -84,6 +84,16 @@ pub enum BranchEnd {
     /// The step fell below the smallest step: the corrector does not
     /// converge there.
     StepTooSmall(f64),
+    /// The loads have no potential at the next point (e.g. a dead tip
+    /// couple grown from zero on a spatial rod): the second variation no
+    /// longer decides stability, so the branch ends at the last point
+    /// where it does.
+    NotConservative {
+        /// The parameter of the point refused.
+        parameter: f64,
+        /// Why the loads have no potential there.
+        reason: String,
+    },
     /// A point could not be evaluated.
     Failed(String),
     /// The branch's first point could not be evaluated.
@@ -123,6 +133,11 @@ impl fmt::Display for BranchEnd {
             BranchEnd::StepTooSmall(min) => write!(
                 f,
                 "step size below {min:.1e}: the corrector does not converge"
+            ),
+            BranchEnd::NotConservative { parameter, reason } => write!(
+                f,
+                "loads not conservative at parameter {parameter}, where stability has no \
+                 meaning: {reason}"
             ),
             BranchEnd::Failed(e) => write!(f, "stopped: {e}"),
             BranchEnd::StartFailed(e) => write!(f, "start point failed: {e}"),
