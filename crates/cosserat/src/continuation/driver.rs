@@ -341,7 +341,7 @@ impl<'a> Run<'a> {
                 return end(specials, reason, false);
             }
             let (x, p, tangent, iterations) = match self.step(&last, sign, ds) {
-                Ok(Some(stepped)) => self.land_on_tip_angle(&last, sign, ds, stepped),
+                Ok(Some(stepped)) => stepped,
                 Ok(None) => {
                     ds *= 0.5;
                     if ds < self.opts.min_step {
@@ -356,7 +356,7 @@ impl<'a> Run<'a> {
             if let Some(reason) = self.not_conservative(p) {
                 return end(specials, reason, false);
             }
-            let next = match self.point(x, p, tangent) {
+            let next = match self.next_point(&last, sign, ds, x, p, tangent) {
                 Ok(pt) => pt,
                 Err(e) => return end(specials, BranchEnd::Failed(e.to_string()), false),
             };

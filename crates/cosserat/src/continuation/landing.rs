@@ -8,7 +8,8 @@
 //! bounds land on the bound by Newton at fixed p: `driver.rs`.)
 
 use super::corrector::Stepped;
-use super::{tip_angle, Point};
+use super::tracking::Modes;
+use super::{tip_angle, ContinuationError, Point};
 use crate::numerics::scalar::Illinois;
 
 use super::driver::Run;
@@ -27,32 +28,47 @@ impl Run<'_> {
         Some(tip_angle(&rod.clamp().frame, &tip))
     }
 
-    /// `stepped` (a step of length `ds` from `last` in direction `sign`),
-    /// or, if it turned the tip past the limit, the step shortened so that
-    /// the tip angle lies in [limit, limit + [`ANGLE_TOLERANCE`]]. Should a
-    /// trial step fail, the full step is kept: the branch then stops at the
-    /// angle it reached, which the stop reason reports.
-    pub(super) fn land_on_tip_angle(
-        &self,
+    /// The point of a step of length `ds` from `last` in direction `sign`
+    /// that ended at (x, p, tangent), measured; if it turned the tip past
+    /// the limit, the point of the step shortened so that the tip angle
+    /// lies in [limit, limit + [`ANGLE_TOLERANCE`]] instead. Only the point
+    /// kept is remembered by the tracker, so both are matched to `last`'s
+    /// modes. Should a trial step fail, the full step is kept: the branch
+    /// then stops at the angle it reached, which the stop reason reports.
+    pub(super) fn next_point(
+        &mut self,
         last: &Point,
         sign: f64,
         ds: f64,
-        stepped: Stepped,
-    ) -> Stepped {
-        let Some(limit) = self.opts.tip_angle_limit else {
-            return stepped;
-        };
-        if last.tip_angle >= limit {
-            return stepped;
+        x: Vec<f64>,
+        p: f64,
+        tangent: Vec<f64>,
+    ) -> Result<Point, ContinuationError> {
+        let (mut point, mut modes) = self.measured(x, p, tangent)?;
+        if let Some(limit) = self.opts.tip_angle_limit {
+            let crossed = last.tip_angle < limit && point.tip_angle - limit > ANGLE_TOLERANCE;
+            let landed = crossed
+                .then(|| self.shortened(last, sign, ds, limit, point.tip_angle - limit))
+                .flatten();
+            if let Some((x, p, tangent, _)) = landed {
+                (point, modes) = self.measured(x, p, tangent)?;
+            }
         }
-        let Some(reached) = self.tip_angle_at(&stepped.0, stepped.1) else {
-            return stepped;
-        };
-        if reached - limit <= ANGLE_TOLERANCE {
-            return stepped;
-        }
-        self.shortened(last, sign, ds, limit, reached - limit)
-            .unwrap_or(stepped)
+        self.tracker.remember(&point.eigenvalues, modes);
+        Ok(point)
+    }
+
+    /// The point at (x, p) with its spectrum matched to the remembered
+    /// modes, and its own modes (not yet remembered).
+    fn measured(
+        &self,
+        x: Vec<f64>,
+        p: f64,
+        tangent: Vec<f64>,
+    ) -> Result<(Point, Modes), ContinuationError> {
+        let mut spectrum = self.tracker.evaluate(self.family, &x, p)?;
+        let modes = std::mem::take(&mut spectrum.vectors);
+        Ok((self.point_from(x, p, tangent, spectrum)?, modes))
     }
 
     /// Illinois on g(h) = θ(step(h)) − limit over (0, ds): the trial step

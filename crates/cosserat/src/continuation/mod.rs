@@ -39,6 +39,6 @@ pub use family::{tip_angle, Family, FamilyError, Parameter, PointError};
 pub use options::ContinuationOptions;
 pub use resume::{resume, SavedBranch, SavedDiagram, SavedSpecial};
 pub use status::{BranchEnd, RunState};
-pub use tracking::{Spectrum, Tracker};
+pub use tracking::{Modes, Spectrum, Tracker};
 
 use driver::{drain, Pending, Run};

@@ -17,13 +17,16 @@ use crate::stability::{
     coefficients, support_constraints, Block, FiniteElements, StabilityOptions,
 };
 
+/// Tracked modes: per block, per tracked eigenvalue, its eigenvector.
+pub type Modes = Vec<Vec<Vec<f64>>>;
+
 /// The measured spectrum at one point.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Spectrum {
     /// Tracked eigenvalues, block after block.
     pub values: Vec<f64>,
     /// Eigenvectors per block, in tracked order.
-    pub vectors: Vec<Vec<Vec<f64>>>,
+    pub vectors: Modes,
     /// Morse index per block.
     pub block_morse: Vec<usize>,
     /// Total Morse index.
@@ -45,7 +48,7 @@ pub struct Tracker {
     blocks: Vec<Block>,
     opts: StabilityOptions,
     base_length: f64,
-    previous: Option<Vec<Vec<Vec<f64>>>>,
+    previous: Option<Modes>,
     previous_values: Option<Vec<Vec<f64>>>,
 }
 
@@ -137,8 +140,25 @@ impl Tracker {
         Ok((fe, mats, norm, shape))
     }
 
-    /// The spectrum at (x, p), matched to the previous point's modes.
+    /// The spectrum at (x, p), matched to the previous point's modes, which
+    /// it then replaces ([`Tracker::evaluate`], then [`Tracker::remember`]).
     pub fn measure(&mut self, family: &Family, x: &[f64], p: f64) -> Result<Spectrum, PointError> {
+        let spectrum = self.evaluate(family, x, p)?;
+        self.remember(&spectrum.values, spectrum.vectors.clone());
+        Ok(spectrum)
+    }
+
+    /// The modes (and their eigenvalues, `eigenvalues` per block) of the
+    /// point the next one is matched to.
+    pub fn remember(&mut self, values: &[f64], vectors: Modes) {
+        self.previous = Some(vectors);
+        let k = self.opts.eigenvalues();
+        self.previous_values = Some(values.chunks(k).map(<[f64]>::to_vec).collect());
+    }
+
+    /// The spectrum at (x, p), matched to the previous point's modes,
+    /// which stay remembered (a trial point need not replace them).
+    pub fn evaluate(&self, family: &Family, x: &[f64], p: f64) -> Result<Spectrum, PointError> {
         let (_, mats, norm, shape_samples) = self.matrices(family, x, p)?;
         let mut values = vec![];
         let mut vectors = vec![];
@@ -195,9 +215,6 @@ impl Tracker {
                     })?,
             );
         }
-        self.previous = Some(vectors.clone());
-        let k = self.opts.eigenvalues();
-        self.previous_values = Some(values.chunks(k).map(<[f64]>::to_vec).collect());
         let shape = shape_samples.iter().map(|s| s.position).collect();
         Ok(Spectrum {
             tip: shape_samples.last().expect("21 shape points").clone(),
