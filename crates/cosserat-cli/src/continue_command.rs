@@ -61,8 +61,7 @@ pub fn run_continue(
         Ok(saved) => saved,
         Err(code) => return code,
     };
-    let parameter_name = section_key(&problem.text, "parameter")
-        .unwrap_or_else(|| format!("{:?}", family.parameter()));
+    let parameter_name = family.key();
     println!("problem   {}", path.display());
     println!(
         "model     {} ({})",

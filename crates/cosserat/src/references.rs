@@ -224,6 +224,18 @@ pub const FORMULAS: &[(&str, &str, &str)] = &[
         "no such value exists (e.g. no static critical load): the reference is `none`",
     ),
     (
+        "twisted_clamped_moment",
+        "",
+        "M L/B = 2x₁, tan x₁ = x₁: a rod twisted between two clamps at a fixed distance \
+         (Love, Treatise §272)",
+    ),
+    (
+        "clamped_elastica_load",
+        "shortening",
+        "P L²/B = 16K(k)², δ/L = 2(1 − E(k)/K(k)): the clamped–clamped elastica under end \
+         shortening δ (Love, Treatise §263)",
+    ),
+    (
         "timoshenko_ltb",
         "",
         "F L²/√(B1 B3) = 2 j₋₁/₄,₁ (Timoshenko & Gere 1961, Sec. 6.3)",
@@ -293,6 +305,39 @@ pub fn greenhill_clamped(tau: f64) -> f64 {
     0.5 * (lo + hi)
 }
 
+/// The critical end moment of a twisted rod clamped at both ends, the
+/// distance between them held and no axial force (B = L = 1): the
+/// deflection w = a + b s + c s² + d e^{iMs} of B w'''' − i M w''' = 0 with
+/// w = w' = 0 at both ends exists where tan(M/2) = M/2, so M L/B = 2 x₁
+/// with x₁ = 4.4934… the first positive root of tan x = x (Love's
+/// Treatise §272; the P = 0 end of [`greenhill_clamped`]). The critical
+/// end rotation of a rod of torsional stiffness C is θ = M L/C.
+pub fn twisted_clamped_moment() -> f64 {
+    // tan x = x ⇔ g(x) = sin x − x cos x = 0; g > 0 at π, g < 0 at 3π/2.
+    let g = |x: f64| x.sin() - x * x.cos();
+    let (lo, hi) = bisect(PI, 1.5 * PI, 200, |m| g(m) > 0.0, |_, _| false);
+    lo + hi
+}
+
+/// The load of the clamped–clamped elastica whose ends are brought
+/// together by the shortening δ (B = L = 1, the symmetric first mode): the
+/// rod is four quarter-waves of the elastica θ'' + λ² sin θ = 0 with
+/// modulus k = sin(α/2), so λ = 4K(k), P L²/B = 16 K(k)², and the chord
+/// 2E(k)/K(k) − 1 gives δ = 2(1 − E(k)/K(k)) (Love's Treatise §263;
+/// Timoshenko & Gere, Sec. 2.7). k is found by bisection (δ grows with k).
+pub fn clamped_elastica_load(shortening: f64) -> f64 {
+    let delta = |k: f64| 2.0 * (1.0 - ellip_e(FRAC_PI_2, k) / ellip_f(FRAC_PI_2, k));
+    let (lo, hi) = bisect(
+        0.0,
+        1.0 - 1e-15,
+        200,
+        |m| delta(m) < shortening,
+        |_, _| false,
+    );
+    let k = 0.5 * (lo + hi);
+    16.0 * ellip_f(FRAC_PI_2, k).powi(2)
+}
+
 /// Evaluates the formula `name` with the point's parameters.
 pub fn evaluate(name: &str, params: &BTreeMap<String, f64>) -> Result<f64, String> {
     let k = || param(params, "k", name);
@@ -337,6 +382,8 @@ pub fn evaluate(name: &str, params: &BTreeMap<String, f64>) -> Result<f64, Strin
         "deflection_span" => 2.0 * (param(params, "tilt", name)? / 2.0).cos(),
         "timoshenko_ltb" => 2.0 * j(),
         "timoshenko_chi" => (2.0 * j()).sqrt(),
+        "twisted_clamped_moment" => twisted_clamped_moment(),
+        "clamped_elastica_load" => clamped_elastica_load(param(params, "shortening", name)?),
         other => {
             let known: Vec<&str> = FORMULAS.iter().map(|f| f.0).collect();
             return Err(format!(

@@ -1,7 +1,10 @@
 //! The closed forms of `cosserat::references` (the one copy the validation
 //! runner and the tests share) against published values and limits.
 mod support;
-use cosserat::references::{bessel_first_zero, ellip_e, ellip_f, greenhill_clamped, CantileverTip};
+use cosserat::references::{
+    bessel_first_zero, clamped_elastica_load, ellip_e, ellip_f, greenhill_clamped,
+    twisted_clamped_moment, CantileverTip,
+};
 
 #[test]
 fn complete_integrals_match_tabulated_values() {
@@ -55,4 +58,32 @@ fn column_references_match_their_classical_limits() {
     let vanishes_at = 8.98 + nearer * 0.03 / (near - nearer);
     let greenhill = 2.0 * 4.493_409_457_909_064;
     assert!((vanishes_at - greenhill).abs() < 2e-3, "{vanishes_at}");
+}
+
+/// The twisted clamped rod: 2x₁ with x₁ = 4.493409457909064 (tan x = x,
+/// tabulated in Abramowitz & Stegun Table 4.19); the P = 0 end of the
+/// independent Greenhill determinant is checked against the same value in
+/// `column_references_match_their_classical_limits`.
+#[test]
+fn twisted_rod_reference_is_twice_the_root_of_tan_x_equals_x() {
+    let m = twisted_clamped_moment();
+    assert!((m - 2.0 * 4.493_409_457_909_064).abs() < 1e-13, "{m}");
+}
+
+/// The clamped–clamped elastica: at small shortening the load tends to
+/// Euler's 4π² with the classical post-buckling slope, P ≈ 4π²(1 + δ/2)
+/// (δ = k² + O(k⁴) and 16K² = 4π²(1 + k²/2 + O(k⁴))), and it grows with
+/// the shortening.
+#[test]
+fn clamped_elastica_reference_starts_at_euler_with_its_slope() {
+    let euler = 4.0 * std::f64::consts::PI.powi(2);
+    for delta in [1e-4, 1e-3] {
+        let p = clamped_elastica_load(delta);
+        let slope = (p / euler - 1.0) / delta;
+        assert!(
+            (slope - 0.5).abs() < 2.0 * delta,
+            "δ = {delta}: slope {slope}"
+        );
+    }
+    assert!(clamped_elastica_load(0.2) > clamped_elastica_load(0.1));
 }

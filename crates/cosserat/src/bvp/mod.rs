@@ -86,6 +86,12 @@ pub struct SolverOptions {
     /// A guess of the curvature at the clamp; the straight-rod balance when
     /// absent.
     pub initial_guess: Option<Vec<f64>>,
+    /// A guess of the tip support's reaction force R (global components,
+    /// the force the support exerts on the tip) when the support holds the
+    /// tip's position; zero when absent. A displacement-controlled rod far
+    /// from its unloaded shape needs it: with R = 0 Newton starts from a
+    /// rod that no force holds there.
+    pub initial_reaction: Option<nalgebra::Vector3<f64>>,
     /// How the loads are applied.
     pub strategy: Strategy,
 }
@@ -125,6 +131,7 @@ impl Default for SolverOptions {
             collocation: CollocationOptions::default(),
             output_points: 201,
             initial_guess: None,
+            initial_reaction: None,
             strategy: Strategy::Auto,
         }
     }
@@ -448,9 +455,19 @@ fn solve_at(
     stats: &mut IntegrationStats,
 ) -> Result<Solved, SolveError> {
     let eq = equations(rod, level);
-    let guess = |eq: &dyn RodEquations| match &opts.initial_guess {
-        Some(g) => guess_for_level(g, eq, level),
-        None => Ok(eq.initial_guess()),
+    let guess = |eq: &dyn RodEquations| {
+        let mut u = match &opts.initial_guess {
+            Some(g) => guess_for_level(g, eq, level)?,
+            None => eq.initial_guess(),
+        };
+        if let Some(r) = &opts.initial_reaction {
+            if !eq.set_reaction(&mut u, r) {
+                return Err(SolveError::Options(
+                    "initial_reaction needs a tip support that holds the tip's position".into(),
+                ));
+            }
+        }
+        Ok(u)
     };
     if let Method::Collocation { stages } = opts.method {
         let copts = CollocationOptions {
@@ -552,6 +569,7 @@ fn ramp(
     let mut steps = 0;
     let step_opts = SolverOptions {
         initial_guess: None,
+        initial_reaction: None,
         newton: NewtonOptions {
             max_iterations: opts.newton.max_iterations.min(RAMP_ITERATIONS),
             ..opts.newton

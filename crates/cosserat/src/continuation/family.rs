@@ -7,107 +7,25 @@
 //! slows the corrector at worst — the points themselves satisfy F = 0 to
 //! the Newton tolerance.
 
+use std::sync::Arc;
+
 use nalgebra::{DMatrix, DVector, Matrix3};
+
+use super::lens::{Lens, Parameter, RodLens};
 
 use crate::bvp::newton::NonlinearSystem;
 use crate::bvp::{equations, ShootingSystem};
 use crate::equations::RodSample;
-use crate::model::{ModelLevel, ProfileKind, Rod};
+use crate::model::{ModelLevel, Rod};
 use crate::numerics::integrator::{IntegrationError, Tolerances};
 
-/// Which number of the rod the parameter sets.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Parameter {
-    /// All loads multiplied by p.
-    LoadScale,
-    /// All loads and the intrinsic curvature κ⁰(s) multiplied by p
-    /// together: the control path of a designed arm, on which the
-    /// actuators raise κ⁰ as the load is applied (paper Sec. 5).
-    ControlScale,
-    /// All loads multiplied by p and the intrinsic curvature moved from
-    /// the base rod's (p = 0) to a target's (p = 1),
-    /// κ⁰ = (1 − p) κ⁰_base + p κ⁰_target; build with
-    /// [`Family::towards`]. With κ⁰_base = φ' and
-    /// κ⁰_target from (43) the designed shape is an equilibrium all along
-    /// (the shape-holding control of a designed arm).
-    CurvatureTowards,
-    /// Component i of the tip force.
-    TipForce(usize),
-    /// Component i of the tip couple.
-    TipCouple(usize),
-    /// Component i of the distributed force.
-    DistributedForce(usize),
-    /// The rod length.
-    Length,
-    /// The constant stiffness B_i (i = 0, 1, 2).
-    Stiffness(usize),
-    /// The constant intrinsic curvature κ⁰_i.
-    IntrinsicCurvature(usize),
-    /// The clamp turned by p (rad) about d2(0), d3 towards d1.
-    ClampAngle,
-}
-
-impl std::fmt::Display for Parameter {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            Parameter::LoadScale => f.write_str("load_scale"),
-            Parameter::ControlScale => f.write_str("control_scale"),
-            Parameter::CurvatureTowards => f.write_str("the shape-holding control"),
-            Parameter::TipForce(i) => write!(f, "loads.tip_force[{i}]"),
-            Parameter::TipCouple(i) => write!(f, "loads.tip_couple[{i}]"),
-            Parameter::DistributedForce(i) => write!(f, "loads.distributed_force[{i}]"),
-            Parameter::Length => f.write_str("rod.length"),
-            Parameter::Stiffness(i) => write!(f, "energy.stiffness[{i}]"),
-            Parameter::IntrinsicCurvature(i) => write!(f, "energy.intrinsic_curvature[{i}]"),
-            Parameter::ClampAngle => f.write_str("clamp.angle"),
-        }
-    }
-}
-
-impl Parameter {
-    /// The parameter named by a problem-file key: `load_scale`,
-    /// `loads.tip_force[i]`, `loads.tip_couple[i]`,
-    /// `loads.distributed_force[i]`, `control_scale`, `rod.length`, `energy.stiffness[i]`,
-    /// `energy.intrinsic_curvature[i]`, `clamp.angle`.
-    pub fn from_key(key: &str) -> Option<Parameter> {
-        let indexed = |prefix: &str| -> Option<usize> {
-            let rest = key
-                .strip_prefix(prefix)?
-                .strip_prefix('[')?
-                .strip_suffix(']')?;
-            rest.parse().ok().filter(|i| *i < 3)
-        };
-        Some(match key {
-            "load_scale" => Parameter::LoadScale,
-            "control_scale" => Parameter::ControlScale,
-            "rod.length" => Parameter::Length,
-            "clamp.angle" => Parameter::ClampAngle,
-            _ => {
-                if let Some(i) = indexed("loads.tip_force") {
-                    Parameter::TipForce(i)
-                } else if let Some(i) = indexed("loads.tip_couple") {
-                    Parameter::TipCouple(i)
-                } else if let Some(i) = indexed("loads.distributed_force") {
-                    Parameter::DistributedForce(i)
-                } else if let Some(i) = indexed("energy.stiffness") {
-                    Parameter::Stiffness(i)
-                } else if let Some(i) = indexed("energy.intrinsic_curvature") {
-                    Parameter::IntrinsicCurvature(i)
-                } else {
-                    return None;
-                }
-            }
-        })
-    }
-}
-
-/// A rod whose one number is the parameter.
+/// A rod whose one number is the parameter: a [`Lens`] gives the rod at
+/// p, the family discretizes its equilibrium equations.
 #[derive(Debug, Clone)]
 pub struct Family {
+    /// The rod at the start (its sizes and scales weight the unknowns).
     base: Rod,
-    /// The target energy of [`Parameter::CurvatureTowards`].
-    target: Option<std::sync::Arc<dyn crate::model::StoredEnergy>>,
-    parameter: Parameter,
+    lens: Arc<dyn Lens>,
     level: ModelLevel,
     segments: usize,
     /// Gauss points per interval when the segments are collocation
@@ -125,17 +43,41 @@ pub enum FamilyError {
          linear energy, possibly with energy.shear; a stiffness or curvature parameter replaces \
          a constant, never a varying profile)"
     )]
-    NotConstant(Parameter),
+    NotConstant(String),
     /// A value outside the physical range.
     #[error(
         "continuation.parameter = {parameter} is not physical at {value} (a length or stiffness \
          must be positive): narrow continuation.bounds"
     )]
     NotPhysical {
-        /// The continuation parameter.
-        parameter: Parameter,
+        /// The continuation parameter's key.
+        parameter: String,
         /// Its value outside the physical range.
         value: f64,
+    },
+    /// The problem with the parameter set to the value is refused by the
+    /// problem's own checks (a generic lens rereads the problem).
+    #[error("continuation.parameter = {parameter} at {value}: {reason}")]
+    Refused {
+        /// The continuation parameter's key.
+        parameter: String,
+        /// The value.
+        value: f64,
+        /// The problem's error at that value.
+        reason: String,
+    },
+    /// The rod at the value needs a richer model than the family's.
+    #[error(
+        "continuation.parameter = {parameter} at {value} takes the rod out of the planar \
+         model the branch started on ({why}); set solver.model = \"kirchhoff\""
+    )]
+    NeedsModel {
+        /// The continuation parameter's key.
+        parameter: String,
+        /// The value.
+        value: f64,
+        /// What the planar model cannot represent.
+        why: String,
     },
 }
 
@@ -149,10 +91,23 @@ impl Family {
         segments: usize,
         tolerances: Tolerances,
     ) -> Self {
+        let lens = Arc::new(RodLens::new(base.clone(), parameter));
+        Family::of_lens(lens, base, level, segments, tolerances)
+    }
+
+    /// The family of any [`Lens`] (e.g. a problem-file key read by the
+    /// input stage), `base` its rod at the start, discretized at `level` by
+    /// shooting on `segments`.
+    pub fn of_lens(
+        lens: Arc<dyn Lens>,
+        base: Rod,
+        level: ModelLevel,
+        segments: usize,
+        tolerances: Tolerances,
+    ) -> Self {
         Family {
             base,
-            target: None,
-            parameter,
+            lens,
             level,
             segments: segments.max(1),
             stages: None,
@@ -172,6 +127,13 @@ impl Family {
         stages: usize,
         tolerances: Tolerances,
     ) -> Self {
+        Family::new(base, parameter, level, intervals, tolerances).collocated(stages)
+    }
+
+    /// The same family with its segments as collocation intervals of
+    /// `stages` Gauss points (1 to 3).
+    #[must_use]
+    pub fn collocated(self, stages: usize) -> Self {
         // The problem reader checks solver.stages; another value is a
         // caller's error (it was clamped silently, running another order).
         assert!(
@@ -180,7 +142,7 @@ impl Family {
         );
         Family {
             stages: Some(stages),
-            ..Family::new(base, parameter, level, intervals, tolerances)
+            ..self
         }
     }
 
@@ -197,21 +159,13 @@ impl Family {
     /// scaled by p, κ⁰ moved from `base`'s to `target`'s.
     pub fn towards(
         base: Rod,
-        target: std::sync::Arc<dyn crate::model::StoredEnergy>,
+        target: Arc<dyn crate::model::StoredEnergy>,
         level: ModelLevel,
         segments: usize,
         tolerances: Tolerances,
     ) -> Self {
-        Family {
-            target: Some(target),
-            ..Family::new(
-                base,
-                Parameter::CurvatureTowards,
-                level,
-                segments,
-                tolerances,
-            )
-        }
+        let lens = Arc::new(RodLens::towards(base.clone(), target));
+        Family::of_lens(lens, base, level, segments, tolerances)
     }
 
     /// The BVP method of the family's discretization, or, for collocation,
@@ -234,102 +188,27 @@ impl Family {
         self.level
     }
 
-    /// The parameter.
-    pub fn parameter(&self) -> Parameter {
-        self.parameter
+    /// The parameter's key (`loads.tip_force[2]`, `support.turn.angle`).
+    pub fn key(&self) -> String {
+        self.lens.key()
     }
 
-    /// The rod at p.
+    /// The rod at p: the lens's rod, refused where it needs a richer
+    /// model than the family's level (a planar family whose parameter turns
+    /// a load or an end out of the plane would otherwise drop the
+    /// out-of-plane part without a word).
     pub fn rod_at(&self, p: f64) -> Result<Rod, FamilyError> {
-        let mut rod = self.base.clone();
-        let bad = || FamilyError::NotPhysical {
-            parameter: self.parameter,
-            value: p,
-        };
-        if !p.is_finite() {
-            return Err(bad());
-        }
-        match self.parameter {
-            Parameter::LoadScale => {
-                rod = rod
-                    .with_loads(self.base.loads().scaled(p))
-                    .map_err(|_| bad())?;
-            }
-            Parameter::ControlScale => {
-                rod = rod
-                    .with_loads(self.base.loads().scaled(p))
-                    .map_err(|_| bad())?;
-                rod = rod.with_energy(
-                    self.base
-                        .energy()
-                        .with_intrinsic_scaled(p)
-                        .ok_or(FamilyError::NotConstant(self.parameter))?,
-                );
-            }
-            Parameter::CurvatureTowards => {
-                rod = rod
-                    .with_loads(self.base.loads().scaled(p))
-                    .map_err(|_| bad())?;
-                rod = rod.with_energy(
-                    self.target
-                        .as_ref()
-                        .and_then(|t| self.base.energy().with_intrinsic_towards(t.as_ref(), p))
-                        .ok_or(FamilyError::NotConstant(self.parameter))?,
-                );
-            }
-            Parameter::TipForce(_) | Parameter::TipCouple(_) | Parameter::DistributedForce(_) => {
-                let mut loads = self.base.loads().clone();
-                match self.parameter {
-                    Parameter::TipForce(i) => loads.tip_force[i] = p,
-                    Parameter::TipCouple(i) => loads.tip_couple[i] = p,
-                    Parameter::DistributedForce(i) => loads.distributed_force[i] = p,
-                    _ => unreachable!("only load components"),
-                }
-                rod = rod.with_loads(loads).map_err(|_| bad())?;
-            }
-            Parameter::Length => {
-                if p <= 0.0 {
-                    return Err(bad());
-                }
-                rod = rod.with_length(p).map_err(|_| bad())?;
-            }
-            Parameter::ClampAngle => {
-                // About d2 by +p: d3 turns towards d1 (R d3 = d3 cos p + d1 sin p).
-                let mut clamp = self.base.clamp().clone();
-                clamp.frame = clamp.turned_frame(p).map_err(|_| bad())?;
-                rod = rod.with_clamp(clamp).map_err(|_| bad())?;
-            }
-            Parameter::Stiffness(_) | Parameter::IntrinsicCurvature(_) => {
-                rod = rod.with_energy(self.linear_with(p)?);
+        let rod = self.lens.rod_at(p)?;
+        if self.level == ModelLevel::Planar {
+            if let Err(why) = crate::model::ModelChoice::forced(&rod, ModelLevel::Planar) {
+                return Err(FamilyError::NeedsModel {
+                    parameter: self.lens.key(),
+                    value: p,
+                    why,
+                });
             }
         }
         Ok(rod)
-    }
-
-    /// The base energy with one constant profile set to p, everything else
-    /// (the other profiles, the shear and extension part of a Cosserat rod)
-    /// kept ([`crate::model::StoredEnergy::with_constant`]).
-    fn linear_with(
-        &self,
-        p: f64,
-    ) -> Result<std::sync::Arc<dyn crate::model::StoredEnergy>, FamilyError> {
-        let (kind, i) = match self.parameter {
-            Parameter::Stiffness(i) => {
-                if p <= 0.0 {
-                    return Err(FamilyError::NotPhysical {
-                        parameter: self.parameter,
-                        value: p,
-                    });
-                }
-                (ProfileKind::Stiffness, i)
-            }
-            Parameter::IntrinsicCurvature(i) => (ProfileKind::IntrinsicCurvature, i),
-            _ => unreachable!("only profile parameters"),
-        };
-        self.base
-            .energy()
-            .with_constant(kind, i, p)
-            .ok_or(FamilyError::NotConstant(self.parameter))
     }
 
     /// The typical magnitudes of the shooting unknowns: 1 for the free

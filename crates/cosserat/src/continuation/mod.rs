@@ -28,6 +28,7 @@ mod driver;
 mod events;
 mod family;
 mod landing;
+mod lens;
 mod options;
 mod resume;
 mod status;
@@ -35,7 +36,8 @@ mod tracking;
 
 pub use diagram::{Branch, ContinuationError, Diagram, Point, Progress, SpecialKind, SpecialPoint};
 pub use driver::continuation;
-pub use family::{tip_angle, Family, FamilyError, Parameter, PointError};
+pub use family::{tip_angle, Family, FamilyError, PointError};
+pub use lens::{Lens, Parameter, RodLens};
 pub use options::ContinuationOptions;
 pub use resume::{resume, SavedBranch, SavedDiagram, SavedSpecial};
 pub use status::{BranchEnd, RunState};

@@ -320,6 +320,15 @@ impl RodEquations for KirchhoffEquations {
 
     /// M(0) balancing the loads on the straight rod, in body components at
     /// the clamp, then κ(0) from ∇W(0, κ) = M(0) by Newton from κ = 0.
+    /// R, the unknowns after κ(0).
+    fn set_reaction(&self, u: &mut [f64], r: &Vector3<f64>) -> bool {
+        if !self.reacts() {
+            return false;
+        }
+        u[3..6].copy_from_slice(r.as_slice());
+        true
+    }
+
     fn initial_guess(&self) -> Vec<f64> {
         let m = self.rod.clamp().frame.transpose() * straight_rod_clamp_moment(&self.rod);
         let e = self.rod.energy();

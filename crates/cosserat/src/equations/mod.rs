@@ -70,6 +70,12 @@ pub trait RodEquations: Send + Sync {
     /// A starting guess of the free values: the curvature at the clamp that
     /// balances the loads on the unloaded, straight rod.
     fn initial_guess(&self) -> Vec<f64>;
+    /// Sets the reaction unknowns of `u` to the global force `r` (the
+    /// force the tip support exerts on the rod); false, `u` untouched, when
+    /// the support holds no position (no reaction unknowns).
+    fn set_reaction(&self, _u: &mut [f64], _r: &nalgebra::Vector3<f64>) -> bool {
+        false
+    }
     /// The free values read back from a state at s = 0.
     fn unknowns_of(&self, y0: &[f64]) -> Vec<f64>;
     /// The state in user quantities.

@@ -280,6 +280,17 @@ impl RodEquations for PlanarEquations {
         u
     }
 
+    /// (R_x, R_z) = (R·d1(0), R·d3(0)), the unknowns after the first.
+    fn set_reaction(&self, u: &mut [f64], r: &Vector3<f64>) -> bool {
+        if !self.reacts() {
+            return false;
+        }
+        let c = self.rod.clamp();
+        u[1] = r.dot(&c.director(0));
+        u[2] = r.dot(&c.director(2));
+        true
+    }
+
     fn unknowns_of(&self, y0: &[f64]) -> Vec<f64> {
         let mut u = y0[3..].to_vec();
         if self.rod.clamp().hinge {

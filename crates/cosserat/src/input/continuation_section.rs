@@ -5,15 +5,16 @@ use serde::{Deserialize, Serialize};
 
 use super::mesh::MeshKeys;
 use super::problem::{invalid, within, ProblemError, NEWTON_TOLERANCE};
-use crate::continuation::{ContinuationOptions, Parameter};
+use crate::continuation::ContinuationOptions;
 
 /// `[continuation]`.
 #[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
 pub struct ContinuationSection {
-    /// The key of the continued number: `load_scale`, `loads.tip_force[i]`,
-    /// `loads.tip_couple[i]`, `loads.distributed_force[i]`, `rod.length`,
-    /// `energy.stiffness[i]`, `energy.intrinsic_curvature[i]`, `clamp.angle`.
+    /// The key of the continued number: `load_scale`, `control_scale`, or
+    /// any numeric key of `[rod]`, `[energy]`, `[clamp]`, `[support]`,
+    /// `[loads]` in the `--set` grammar (`loads.tip_force[2]`,
+    /// `support.position[2]`, `support.turn.angle`, `energy.parameters.quartic`).
     pub parameter: String,
     /// The value to start from.
     pub start: f64,
@@ -105,19 +106,11 @@ fn positive(field: &str, v: f64) -> Result<f64, ProblemError> {
 }
 
 impl ContinuationSection {
-    /// The parameter and the options, validated.
-    pub fn build(&self) -> Result<(Parameter, ContinuationOptions), ProblemError> {
-        let parameter = Parameter::from_key(&self.parameter).ok_or_else(|| {
-            invalid(
-                "continuation.parameter",
-                format!(
-                    "unknown parameter `{}`; expected load_scale, loads.tip_force[i], \
-                     loads.tip_couple[i], loads.distributed_force[i], rod.length, \
-                     energy.stiffness[i], energy.intrinsic_curvature[i] or clamp.angle",
-                    self.parameter
-                ),
-            )
-        })?;
+    /// The parameter's key and the options, validated (the key itself is
+    /// checked where the problem text is at hand: a library parameter, or
+    /// any numeric key of the rod's tables).
+    pub fn build(&self) -> Result<(String, ContinuationOptions), ProblemError> {
+        let parameter = self.parameter.trim().to_string();
         let [lo, hi] = self.bounds;
         if !(lo.is_finite() && hi.is_finite() && lo < hi) {
             return Err(invalid(

@@ -14,9 +14,11 @@ mod problem;
 mod strict;
 mod support_section;
 mod sweep_section;
+mod turn_section;
 
 pub use arm_section::ArmSection;
 pub use continuation_section::{ContinuationSection, MEASURES};
 pub use problem::{Problem, ProblemError, ProblemFile, ProfileSpec, MAX_PROBLEM_BYTES};
 pub use support_section::SupportSection;
 pub use sweep_section::{AxisSpec, SweepSection};
+pub use turn_section::{TurnSection, MAX_TURN_ANGLE};

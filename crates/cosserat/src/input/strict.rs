@@ -177,3 +177,13 @@ impl FloorCharBoundary for str {
         i
     }
 }
+
+/// Reads an already parsed document as a `T`, naming the key of any error
+/// (without line and column: the document has no text).
+pub(crate) fn from_table<T: DeserializeOwned>(table: toml::Table) -> Result<T, ProblemError> {
+    serde_path_to_error::deserialize(toml::Value::Table(table)).map_err(|e| {
+        let path = e.path().to_string();
+        let inner = e.into_inner();
+        ProblemError::Parse(format!("{path}: {}", inner.message().trim_end()))
+    })
+}

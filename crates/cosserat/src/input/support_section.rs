@@ -55,6 +55,10 @@ pub struct SupportSection {
         deserialize_with = "super::strict::option"
     )]
     pub d3: Option<[f64; 3]>,
+    /// The held tip frame then turned about a fixed axis by an angle that
+    /// may run through any number of turns (a rod twisted at its end).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub turn: Option<super::TurnSection>,
 }
 
 fn fixed() -> String {
@@ -139,6 +143,11 @@ impl SupportSection {
         }
         // Unit and orthogonal to 1e-9 above, so within Frame::TOLERANCE; a
         // frame refused all the same is named by its directors.
-        Frame::from_directors(d1, d3).map_err(|e| invalid("support.d3", e.to_string()))
+        let frame =
+            Frame::from_directors(d1, d3).map_err(|e| invalid("support.d3", e.to_string()))?;
+        match &self.turn {
+            Some(turn) => turn.apply("support.turn", &frame),
+            None => Ok(frame),
+        }
     }
 }

@@ -96,9 +96,12 @@ impl EnergySpec {
 pub type EnergyBuilder =
     dyn Fn(&EnergySpec) -> Result<Arc<dyn StoredEnergy>, EnergySpecError> + Send + Sync;
 
-/// Named energy builders.
+/// Named energy builders. Cloning shares the builders (a continuation
+/// lens rebuilds the rod at every parameter value with the catalog the
+/// problem was read with).
+#[derive(Clone)]
 pub struct EnergyCatalog {
-    builders: BTreeMap<String, Box<EnergyBuilder>>,
+    builders: BTreeMap<String, Arc<EnergyBuilder>>,
 }
 
 impl std::fmt::Debug for EnergyCatalog {
@@ -147,7 +150,7 @@ impl EnergyCatalog {
             + Sync
             + 'static,
     ) {
-        self.builders.insert(name.to_owned(), Box::new(builder));
+        self.builders.insert(name.to_owned(), Arc::new(builder));
     }
 
     /// The registered names.

@@ -80,6 +80,24 @@ impl Frame {
     }
 }
 
+impl Frame {
+    /// The frame turned by `angle` (rad, any real number: a turn of 2π
+    /// gives the same frame, but a continued angle runs through any number
+    /// of turns) about the fixed direction `axis`: R(axis, angle) Q
+    /// (Rodrigues). Refused ([`ModelError::Angle`]) for a non-finite angle
+    /// or an axis that is not a finite non-zero vector.
+    pub fn rotated(&self, axis: Vector3<f64>, angle: f64) -> Result<Frame, ModelError> {
+        let norm = axis.norm();
+        if !angle.is_finite() || !norm.is_finite() || norm == 0.0 {
+            return Err(ModelError::Angle(angle));
+        }
+        let a = Unit::new_unchecked(axis / norm);
+        Ok(Frame(
+            Rotation3::from_axis_angle(&a, angle).matrix() * self.0,
+        ))
+    }
+}
+
 impl std::ops::Deref for Frame {
     type Target = Matrix3<f64>;
 

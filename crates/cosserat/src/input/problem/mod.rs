@@ -13,6 +13,7 @@
 //! reads the file and assembles the checked [`Problem`].
 
 mod checks;
+mod key_lens;
 mod options;
 mod overrides;
 mod rod;
@@ -107,7 +108,29 @@ impl Problem {
         let text = apply_overrides(text, overrides)?;
         let file: ProblemFile = strict::parse(&text)?;
         let rod = build_rod(&file, catalog)?;
-        let model = choose_model(&rod, &file.solver.model, file.energy.shear.is_some())?;
+        let mut model = choose_model(&rod, &file.solver.model, file.energy.shear.is_some())?;
+        let options = build_options(&file.solver)?;
+        if options.initial_reaction.is_some()
+            && !rod.support().as_ref().is_some_and(|s| s.holds_position())
+        {
+            return Err(invalid(
+                "solver.initial_reaction",
+                "guesses the reaction of a tip support that holds the tip's position; this \
+                 scene has none ([support] translation = \"fixed\" or \"axial\")",
+            ));
+        }
+        let shape = build_shape(&file)?;
+        let stability = build_stability(&file.stability)?;
+        eigenvalue_count("stability", &stability, &rod)?;
+        let continuation = build_continuation(
+            &file,
+            &text,
+            catalog,
+            &rod,
+            &mut model,
+            &options,
+            shape.as_ref(),
+        )?;
         if rod.clamp().hinge && model.level != ModelLevel::Planar {
             return Err(invalid(
                 "clamp.hinge",
@@ -117,11 +140,6 @@ impl Problem {
                 ),
             ));
         }
-        let options = build_options(&file.solver)?;
-        let shape = build_shape(&file)?;
-        let stability = build_stability(&file.stability)?;
-        eigenvalue_count("stability", &stability, &rod)?;
-        let continuation = build_continuation(&file, &rod, &model, &options, shape.as_ref())?;
         let arm = file.arm.as_ref().map(|a| a.build(&rod)).transpose()?;
         let arm_scene = file
             .arm

@@ -11,25 +11,34 @@ use super::sections::{ProblemFile, ProfileSpec, SolverSection, StabilitySection}
 use super::{invalid, ProblemError};
 use crate::bvp::newton::NewtonOptions;
 use crate::bvp::{Method, SolverOptions, Strategy};
-use crate::continuation::{ContinuationOptions, Family, Parameter};
+use std::sync::Arc;
+
+use super::key_lens::KeyLens;
+use crate::continuation::{ContinuationOptions, Family, Lens, Parameter, RodLens};
 use crate::input::mesh::MeshKeys;
-use crate::model::{ModelChoice, Profile, Rod};
+use crate::model::{EnergyCatalog, ModelChoice, ModelLevel, Profile, Rod};
 use crate::numerics::integrator::Tolerances;
 use crate::stability::{FixedShape, StabilityOptions};
 
 /// The family of a `[continuation]` table, discretized by the solver's
-/// shooting method at the scene's model level.
+/// shooting method at the scene's model level (raised to the spatial
+/// model, when the level was chosen automatically, if the parameter takes
+/// the rod out of its plane inside the bounds). `text` is the effective
+/// problem text: a key that is not one of the library's parameters is
+/// continued by rereading it ([`KeyLens`]).
 pub(super) fn build_continuation(
     file: &ProblemFile,
+    text: &str,
+    catalog: &EnergyCatalog,
     rod: &Rod,
-    model: &ModelChoice,
+    model: &mut ModelChoice,
     options: &SolverOptions,
     shape: Option<&FixedShape>,
 ) -> Result<Option<(Family, ContinuationOptions)>, ProblemError> {
     let Some(section) = &file.continuation else {
         return Ok(None);
     };
-    let (parameter, mut opts) = section.build()?;
+    let (key, mut opts) = section.build()?;
     // The start is solved as the problem's [solver] says.
     opts.start_solver = Some(options.clone());
     eigenvalue_count("continuation", &opts.stability, rod)?;
@@ -47,55 +56,101 @@ pub(super) fn build_continuation(
         }
     };
     if let Some(shape) = shape {
-        // A fixed shape's κ⁰ follows from the load; continuation needs a
-        // rod with one κ⁰: only shapes on which the loads make no moment
-        // (κ⁰ = φ', e.g. a straight column under an axial load) qualify.
-        let fe_points: Vec<f64> = (0..=64)
-            .map(|i| rod.length() * f64::from(i) / 64.0)
-            .collect();
-        let moment = shape
-            .samples(rod, &fe_points)
-            .map_err(|e| invalid("shape", e.to_string()))?
-            .iter()
-            .map(|p| p.moment.norm())
-            .fold(0.0, f64::max);
-        if moment > 1e-12 * rod.moment_scale()
-            || !matches!(shape.turning_angle, Profile::Constant(_))
-        {
-            return Err(invalid(
-                "shape",
-                "continuation from a fixed shape needs a straight shape on which the loads make no moment",
-            ));
-        }
+        check_shape_continuable(shape, rod)?;
     }
-    let mut base = rod.clone();
-    if parameter == Parameter::ClampAngle {
-        // The parameter is the absolute angle: start from the unturned frame.
-        let mut clamp = rod.clamp().clone();
-        clamp.frame = clamp
-            .turned_frame(-file.clamp.angle)
-            .map_err(|e| invalid("clamp.angle", e.to_string()))?;
-        base = base
-            .with_clamp(clamp)
-            .map_err(|e| invalid("clamp.angle", e.to_string()))?;
-    }
-    let family = match stages {
-        None => Family::new(base, parameter, model.level, segments, options.integration),
-        Some(m) => Family::collocation(
-            base,
-            parameter,
-            model.level,
-            segments,
-            m,
-            options.integration,
-        ),
+    let lens: Arc<dyn Lens> = match Parameter::from_key(&key) {
+        Some(parameter) => Arc::new(RodLens::new(native_base(file, rod, parameter)?, parameter)),
+        None => Arc::new(KeyLens::new(&key, text, catalog)?),
     };
+    if file.solver.model == "auto" {
+        raise_level(model, lens.as_ref(), &opts);
+    }
+    let mut family = Family::of_lens(
+        lens,
+        rod.clone(),
+        model.level,
+        segments,
+        options.integration,
+    );
+    if let Some(m) = stages {
+        family = family.collocated(m);
+    }
     // A parameter the energy cannot vary (a varying profile, an energy
     // without that profile) is refused here, not at the first point.
     family
         .rod_at(opts.start)
         .map_err(|e| invalid("continuation.parameter", e.to_string()))?;
     Ok(Some((family, opts)))
+}
+
+/// The base rod of a library parameter: the problem's rod, but for
+/// `clamp.angle` (the parameter is the absolute angle) the unturned frame.
+fn native_base(file: &ProblemFile, rod: &Rod, parameter: Parameter) -> Result<Rod, ProblemError> {
+    if parameter != Parameter::ClampAngle {
+        return Ok(rod.clone());
+    }
+    let mut clamp = rod.clamp().clone();
+    clamp.frame = clamp
+        .turned_frame(-file.clamp.angle)
+        .map_err(|e| invalid("clamp.angle", e.to_string()))?;
+    rod.clone()
+        .with_clamp(clamp)
+        .map_err(|e| invalid("clamp.angle", e.to_string()))
+}
+
+/// Points of the bounds probed for a rod that leaves the plane.
+const LEVEL_PROBES: u32 = 16;
+
+/// An automatically chosen planar level raised to the spatial model when
+/// the rod at some probed parameter value (the start, the bounds and
+/// [`LEVEL_PROBES`] points between) cannot be planar; a point the probes
+/// miss is refused at run time ([`crate::continuation::FamilyError::NeedsModel`]).
+fn raise_level(model: &mut ModelChoice, lens: &dyn Lens, opts: &ContinuationOptions) {
+    if model.level != ModelLevel::Planar {
+        return;
+    }
+    let (lo, hi) = opts.bounds;
+    let probes = (0..=LEVEL_PROBES)
+        .map(|i| lo + (hi - lo) * f64::from(i) / f64::from(LEVEL_PROBES))
+        .chain([opts.start]);
+    for p in probes {
+        let Ok(rod) = lens.rod_at(p) else { continue };
+        let choice = ModelChoice::for_rod(&rod);
+        if choice.level != ModelLevel::Planar {
+            *model = ModelChoice {
+                level: choice.level,
+                reason: format!(
+                    "{}: continuation.parameter = {} takes the rod out of the plane (at {p}: {})",
+                    choice.level.name(),
+                    lens.key(),
+                    choice.reason
+                ),
+            };
+            return;
+        }
+    }
+}
+
+/// A fixed shape's κ⁰ follows from the load; continuation needs a rod with
+/// one κ⁰: only shapes on which the loads make no moment (κ⁰ = φ', e.g. a
+/// straight column under an axial load) qualify.
+fn check_shape_continuable(shape: &FixedShape, rod: &Rod) -> Result<(), ProblemError> {
+    let fe_points: Vec<f64> = (0..=64)
+        .map(|i| rod.length() * f64::from(i) / 64.0)
+        .collect();
+    let moment = shape
+        .samples(rod, &fe_points)
+        .map_err(|e| invalid("shape", e.to_string()))?
+        .iter()
+        .map(|p| p.moment.norm())
+        .fold(0.0, f64::max);
+    if moment > 1e-12 * rod.moment_scale() || !matches!(shape.turning_angle, Profile::Constant(_)) {
+        return Err(invalid(
+            "shape",
+            "continuation from a fixed shape needs a straight shape on which the loads make no moment",
+        ));
+    }
+    Ok(())
 }
 
 pub(super) fn build_shape(file: &ProblemFile) -> Result<Option<FixedShape>, ProblemError> {
@@ -258,6 +313,10 @@ pub(super) fn build_options(s: &SolverSection) -> Result<SolverOptions, ProblemE
         Some(k) => Some(vector("solver.initial_curvature", k)?.as_slice().to_vec()),
         None => None,
     };
+    let initial_reaction = s
+        .initial_reaction
+        .map(|r| vector("solver.initial_reaction", r))
+        .transpose()?;
     Ok(SolverOptions {
         method,
         newton: NewtonOptions {
@@ -273,6 +332,7 @@ pub(super) fn build_options(s: &SolverSection) -> Result<SolverOptions, ProblemE
         collocation,
         output_points: s.output_points,
         initial_guess,
+        initial_reaction,
         strategy,
     })
 }

@@ -25,39 +25,59 @@ pub(super) fn apply_overrides(text: &str, overrides: &[String]) -> Result<String
         let (key, raw) = assignment
             .split_once('=')
             .ok_or_else(|| fail("expected key=value"))?;
-        let path: Vec<&str> = key.trim().split('.').map(str::trim).collect();
-        if path.iter().any(|p| p.is_empty()) {
-            return Err(fail("empty key"));
-        }
-        let value = parse_value(raw.trim());
-        let (last, parents) = path.split_last().expect("non-empty path");
-        let mut table = &mut doc;
-        for part in parents {
-            let entry = table
-                .entry(part.to_string())
-                .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-            table = entry
-                .as_table_mut()
-                .ok_or_else(|| fail(&format!("`{part}` is not a table")))?;
-        }
-        match indexed(last) {
-            Some((name, i)) => {
-                let list = table
-                    .get_mut(name)
-                    .and_then(toml::Value::as_array_mut)
-                    .ok_or_else(|| fail(&format!("`{name}` is not an array")))?;
-                let len = list.len();
-                *list
-                    .get_mut(i)
-                    .ok_or_else(|| fail(&format!("`{name}` has {len} elements, no [{i}]")))? =
-                    value;
-            }
-            None => {
-                table.insert(last.to_string(), value);
-            }
-        }
+        set_key(&mut doc, key, parse_value(raw.trim())).map_err(|m| fail(&m))?;
     }
     toml::to_string(&doc).map_err(|e| ProblemError::Parse(e.to_string()))
+}
+
+/// Sets the dotted `key` (`a.b.c`, the last part possibly `name[i]`) of
+/// `doc` to `value`, creating missing tables; an indexed element must
+/// exist. The error says why the key cannot be set.
+pub(crate) fn set_key(doc: &mut toml::Table, key: &str, value: toml::Value) -> Result<(), String> {
+    let path: Vec<&str> = key.trim().split('.').map(str::trim).collect();
+    if path.iter().any(|p| p.is_empty()) {
+        return Err("empty key".into());
+    }
+    let (last, parents) = path.split_last().expect("non-empty path");
+    let mut table = doc;
+    for part in parents {
+        let entry = table
+            .entry((*part).to_string())
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        table = entry
+            .as_table_mut()
+            .ok_or_else(|| format!("`{part}` is not a table"))?;
+    }
+    match indexed(last) {
+        Some((name, i)) => {
+            let list = table
+                .get_mut(name)
+                .and_then(toml::Value::as_array_mut)
+                .ok_or_else(|| format!("`{name}` is not an array"))?;
+            let len = list.len();
+            *list
+                .get_mut(i)
+                .ok_or_else(|| format!("`{name}` has {len} elements, no [{i}]"))? = value;
+        }
+        None => {
+            table.insert((*last).to_string(), value);
+        }
+    }
+    Ok(())
+}
+
+/// The value at the dotted `key` of `doc`, if there is one.
+pub(crate) fn get_key<'d>(doc: &'d toml::Table, key: &str) -> Option<&'d toml::Value> {
+    let path: Vec<&str> = key.trim().split('.').map(str::trim).collect();
+    let (last, parents) = path.split_last()?;
+    let mut table = doc;
+    for part in parents {
+        table = table.get(*part)?.as_table()?;
+    }
+    match indexed(last) {
+        Some((name, i)) => table.get(name)?.as_array()?.get(i),
+        None => table.get(*last),
+    }
 }
 
 /// `name[i]` → (name, i): one element of an array, as in

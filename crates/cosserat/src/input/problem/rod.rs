@@ -290,10 +290,14 @@ pub(super) fn build_clamp(c: &ClampSection) -> Result<Clamp, ProblemError> {
     // Unit and orthogonal to 1e-9 above, so within Frame::TOLERANCE; a
     // frame refused all the same is named by its directors.
     let clamp = Clamp::new(position, d1, d3).map_err(|e| invalid("clamp.d3", e.to_string()))?;
+    let mut frame = clamp
+        .turned_frame(angle)
+        .map_err(|e| invalid("clamp.angle", e.to_string()))?;
+    if let Some(turn) = &c.turn {
+        frame = turn.apply("clamp.turn", &frame)?;
+    }
     Ok(Clamp {
-        frame: clamp
-            .turned_frame(angle)
-            .map_err(|e| invalid("clamp.angle", e.to_string()))?,
+        frame,
         hinge: c.hinge,
         ..clamp
     })

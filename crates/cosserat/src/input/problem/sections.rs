@@ -215,6 +215,10 @@ pub struct ClampSection {
     /// A hinge about d2 instead of a clamp (a pinned base; planar scenes).
     #[serde(default)]
     pub hinge: bool,
+    /// The frame then turned about a fixed axis (after `angle`), by an
+    /// angle that may run through any number of turns.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub turn: Option<crate::input::TurnSection>,
 }
 
 fn unit_x() -> [f64; 3] {
@@ -233,6 +237,7 @@ impl Default for ClampSection {
             d3: unit_z(),
             angle: 0.0,
             hinge: false,
+            turn: None,
         }
     }
 }
@@ -300,6 +305,13 @@ pub struct SolverSection {
         deserialize_with = "strict::option"
     )]
     pub initial_curvature: Option<[f64; 3]>,
+    /// Guess of the tip support's reaction force, global components (N).
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "strict::option"
+    )]
+    pub initial_reaction: Option<[f64; 3]>,
 }
 
 fn default_method() -> String {
