@@ -71,6 +71,18 @@ pub enum Command {
         /// Go on with an interrupted run saved in the output file.
         #[arg(long)]
         resume: bool,
+        /// Start from a point of this stored diagram (with --point) instead
+        /// of the problem's own solve.
+        #[arg(
+            long,
+            value_name = "DIAGRAM",
+            requires = "point",
+            conflicts_with = "resume"
+        )]
+        from: Option<PathBuf>,
+        /// The stored point: BRANCH/POINT, e.g. 1/10 or 1/last.
+        #[arg(long, value_name = "B/I", requires = "from")]
+        point: Option<String>,
         /// Override any key of the problem file.
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,

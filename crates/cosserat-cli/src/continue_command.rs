@@ -7,9 +7,10 @@ use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
 use crate::plot::{draw, read_diagram};
+use crate::stored_start::{stored_start, StoredStart};
 use cosserat::continuation::{
-    continuation, ContinuationError, ContinuationOptions, Diagram, Family, Progress, RunState,
-    SavedDiagram,
+    continuation, continuation_from, ContinuationError, ContinuationOptions, Diagram, Family,
+    Progress, RunState, SavedDiagram, StartPoint,
 };
 use cosserat::input::{Problem, MEASURES};
 use cosserat::output::target::replace_atomically;
@@ -29,18 +30,51 @@ fn section_key(text: &str, key: &str) -> Option<String> {
     Some(table.get("continuation")?.get(key)?.as_str()?.to_string())
 }
 
+/// What `cosserat continue` was asked.
+pub struct ContinueArgs<'a> {
+    /// The problem file.
+    pub path: &'a Path,
+    /// The diagram file to write.
+    pub output: &'a Path,
+    /// The chart to draw.
+    pub plot: Option<&'a Path>,
+    /// `--set` overrides.
+    pub set: &'a [String],
+    /// Replace an existing output.
+    pub force: bool,
+    /// Go on with the output's interrupted run.
+    pub resume: bool,
+    /// Start from a stored point: the diagram file and `B/I`.
+    pub from: Option<(&'a Path, &'a str)>,
+}
+
+/// The problem, and the stored start when `--from` is given (its
+/// parameter value set before the user's `--set`).
+fn read_problem(args: &ContinueArgs) -> Result<(Problem, Option<StoredStart>), ExitCode> {
+    let read = |set: &[String]| {
+        Problem::from_path(args.path, set)
+            .map_err(|e| fail(BAD_INPUT, format!("{}: {e}", args.path.display())))
+    };
+    let problem = read(args.set)?;
+    let Some((file, spec)) = args.from else {
+        return Ok((problem, None));
+    };
+    let Some((family, _)) = &problem.continuation else {
+        return Ok((problem, None));
+    };
+    let stored = stored_start(file, spec, &family.key()).map_err(|e| fail(BAD_INPUT, e))?;
+    let mut set = stored.sets.clone();
+    set.extend_from_slice(args.set);
+    Ok((read(&set)?, Some(stored)))
+}
+
 /// Runs the continuation of a problem file.
-pub fn run_continue(
-    path: &Path,
-    output: &Path,
-    plot: Option<&Path>,
-    set: &[String],
-    force: bool,
-    resume: bool,
-) -> ExitCode {
-    let problem = match Problem::from_path(path, set) {
-        Ok(p) => p,
-        Err(e) => return fail(BAD_INPUT, format!("{}: {e}", path.display())),
+pub fn run_continue(args: &ContinueArgs) -> ExitCode {
+    let (path, output, plot, force, resume) =
+        (args.path, args.output, args.plot, args.force, args.resume);
+    let (problem, stored) = match read_problem(args) {
+        Ok(read) => read,
+        Err(code) => return code,
     };
     let Some((family, opts)) = &problem.continuation else {
         return fail(
@@ -53,7 +87,9 @@ pub fn run_continue(
     };
     let mut outputs: Vec<&Path> = vec![output];
     outputs.extend(plot);
-    let _claims = match crate::solve_command::claim_outputs(&outputs, &[path], force || resume) {
+    let mut inputs = vec![path];
+    inputs.extend(args.from.map(|(file, _)| file));
+    let _claims = match crate::solve_command::claim_outputs(&outputs, &inputs, force || resume) {
         Ok(c) => c,
         Err(code) => return code,
     };
@@ -72,6 +108,9 @@ pub fn run_continue(
         "continue  {parameter_name} from {} in [{}, {}]",
         opts.start, opts.bounds.0, opts.bounds.1
     );
+    if let Some(stored) = &stored {
+        println!("from      {}", stored.summary);
+    }
     let bar = spinner();
     let start = Instant::now();
     let run = Run {
@@ -81,7 +120,7 @@ pub fn run_continue(
         text: &problem.text,
         parameter_name: &parameter_name,
     };
-    let outcome = run.follow(&bar, saved.as_ref());
+    let outcome = run.follow(&bar, saved.as_ref(), stored.as_ref().map(|s| &s.start));
     let diagram = match outcome {
         Ok(d) => d,
         Err(e) => return fail(NO_RESULT, e),
@@ -147,6 +186,7 @@ impl Run<'_> {
         &self,
         bar: &ProgressBar,
         saved: Option<&SavedDiagram>,
+        start: Option<&StartPoint>,
     ) -> Result<Diagram, ContinuationError> {
         let mut last_save = Instant::now();
         let mut checkpoint_error = None;
@@ -178,11 +218,12 @@ impl Run<'_> {
                 self.output.display()
             );
         }
-        let outcome = match saved {
-            Some(saved) => {
+        let outcome = match (saved, start) {
+            (Some(saved), _) => {
                 cosserat::continuation::resume(self.family, self.opts, saved, &mut monitor)
             }
-            None => continuation(self.family, self.opts, &mut monitor),
+            (None, Some(start)) => continuation_from(self.family, self.opts, start, &mut monitor),
+            (None, None) => continuation(self.family, self.opts, &mut monitor),
         };
         bar.finish_and_clear();
         signals::set_mode(signals::Mode::Immediate);

@@ -39,6 +39,7 @@ pub mod optimize_command;
 pub mod plot;
 pub mod signals;
 pub mod solve_command;
+pub mod stored_start;
 pub mod sweep_chart;
 pub mod sweep_command;
 pub mod sweep_figure;
@@ -75,11 +76,19 @@ pub fn run(cli: Cli) -> ExitCode {
             output,
             plot,
             resume,
+            from,
+            point,
             set,
             force,
-        } => {
-            continue_command::run_continue(&problem, &output, plot.as_deref(), &set, force, resume)
-        }
+        } => continue_command::run_continue(&continue_command::ContinueArgs {
+            path: &problem,
+            output: &output,
+            plot: plot.as_deref(),
+            set: &set,
+            force,
+            resume,
+            from: from.as_deref().zip(point.as_deref()),
+        }),
         Command::Optimize {
             problem,
             output,

@@ -33,6 +33,16 @@ pub fn continuation(
     })?;
     let mut run = Run::new(family, opts);
     let first = run.start_point()?;
+    Ok(follow_from(&mut run, first, monitor))
+}
+
+/// The diagram of a run from its first point: the first branch (both ways
+/// if asked) and the branches switched onto from it.
+pub(super) fn follow_from(
+    run: &mut Run,
+    first: Point,
+    monitor: &mut dyn FnMut(Progress, &Diagram) -> bool,
+) -> Diagram {
     let mut diagram = Diagram {
         branches: vec![],
         special_points: vec![],
@@ -43,13 +53,13 @@ pub fn continuation(
     };
     // (start point, direction sign, parent special point, depth)
     let mut queue = vec![(first, 1.0, None::<usize>, 0usize)];
-    if opts.both_directions {
+    if run.opts.both_directions {
         let mut back = queue[0].clone();
         back.1 = -1.0;
         queue.push(back);
     }
-    drain(&mut run, &mut diagram, queue, monitor);
-    Ok(diagram)
+    drain(run, &mut diagram, queue, monitor);
+    diagram
 }
 
 /// A branch to follow: start point, direction, parent special point, depth.

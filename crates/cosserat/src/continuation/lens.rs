@@ -39,7 +39,7 @@ pub enum Parameter {
     /// All loads multiplied by p and the intrinsic curvature moved from
     /// the base rod's (p = 0) to a target's (p = 1),
     /// κ⁰ = (1 − p) κ⁰_base + p κ⁰_target; build with
-    /// [`Family::towards`]. With κ⁰_base = φ' and
+    /// [`super::Family::towards`]. With κ⁰_base = φ' and
     /// κ⁰_target from (43) the designed shape is an equilibrium all along
     /// (the shape-holding control of a designed arm).
     CurvatureTowards,
@@ -77,6 +77,17 @@ impl std::fmt::Display for Parameter {
 }
 
 impl Parameter {
+    /// Whether the parameter is a number a problem file writes (a load
+    /// component, the length, a stiffness…), not one of the library's
+    /// scalings of several numbers at once (`load_scale`, `control_scale`,
+    /// the shape-holding control).
+    pub fn is_file_key(self) -> bool {
+        !matches!(
+            self,
+            Parameter::LoadScale | Parameter::ControlScale | Parameter::CurvatureTowards
+        )
+    }
+
     /// The parameter named by a problem-file key: `load_scale`,
     /// `loads.tip_force[i]`, `loads.tip_couple[i]`,
     /// `loads.distributed_force[i]`, `control_scale`, `rod.length`, `energy.stiffness[i]`,

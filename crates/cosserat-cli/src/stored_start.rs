@@ -1,0 +1,116 @@
+//! `cosserat continue PROBLEM --from DIAGRAM.h5 --point B/I`: a
+//! continuation started from a point of a stored diagram.
+//!
+//! The point's unknowns start Newton at the new run's start value. The
+//! stored parameter carries over: the number it names is set to the
+//! stored value (before the user's own `--set`, which win), and when the
+//! new run continues the same parameter it starts at that value, in the
+//! stored direction of travel — so a branch restarted from one of its own
+//! points goes on as the uninterrupted run did. A stage continued in
+//! another parameter (bend a rod shut, then twist it) starts from the
+//! stored shape with the stored value of the first parameter held.
+
+use std::path::Path;
+
+use cosserat::continuation::{Parameter, SavedDiagram, StartPoint};
+use cosserat::output::read_saved;
+
+/// What a stored point gives a new run.
+pub struct StoredStart {
+    /// `KEY=VALUE` overrides to apply before the user's.
+    pub sets: Vec<String>,
+    /// The unknowns and direction.
+    pub start: StartPoint,
+    /// One line for the report.
+    pub summary: String,
+}
+
+/// `B/I`: branch B, point I (`last` for its last point).
+fn parse_point(spec: &str, saved: &SavedDiagram) -> Result<(usize, usize), String> {
+    let (b, i) = spec
+        .split_once('/')
+        .ok_or_else(|| format!("--point {spec}: expected BRANCH/POINT, e.g. 1/10 or 1/last"))?;
+    let b: usize = b
+        .trim()
+        .parse()
+        .map_err(|_| format!("--point {spec}: the branch `{b}` is not an index"))?;
+    let branch = saved.branches.get(b).ok_or_else(|| {
+        format!(
+            "--point {spec}: the diagram has {} branches (0 to {})",
+            saved.branches.len(),
+            saved.branches.len().saturating_sub(1)
+        )
+    })?;
+    let count = branch.parameter.len();
+    let i = match i.trim() {
+        "last" => count.checked_sub(1),
+        other => other.parse::<usize>().ok().filter(|i| *i < count),
+    }
+    .ok_or_else(|| {
+        format!(
+            "--point {spec}: branch {b} has {count} points (0 to {})",
+            count.saturating_sub(1)
+        )
+    })?;
+    Ok((b, i))
+}
+
+/// The start from point `spec` of the diagram `file`, for a run that
+/// continues `new_key`.
+pub fn stored_start(file: &Path, spec: &str, new_key: &str) -> Result<StoredStart, String> {
+    let (text, saved) =
+        read_saved(file).map_err(|e| format!("{}: not a diagram file: {e}", file.display()))?;
+    let (b, i) = parse_point(spec, &saved)?;
+    let old_key = stored_key(&text).ok_or_else(|| {
+        format!(
+            "{}: its problem names no continuation parameter",
+            file.display()
+        )
+    })?;
+    let branch = &saved.branches[b];
+    let value = branch.parameter[i];
+    let mut sets = vec![];
+    // A number of the problem file is set to the stored value; the
+    // library's scalings (load_scale, control_scale) are not file keys.
+    if Parameter::from_key(&old_key).is_none_or(Parameter::is_file_key) {
+        sets.push(format!("{old_key}={value}"));
+    }
+    let same = old_key == new_key;
+    if same {
+        sets.push(format!("continuation.start={value}"));
+    } else if Parameter::from_key(&old_key).is_some_and(|p| !p.is_file_key()) {
+        return Err(format!(
+            "--from {}: the point is at {old_key} = {value}, a scaling of the problem that a \
+             continuation in {new_key} cannot hold; continue {old_key} from it, or write the \
+             scaled values in the problem",
+            file.display()
+        ));
+    }
+    let direction = same.then(|| branch.tangent[i].clone());
+    Ok(StoredStart {
+        sets,
+        start: StartPoint::new(branch.unknowns[i].clone(), direction),
+        summary: format!(
+            "{} branch {b} point {i}: {old_key} = {value}{}",
+            file.display(),
+            if same {
+                ", in its direction of travel"
+            } else {
+                ""
+            }
+        ),
+    })
+}
+
+/// The continued key of a stored problem text.
+fn stored_key(text: &str) -> Option<String> {
+    let table: toml::Table = toml::from_str(text).ok()?;
+    Some(
+        table
+            .get("continuation")?
+            .get("parameter")?
+            .as_str()?
+            .trim()
+            .to_string(),
+    )
+}

@@ -1,0 +1,140 @@
+//! `cosserat continue --from DIAGRAM --point B/I`: restarts, chained
+//! stages, and refusals with a named reason and exit code 2.
+
+mod common;
+
+use common::run::{run, scratch, stderr};
+
+fn shipped(name: &str) -> String {
+    format!("{}/../../problems/{name}.toml", env!("CARGO_MANIFEST_DIR"))
+}
+
+/// A restart from a point of the buckled Euler branch ends where the
+/// uninterrupted branch ends (the 170° landing), and says where it started.
+#[test]
+fn a_restart_goes_on_along_the_stored_branch() {
+    let dir = scratch("from", "restart");
+    let full = dir.join("full.h5");
+    let again = dir.join("again.h5");
+    let euler = shipped("euler_column");
+    let o = run(&["continue", &euler, "-o", full.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = run(&[
+        "continue",
+        &euler,
+        "-o",
+        again.to_str().unwrap(),
+        "--from",
+        full.to_str().unwrap(),
+        "--point",
+        "1/10",
+        "--set",
+        "continuation.switch_depth=0",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("branch 1 point 10: load_scale = "), "{out}");
+    assert!(out.contains("tip angle 170.00° reached"), "{out}");
+}
+
+/// A second stage in another parameter: the twisted rod's straight branch
+/// stored, then continued in the torsional stiffness from its point at one
+/// full turn — the key of the first stage is held at the stored value.
+#[test]
+fn a_chained_stage_holds_the_first_parameter() {
+    let dir = scratch("from", "chain");
+    let first = dir.join("twist.h5");
+    let second = dir.join("stiffness.h5");
+    let twisted = shipped("twisted_rod");
+    let o = run(&[
+        "continue",
+        &twisted,
+        "-o",
+        first.to_str().unwrap(),
+        "--set",
+        "continuation.bounds=[0.0, 6.3]",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = run(&[
+        "continue",
+        &twisted,
+        "-o",
+        second.to_str().unwrap(),
+        "--from",
+        first.to_str().unwrap(),
+        "--point",
+        "0/last",
+        "--set",
+        "continuation.parameter=\"energy.stiffness[2]\"",
+        "--set",
+        "continuation.start=1.0",
+        "--set",
+        "continuation.bounds=[0.5, 1.5]",
+        "--set",
+        "continuation.switch_depth=0",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("support.turn.angle = 6.3"), "{out}");
+    // Held at θ = 6.3, the straight rod carries M = C θ/L and loses
+    // stability where M L/B = 2x₁: C = 2x₁ B/θ = 8.98682/6.3 = 1.42648.
+    let exact = cosserat::references::twisted_clamped_moment() / 6.3;
+    assert!((exact - 1.42648).abs() < 1e-5);
+    assert!(
+        out.contains("branch_point on branch 0 at parameter 1.4264"),
+        "{out}"
+    );
+}
+
+/// Refusals: a malformed or missing point, a file that is not a diagram,
+/// and --from without --point.
+#[test]
+fn bad_stored_points_are_refused_by_name() {
+    let dir = scratch("from", "refusals");
+    let full = dir.join("full.h5");
+    let out = dir.join("out.h5");
+    let euler = shipped("euler_column");
+    let o = run(&["continue", &euler, "-o", full.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for (point, says) in [
+        ("7/0", "branches"),
+        ("1/999", "points"),
+        ("x", "BRANCH/POINT"),
+        ("1/y", "points"),
+    ] {
+        let o = run(&[
+            "continue",
+            &euler,
+            "-o",
+            out.to_str().unwrap(),
+            "--from",
+            full.to_str().unwrap(),
+            "--point",
+            point,
+        ]);
+        assert_eq!(o.status.code(), Some(2), "{point}");
+        assert!(stderr(&o).contains(says), "{point}: {}", stderr(&o));
+        assert!(!out.exists(), "nothing written");
+    }
+    let o = run(&[
+        "continue",
+        &euler,
+        "-o",
+        out.to_str().unwrap(),
+        "--from",
+        &euler,
+        "--point",
+        "0/0",
+    ]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("not a diagram file"), "{}", stderr(&o));
+    let o = run(&[
+        "continue",
+        &euler,
+        "-o",
+        out.to_str().unwrap(),
+        "--from",
+        full.to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(2), "--from needs --point");
+}

@@ -1,0 +1,88 @@
+//! Continuation from a given equilibrium instead of the problem's own
+//! solve: a point of a stored diagram (`cosserat continue --from FILE
+//! --point B/I`), or any unknowns a program has. The given unknowns start
+//! Newton at the start value of the parameter, so the first point is an
+//! equilibrium of the problem as posed (to the corrector's tolerance) and
+//! the guess only chooses which one; with the stored direction of travel,
+//! a branch restarted from one of its own points goes on as the
+//! uninterrupted run did.
+
+use super::driver::follow_from;
+use super::{ContinuationError, ContinuationOptions, Diagram, Family, Point, Progress, Run};
+
+/// Where a continuation starts: the family's (scaled) unknowns at
+/// `ContinuationOptions::start`, and the direction of travel to keep.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StartPoint {
+    unknowns: Vec<f64>,
+    direction: Option<Vec<f64>>,
+}
+
+impl StartPoint {
+    /// The start from `unknowns` (the family's scaled unknowns, as a
+    /// diagram stores them), travelling along `direction` (a tangent
+    /// (x, p) of the same size plus one) if given, else towards
+    /// increasing p.
+    pub fn new(unknowns: Vec<f64>, direction: Option<Vec<f64>>) -> Self {
+        StartPoint {
+            unknowns,
+            direction,
+        }
+    }
+
+    /// The unknowns.
+    pub fn unknowns(&self) -> &[f64] {
+        &self.unknowns
+    }
+}
+
+/// [`super::continuation`] from `start` instead of the problem's own
+/// solve. Refused ([`ContinuationError::Start`]) when the unknowns are not
+/// of this family's discretization or Newton at the start value does not
+/// converge from them.
+pub fn continuation_from(
+    family: &Family,
+    opts: &ContinuationOptions,
+    start: &StartPoint,
+    monitor: &mut dyn FnMut(Progress, &Diagram) -> bool,
+) -> Result<Diagram, ContinuationError> {
+    let rod = family.rod_at(opts.start).map_err(super::PointError::from)?;
+    crate::stability::check_conservative(&rod).map_err(|e| ContinuationError::Start {
+        p: opts.start,
+        message: e.to_string(),
+    })?;
+    let mut run = Run::new(family, opts);
+    let first = run.start_point_from(start)?;
+    Ok(follow_from(&mut run, first, monitor))
+}
+
+impl Run<'_> {
+    /// The equilibrium at the start value reached by Newton from the given
+    /// unknowns, its tangent oriented along the given direction.
+    fn start_point_from(&mut self, start: &StartPoint) -> Result<Point, ContinuationError> {
+        let p = self.opts.start;
+        let n = self.family.size();
+        let start_err = |message: String| ContinuationError::Start { p, message };
+        if start.unknowns.len() != n {
+            return Err(start_err(format!(
+                "the given point has {} unknowns, this discretization {n} (another model level, \
+                 method or mesh)",
+                start.unknowns.len()
+            )));
+        }
+        let x = self
+            .newton_at_fixed_p(start.unknowns.clone(), p)
+            .map_err(|e| start_err(format!("from the given point: {e}")))?;
+        let forward = match &start.direction {
+            Some(d) if d.len() == n + 1 => d.clone(),
+            _ => {
+                let mut f = vec![0.0; n];
+                f.push(1.0);
+                f
+            }
+        };
+        let tangent = self.tangent(&x, p, &forward)?;
+        self.tracker.reset();
+        self.point(x, p, tangent)
+    }
+}
