@@ -272,12 +272,6 @@ fn spinner() -> ProgressBar {
 /// `cosserat plot`: the chart of a diagram file, claimed like every output
 /// (never the input, never a non-regular file, `--force` to replace).
 pub fn run_plot(diagram: &Path, measure: &str, output: &Path, force: bool) -> ExitCode {
-    if !MEASURES.contains(&measure) {
-        return fail(
-            BAD_INPUT,
-            format!("--measure: unknown measure `{measure}`; expected one of {MEASURES:?}"),
-        );
-    }
     let _claims = match crate::solve_command::claim_outputs(&[output], &[diagram], force) {
         Ok(c) => c,
         Err(code) => return code,
@@ -291,6 +285,9 @@ pub fn run_plot(diagram: &Path, measure: &str, output: &Path, force: bool) -> Ex
             )
         }
     };
+    if let Err(e) = known_measure(&data, measure) {
+        return fail(BAD_INPUT, format!("--measure: {e}"));
+    }
     match replace_atomically(output, |tmp| draw(&data, measure, tmp)) {
         Ok(()) => {
             println!("plotted   {}", output.display());
@@ -333,14 +330,26 @@ fn report(d: &Diagram) {
     }
 }
 
+/// A measure the chart can draw: a tip measure or one the diagram stored.
+fn known_measure(data: &crate::plot::DiagramData, measure: &str) -> Result<(), String> {
+    if MEASURES.contains(&measure) || data.measure_names.iter().any(|n| n == measure) {
+        return Ok(());
+    }
+    Err(format!(
+        "unknown measure `{measure}`; expected one of {} or a measure the diagram stored ({})",
+        MEASURES.join(", "),
+        if data.measure_names.is_empty() {
+            "none".to_string()
+        } else {
+            data.measure_names.join(", ")
+        }
+    ))
+}
+
 /// Draws a diagram file (the output already claimed by the caller).
 pub fn plot_file(input: &Path, measure: &str, out: &Path) -> Result<(), String> {
-    if !MEASURES.contains(&measure) {
-        return Err(format!(
-            "unknown measure `{measure}`; expected one of {MEASURES:?}"
-        ));
-    }
     let data = read_diagram(input).map_err(|e| format!("{}: {e}", input.display()))?;
+    known_measure(&data, measure)?;
     replace_atomically(out, |tmp| draw(&data, measure, tmp))?;
     println!("plotted   {}", out.display());
     Ok(())

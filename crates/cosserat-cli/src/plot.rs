@@ -24,6 +24,9 @@ pub struct BranchData {
     pub stable: Vec<bool>,
     /// Shapes, 21 positions each.
     pub shapes: Vec<Vec<[f64; 3]>>,
+    /// The named measures of each point (columns of
+    /// [`DiagramData::measure_names`]).
+    pub measures: Vec<Vec<f64>>,
 }
 
 /// A special point as read from a diagram file.
@@ -39,6 +42,8 @@ pub struct SpecialData {
     pub parameter: f64,
     /// Its tip.
     pub tip: [f64; 3],
+    /// Its named measures.
+    pub measures: Vec<f64>,
 }
 
 /// A diagram file's contents needed for charts.
@@ -50,6 +55,25 @@ pub struct DiagramData {
     pub branches: Vec<BranchData>,
     /// Special points.
     pub specials: Vec<SpecialData>,
+    /// The names of the per-point measures (none in files written before
+    /// measures existed).
+    pub measure_names: Vec<String>,
+}
+
+/// The rows of an m×k dataset, or m empty rows when the file has none
+/// (written before measures existed).
+fn measure_rows(g: &hdf5::Group, k: usize, m: usize) -> hdf5::Result<Vec<Vec<f64>>> {
+    let Ok(ds) = g.dataset("measures") else {
+        return Ok(vec![vec![]; m]);
+    };
+    let v = ds.read_raw::<f64>()?;
+    if k == 0 {
+        return Ok(vec![vec![]; m]);
+    }
+    if v.len() != m * k {
+        return Err("the measures dataset does not have one row per point".into());
+    }
+    Ok(v.chunks_exact(k).map(<[f64]>::to_vec).collect())
 }
 
 /// Rows of three; a length that is not a multiple of three is an error.
@@ -69,6 +93,15 @@ pub fn read_diagram(path: &Path) -> hdf5::Result<DiagramData> {
         .as_str()
         .to_string();
     let root = f.group("branches")?;
+    let measure_names: Vec<String> = match root.dataset("measure_names") {
+        Ok(ds) => ds
+            .read_raw::<hdf5::types::VarLenUnicode>()?
+            .iter()
+            .map(|s| s.as_str().to_string())
+            .collect(),
+        Err(_) => vec![],
+    };
+    let k = measure_names.len();
     let mut branches = vec![];
     for i in 0.. {
         let Ok(g) = root.group(&i.to_string()) else {
@@ -78,8 +111,11 @@ pub fn read_diagram(path: &Path) -> hdf5::Result<DiagramData> {
         let shapes_ds = g.dataset("shapes")?;
         let per = shapes_ds.shape().get(1).copied().unwrap_or(0);
         let shapes = shapes_ds.read_raw::<f64>()?;
+        let parameter = read("parameter")?;
+        let measures = measure_rows(&g, k, parameter.len())?;
         branches.push(BranchData {
-            parameter: read("parameter")?,
+            measures,
+            parameter,
             tip: rows3(&read("tip_position")?)?,
             tip_angle: read("tip_angle")?,
             norm: read("norm")?,
@@ -104,6 +140,7 @@ pub fn read_diagram(path: &Path) -> hdf5::Result<DiagramData> {
     let parameter = sp.dataset("parameter")?.read_raw::<f64>()?;
     let tip = rows3(&sp.dataset("tip_position")?.read_raw::<f64>()?)?;
     let n = kinds.len();
+    let special_measures = measure_rows(&sp, k, n)?;
     if [branch.len(), index.len(), parameter.len(), tip.len()] != [n; 4] {
         return Err("the special-point datasets have different lengths".into());
     }
@@ -114,12 +151,14 @@ pub fn read_diagram(path: &Path) -> hdf5::Result<DiagramData> {
             index: index[i] as usize,
             parameter: parameter[i],
             tip: tip[i],
+            measures: special_measures[i].clone(),
         })
         .collect();
     let data = DiagramData {
         parameter_name,
         branches,
         specials,
+        measure_names,
     };
     data.check().map_err(|e| hdf5::Error::from(e.as_str()))?;
     Ok(data)
@@ -264,8 +303,11 @@ fn diagram_panel<DB: DrawingBackend>(
 where
     DB::ErrorType: 'static,
 {
-    let value =
-        |b: &BranchData, i: usize| measure_value(measure, &b.tip[i], b.tip_angle[i], b.norm[i]);
+    let named = data.measure_names.iter().position(|n| n == measure);
+    let value = |b: &BranchData, i: usize| match named {
+        Some(k) => b.measures[i][k],
+        None => measure_value(measure, &b.tip[i], b.tip_angle[i], b.norm[i]),
+    };
     let xs = bounds(
         data.branches
             .iter()
@@ -316,12 +358,15 @@ where
     for s in &data.specials {
         let b = &data.branches[s.branch];
         let i = s.index.min(b.parameter.len().saturating_sub(1));
-        let y = measure_value(
-            measure,
-            &s.tip,
-            b.tip_angle.get(i).copied().unwrap_or(0.0),
-            b.norm.get(i).copied().unwrap_or(0.0),
-        );
+        let y = match named {
+            Some(k) => s.measures[k],
+            None => measure_value(
+                measure,
+                &s.tip,
+                b.tip_angle.get(i).copied().unwrap_or(0.0),
+                b.norm.get(i).copied().unwrap_or(0.0),
+            ),
+        };
         let name = label(s, &mut counts);
         let marker = (s.parameter, y);
         let element = EmptyElement::at(marker)

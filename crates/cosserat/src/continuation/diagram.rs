@@ -30,6 +30,9 @@ pub struct Point {
     pub norm: f64,
     /// Positions along the rod (for pictures).
     pub shape: Vec<Vector3<f64>>,
+    /// The values of the run's measures
+    /// ([`super::ContinuationOptions::measures`]), in their order.
+    pub measures: Vec<f64>,
 }
 
 /// Kinds of special points.
@@ -103,6 +106,8 @@ pub struct Diagram {
     pub special_points: Vec<SpecialPoint>,
     /// Column names of the eigenvalues: `"in_plane[0]"`, ...
     pub eigenvalue_names: Vec<String>,
+    /// The names of the per-point measures ([`Point::measures`]).
+    pub measure_names: Vec<String>,
     /// Finite-element nodes of the null modes.
     pub nodes: Vec<f64>,
     /// Why the whole run ended: "in progress" while it runs (what a

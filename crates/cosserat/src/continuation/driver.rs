@@ -47,6 +47,7 @@ pub(super) fn follow_from(
         branches: vec![],
         special_points: vec![],
         eigenvalue_names: run.tracker.names(),
+        measure_names: run.opts.measures.iter().map(super::Measure::name).collect(),
         nodes: run.tracker.nodes(),
         stop_reason: RunState::InProgress,
         warnings: vec![],
@@ -213,7 +214,6 @@ impl<'a> Run<'a> {
         );
         Ok(Point {
             parameter: p,
-            unknowns: x,
             tangent,
             tip_angle,
             tip,
@@ -222,6 +222,8 @@ impl<'a> Run<'a> {
             eigenvalues: spectrum.values,
             norm: spectrum.curvature_norm,
             shape: spectrum.shape,
+            measures: self.measures(&x, p)?,
+            unknowns: x,
         })
     }
 

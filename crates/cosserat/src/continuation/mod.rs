@@ -29,6 +29,7 @@ mod events;
 mod family;
 mod landing;
 mod lens;
+mod measure;
 mod options;
 mod restart;
 mod resume;
@@ -39,6 +40,7 @@ pub use diagram::{Branch, ContinuationError, Diagram, Point, Progress, SpecialKi
 pub use driver::continuation;
 pub use family::{tip_angle, Family, FamilyError, PointError};
 pub use lens::{Lens, Parameter, RodLens};
+pub use measure::{Measure, Quantity};
 pub use options::ContinuationOptions;
 pub use restart::{continuation_from, StartPoint};
 pub use resume::{resume, SavedBranch, SavedDiagram, SavedSpecial};

@@ -41,6 +41,8 @@ pub struct ContinuationOptions {
     /// with the family's own discretization as its method. None: the
     /// default solver with the automatic load strategy.
     pub start_solver: Option<SolverOptions>,
+    /// The measures computed at every point ([`super::Measure`]).
+    pub measures: Vec<super::Measure>,
 }
 
 impl Default for ContinuationOptions {
@@ -59,6 +61,7 @@ impl Default for ContinuationOptions {
             tolerance: 1e-11,
             event_tolerance: 1e-11,
             start_solver: None,
+            measures: vec![],
         }
     }
 }

@@ -138,6 +138,7 @@ pub fn resume(
         branches: vec![],
         special_points: vec![],
         eigenvalue_names: run.tracker.names(),
+        measure_names: run.opts.measures.iter().map(super::Measure::name).collect(),
         nodes: run.tracker.nodes(),
         stop_reason: RunState::InProgress,
         warnings: saved.warnings.clone(),

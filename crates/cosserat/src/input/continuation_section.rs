@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use super::mesh::MeshKeys;
 use super::problem::{invalid, within, ProblemError, NEWTON_TOLERANCE};
-use crate::continuation::ContinuationOptions;
+use crate::continuation::{ContinuationOptions, Measure};
 
 /// `[continuation]`.
 #[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
@@ -64,6 +64,10 @@ pub struct ContinuationSection {
     /// `tip_y`, `tip_z`, `norm` or `tip_angle`.
     #[serde(default = "default_measure")]
     pub measure: String,
+    /// Measures computed and stored at every point
+    /// ([`crate::continuation::Measure`]): `force[2]@0`, `turning`, …
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub measures: Vec<String>,
 }
 
 fn default_step() -> f64 {
@@ -160,11 +164,23 @@ impl ContinuationSection {
             }
             None => None,
         };
-        if !MEASURES.contains(&self.measure.as_str()) {
+        let measures = self
+            .measures
+            .iter()
+            .map(|m| Measure::parse(m).map_err(|e| invalid("continuation.measures", e)))
+            .collect::<Result<Vec<_>, _>>()?;
+        let mut names: Vec<String> = measures.iter().map(Measure::name).collect();
+        names.sort();
+        if names.windows(2).any(|w| w[0] == w[1]) {
+            return Err(invalid("continuation.measures", "names a measure twice"));
+        }
+        if !MEASURES.contains(&self.measure.as_str())
+            && !measures.iter().any(|m| m.name() == self.measure)
+        {
             return Err(invalid(
                 "continuation.measure",
                 format!(
-                    "unknown measure `{}`; expected one of {}",
+                    "unknown measure `{}`; expected one of {} or one of continuation.measures",
                     self.measure,
                     MEASURES.join(", ")
                 ),
@@ -186,6 +202,7 @@ impl ContinuationSection {
                 tolerance: within("continuation.tolerance", self.tolerance, NEWTON_TOLERANCE)?,
                 event_tolerance: 1e-11,
                 start_solver: None,
+                measures,
             },
         ))
     }

@@ -2,11 +2,12 @@
 //!
 //! Layout (a contract, see README.md): `/branches/<i>/parameter` (m),
 //! `tip_position` (m×3), `eigenvalues` (m×k), `stable` (m), `morse_index`
-//! (m), `norm` (m), `shapes` (m×21×3), `unknowns` (m×n) and `tangent`
+//! (m), `norm` (m), `measures` (m×k, named by `/branches/measure_names`),
+//! `shapes` (m×21×3), `unknowns` (m×n) and `tangent`
 //! (m×(n+1)) of the discretization, attributes `parent`, `stop_reason`,
 //! `direction` (±1: travel along or against the stored tangents) and
 //! `next_step` (the arclength step a resumed run goes on with); `/special_points/kind` (strings), `branch`, `index`,
-//! `parameter`, `tip_position` (s×3), `block`, `symmetry_breaking`,
+//! `parameter`, `tip_position` (s×3), `measures` (s×k), `block`, `symmetry_breaking`,
 //! `null_vectors` (s×nodes×3), `singularity` (s×2); `/warnings` (events
 //! detected but not located, as text); the problem text as the
 //! root attribute `problem`, the run's `stop_reason` and the parameter name
@@ -67,6 +68,8 @@ fn write_branches(file: &hdf5::File, d: &Diagram) -> hdf5::Result<()> {
     let root = file.create_group("branches")?;
     let names: Vec<&str> = d.eigenvalue_names.iter().map(String::as_str).collect();
     strings(&root, "eigenvalue_names", &names)?;
+    let measure_names: Vec<&str> = d.measure_names.iter().map(String::as_str).collect();
+    strings(&root, "measure_names", &measure_names)?;
     for (i, b) in d.branches.iter().enumerate() {
         let g = root.create_group(&i.to_string())?;
         let m = b.points.len();
@@ -93,6 +96,8 @@ fn write_branches(file: &hdf5::File, d: &Diagram) -> hdf5::Result<()> {
         integers(&g, "morse_index", &morse)?;
         array(&g, "norm", &[m], &col(&|p| p.norm))?;
         array(&g, "tip_angle", &[m], &col(&|p| p.tip_angle))?;
+        let measures: Vec<f64> = b.points.iter().flat_map(|p| p.measures.clone()).collect();
+        array(&g, "measures", &[m, d.measure_names.len()], &measures)?;
         // The discrete unknowns and tangents: enough to restart a branch.
         let n = b.points.first().map_or(0, |p| p.unknowns.len());
         let x: Vec<f64> = b.points.iter().flat_map(|p| p.unknowns.clone()).collect();
@@ -155,6 +160,13 @@ fn write_special_points(file: &hdf5::File, d: &Diagram) -> hdf5::Result<()> {
         .flat_map(|s| s.point.tip.position.as_slice().to_vec())
         .collect();
     array(&g, "tip_position", &[sp.len(), 3], &tip)?;
+    let measures: Vec<f64> = sp.iter().flat_map(|s| s.point.measures.clone()).collect();
+    array(
+        &g,
+        "measures",
+        &[sp.len(), d.measure_names.len()],
+        &measures,
+    )?;
     let sing: Vec<f64> = sp
         .iter()
         .flat_map(|s| [s.singularity.0, s.singularity.1])

@@ -65,6 +65,7 @@ pub(super) fn build_continuation(
     if file.solver.model == "auto" {
         raise_level(model, lens.as_ref(), &opts);
     }
+    check_measures(&opts, model, rod)?;
     let mut family = Family::of_lens(
         lens,
         rod.clone(),
@@ -96,6 +97,35 @@ fn native_base(file: &ProblemFile, rod: &Rod, parameter: Parameter) -> Result<Ro
     rod.clone()
         .with_clamp(clamp)
         .map_err(|e| invalid("clamp.angle", e.to_string()))
+}
+
+/// The integral measures need what they integrate: `turning` the planar
+/// angle, `stored_energy` an energy that is all of W (no shear part).
+fn check_measures(
+    opts: &ContinuationOptions,
+    model: &ModelChoice,
+    rod: &Rod,
+) -> Result<(), ProblemError> {
+    use crate::continuation::Measure;
+    if opts.measures.contains(&Measure::Turning) && model.level != ModelLevel::Planar {
+        return Err(invalid(
+            "continuation.measures",
+            format!(
+                "`turning` is the planar turning angle ∫κ2 ds, but the scene runs {}; sample \
+                 `tangent[i]@1` instead",
+                model.reason
+            ),
+        ));
+    }
+    if opts.measures.contains(&Measure::StoredEnergy) && rod.energy().shear_stiffness(0.0).is_some()
+    {
+        return Err(invalid(
+            "continuation.measures",
+            "`stored_energy` integrates W(s, κ); a shearable rod's shear and extension energy \
+             is not in it",
+        ));
+    }
+    Ok(())
 }
 
 /// Points of the bounds probed for a rod that leaves the plane.

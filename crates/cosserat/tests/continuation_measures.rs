@@ -1,0 +1,134 @@
+//! Per-point measures against closed forms: the buckled Euler column's
+//! unfolded turning angle and stored energy along the elastica, and the
+//! force a displacement-controlled support exerts.
+
+use std::f64::consts::FRAC_PI_2;
+
+use cosserat::continuation::continuation;
+use cosserat::input::Problem;
+use cosserat::numerics::scalar::bisect;
+use cosserat::references::{clamped_elastica_load, ellip_e, ellip_f};
+
+const EULER: &str = include_str!("../../../problems/euler_column.toml");
+const DISPLACEMENT: &str = include_str!("../../../problems/clamped_elastica_displacement.toml");
+
+/// The modulus k of the clamped–free elastica at the load p = F L²/B:
+/// p = K(k)² (B = L = 1).
+fn modulus(p: f64) -> f64 {
+    let (lo, hi) = bisect(
+        0.0,
+        1.0 - 1e-15,
+        200,
+        |k| ellip_f(FRAC_PI_2, k).powi(2) < p,
+        |_, _| false,
+    );
+    0.5 * (lo + hi)
+}
+
+/// On the buckled column (B = L = 1, load p): the tip turns by
+/// α = 2 asin k, and the stored energy is ½∫θ'² ds = 2K(E − (1 − k²)K)
+/// (θ' = 2kλ cn(λs), λ = K: ∫₀ᴷ cn² = (E − k'²K)/k²).
+#[test]
+fn turning_and_energy_follow_the_elastica() {
+    let set = [
+        "continuation.measures=[\"turning\", \"stored_energy\"]".to_string(),
+        "continuation.switch_depth=1".to_string(),
+    ];
+    let problem = Problem::from_str_with(EULER, &set).unwrap();
+    let (family, opts) = problem.continuation.clone().unwrap();
+    let d = continuation(&family, &opts, &mut |_, _| true).unwrap();
+    assert_eq!(d.measure_names, ["turning", "stored_energy"]);
+    let buckled = &d.branches[1];
+    let mut checked = 0;
+    for point in &buckled.points[1..] {
+        let k = modulus(point.parameter);
+        let alpha = 2.0 * k.asin();
+        let (kk, ee) = (ellip_f(FRAC_PI_2, k), ellip_e(FRAC_PI_2, k));
+        let energy = 2.0 * kk * (ee - (1.0 - k * k) * kk);
+        let (turning, stored) = (point.measures[0], point.measures[1]);
+        assert!(
+            (turning.abs() - alpha).abs() < 1e-8,
+            "p = {}: turning {turning}, α {alpha}",
+            point.parameter
+        );
+        assert!(
+            (stored - energy).abs() < 1e-8 * energy.max(1e-3),
+            "p = {}: {stored} vs {energy}",
+            point.parameter
+        );
+        checked += 1;
+    }
+    assert!(checked > 20);
+    // Unfolded: the last point has turned 170°, and the sign is kept.
+    let last = buckled.points.last().unwrap().measures[0];
+    assert!((last.abs() - 170f64.to_radians()).abs() < 1e-8, "{last}");
+}
+
+/// The stored measure is the force the support exerts (−P along the axis).
+#[test]
+fn the_support_force_is_measured_along_the_displacement_branch() {
+    let problem = Problem::from_str_with(DISPLACEMENT, &[]).unwrap();
+    let (family, opts) = problem.continuation.clone().unwrap();
+    let d = continuation(&family, &opts, &mut |_, _| true).unwrap();
+    assert_eq!(d.measure_names[0], "force[2]@1");
+    for point in d.branches.iter().flat_map(|b| &b.points) {
+        let delta = 1.0 - point.parameter;
+        if delta < 1e-3 {
+            continue;
+        }
+        let exact = clamped_elastica_load(delta);
+        assert!(
+            (-point.measures[0] - exact).abs() <= 1e-8 * exact,
+            "δ = {delta}"
+        );
+        // The midspan sways by two quarter-waves' 2k/λ: k/K (λ = 4K).
+        let (lo, hi) = bisect(
+            0.0,
+            1.0 - 1e-15,
+            200,
+            |k| 2.0 * (1.0 - ellip_e(FRAC_PI_2, k) / ellip_f(FRAC_PI_2, k)) < delta,
+            |_, _| false,
+        );
+        let k = 0.5 * (lo + hi);
+        let sway = k / ellip_f(FRAC_PI_2, k);
+        assert!(
+            (point.measures[2].abs() - sway).abs() < 1e-8,
+            "δ = {delta}: sway {}",
+            point.measures[2]
+        );
+    }
+}
+
+/// Measures that cannot be computed for the scene are refused by name.
+#[test]
+fn measures_outside_their_scene_are_refused() {
+    const TWISTED: &str = include_str!("../../../problems/twisted_rod.toml");
+    for (text, set, says) in [
+        (TWISTED, "continuation.measures=[\"turning\"]", "planar"),
+        (
+            EULER,
+            "continuation.measures=[\"force[3]@0\"]",
+            "not a measure",
+        ),
+        (
+            EULER,
+            "continuation.measures=[\"force[2]@2\"]",
+            "not a measure",
+        ),
+        (
+            EULER,
+            "continuation.measures=[\"turning\", \"turning\"]",
+            "twice",
+        ),
+        (
+            EULER,
+            "continuation.measure=\"force[0]@0\"",
+            "unknown measure",
+        ),
+    ] {
+        let err = Problem::from_str_with(text, &[set.to_string()])
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains(says), "{set}: {err}");
+    }
+}
