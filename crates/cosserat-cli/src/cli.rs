@@ -80,7 +80,8 @@ pub enum Command {
             conflicts_with = "resume"
         )]
         from: Option<PathBuf>,
-        /// The stored point: BRANCH/POINT, e.g. 1/10 or 1/last.
+        /// The stored point: BRANCH/POINT, e.g. 1/10 or 1/last; or
+        /// special/K to switch at the stored branch point K.
         #[arg(long, value_name = "B/I", requires = "from")]
         point: Option<String>,
         /// Override any key of the problem file.

@@ -7,10 +7,10 @@ use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
 use crate::plot::{draw, read_diagram};
-use crate::stored_start::{stored_start, StoredStart};
+use crate::stored_start::{stored_start, Start, StoredStart};
 use cosserat::continuation::{
-    continuation, continuation_from, ContinuationError, ContinuationOptions, Diagram, Family,
-    Progress, RunState, SavedDiagram, StartPoint,
+    continuation, continuation_from, switch_from, ContinuationError, ContinuationOptions, Diagram,
+    Family, Progress, RunState, SavedDiagram,
 };
 use cosserat::input::{Problem, MEASURES};
 use cosserat::output::target::replace_atomically;
@@ -186,7 +186,7 @@ impl Run<'_> {
         &self,
         bar: &ProgressBar,
         saved: Option<&SavedDiagram>,
-        start: Option<&StartPoint>,
+        start: Option<&Start>,
     ) -> Result<Diagram, ContinuationError> {
         let mut last_save = Instant::now();
         let mut checkpoint_error = None;
@@ -222,7 +222,12 @@ impl Run<'_> {
             (Some(saved), _) => {
                 cosserat::continuation::resume(self.family, self.opts, saved, &mut monitor)
             }
-            (None, Some(start)) => continuation_from(self.family, self.opts, start, &mut monitor),
+            (None, Some(Start::Point(start))) => {
+                continuation_from(self.family, self.opts, start, &mut monitor)
+            }
+            (None, Some(Start::Switch { saved, special })) => {
+                switch_from(self.family, self.opts, saved, *special, &mut monitor)
+            }
             (None, None) => continuation(self.family, self.opts, &mut monitor),
         };
         bar.finish_and_clear();

@@ -15,12 +15,25 @@ use std::path::Path;
 use cosserat::continuation::{Parameter, SavedDiagram, StartPoint};
 use cosserat::output::read_saved;
 
+/// Where the new run begins.
+pub enum Start {
+    /// From a point's unknowns.
+    Point(StartPoint),
+    /// The switch at a stored branch point.
+    Switch {
+        /// The stored diagram.
+        saved: Box<SavedDiagram>,
+        /// The branch point's index.
+        special: usize,
+    },
+}
+
 /// What a stored point gives a new run.
 pub struct StoredStart {
     /// `KEY=VALUE` overrides to apply before the user's.
     pub sets: Vec<String>,
-    /// The unknowns and direction.
-    pub start: StartPoint,
+    /// The unknowns and direction, or the branch point.
+    pub start: Start,
     /// One line for the report.
     pub summary: String,
 }
@@ -60,13 +73,16 @@ fn parse_point(spec: &str, saved: &SavedDiagram) -> Result<(usize, usize), Strin
 pub fn stored_start(file: &Path, spec: &str, new_key: &str) -> Result<StoredStart, String> {
     let (text, saved) =
         read_saved(file).map_err(|e| format!("{}: not a diagram file: {e}", file.display()))?;
-    let (b, i) = parse_point(spec, &saved)?;
     let old_key = stored_key(&text).ok_or_else(|| {
         format!(
             "{}: its problem names no continuation parameter",
             file.display()
         )
     })?;
+    if let Some(k) = spec.strip_prefix("special/") {
+        return switch_start(file, k, saved, &old_key, new_key);
+    }
+    let (b, i) = parse_point(spec, &saved)?;
     let branch = &saved.branches[b];
     let value = branch.parameter[i];
     let mut sets = vec![];
@@ -89,7 +105,7 @@ pub fn stored_start(file: &Path, spec: &str, new_key: &str) -> Result<StoredStar
     let direction = same.then(|| branch.tangent[i].clone());
     Ok(StoredStart {
         sets,
-        start: StartPoint::new(branch.unknowns[i].clone(), direction),
+        start: Start::Point(StartPoint::new(branch.unknowns[i].clone(), direction)),
         summary: format!(
             "{} branch {b} point {i}: {old_key} = {value}{}",
             file.display(),
@@ -99,6 +115,47 @@ pub fn stored_start(file: &Path, spec: &str, new_key: &str) -> Result<StoredStar
                 ""
             }
         ),
+    })
+}
+
+/// `--point special/K`: the switch at stored branch point K, in the
+/// stored parameter (at its stored value: the branch point's own family).
+fn switch_start(
+    file: &Path,
+    k: &str,
+    saved: SavedDiagram,
+    old_key: &str,
+    new_key: &str,
+) -> Result<StoredStart, String> {
+    let special: usize = k
+        .trim()
+        .parse()
+        .ok()
+        .filter(|k| *k < saved.specials.len())
+        .ok_or_else(|| {
+            format!(
+                "--point special/{k}: the diagram has {} special points",
+                saved.specials.len()
+            )
+        })?;
+    if old_key != new_key {
+        return Err(format!(
+            "--point special/{special}: the branch point is one of {old_key}; switch at it in \
+             the same parameter (this problem continues {new_key})"
+        ));
+    }
+    let value = saved.specials[special].parameter;
+    Ok(StoredStart {
+        sets: vec![format!("continuation.start={value}")],
+        summary: format!(
+            "{} special point {special}: {} at {old_key} = {value}, switched",
+            file.display(),
+            saved.specials[special].kind.name()
+        ),
+        start: Start::Switch {
+            saved: Box::new(saved),
+            special,
+        },
     })
 }
 

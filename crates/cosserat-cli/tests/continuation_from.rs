@@ -138,3 +138,59 @@ fn bad_stored_points_are_refused_by_name() {
     ]);
     assert_eq!(o.status.code(), Some(2), "--from needs --point");
 }
+
+/// `--point special/K` switches at a stored branch point: the Euler
+/// column's two buckled branches again, ending at the same 170° tip angle,
+/// in a diagram that carries the stored straight branch and the point.
+#[test]
+fn a_stored_branch_point_is_switched_again() {
+    let dir = scratch("from", "special");
+    let full = dir.join("full.h5");
+    let again = dir.join("again.h5");
+    let euler = shipped("euler_column");
+    let o = run(&["continue", &euler, "-o", full.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let first = String::from_utf8_lossy(&o.stdout).into_owned();
+    let o = run(&[
+        "continue",
+        &euler,
+        "-o",
+        again.to_str().unwrap(),
+        "--from",
+        full.to_str().unwrap(),
+        "--point",
+        "special/0",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    let buckled = |text: &str| {
+        text.lines()
+            .filter(|l| l.contains("from special point 0; tip angle 170.00° reached"))
+            .map(|l| {
+                l.split(',')
+                    .next()
+                    .unwrap_or_default()
+                    .split_whitespace()
+                    .last()
+                    .unwrap_or_default()
+                    .to_string()
+            })
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(buckled(&out).len(), 2, "{out}");
+    assert_eq!(buckled(&out), buckled(&first), "the same branches: {out}");
+    for bad in ["special/9", "special/x"] {
+        let o = run(&[
+            "continue",
+            &euler,
+            "-o",
+            dir.join("bad.h5").to_str().unwrap(),
+            "--from",
+            full.to_str().unwrap(),
+            "--point",
+            bad,
+        ]);
+        assert_eq!(o.status.code(), Some(2), "{bad}");
+        assert!(stderr(&o).contains("special points"), "{}", stderr(&o));
+    }
+}

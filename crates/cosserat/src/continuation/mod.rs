@@ -42,7 +42,7 @@ pub use family::{tip_angle, Family, FamilyError, PointError};
 pub use lens::{Lens, Parameter, RodLens};
 pub use measure::{Measure, Quantity};
 pub use options::ContinuationOptions;
-pub use restart::{continuation_from, StartPoint};
+pub use restart::{continuation_from, switch_from, StartPoint};
 pub use resume::{resume, SavedBranch, SavedDiagram, SavedSpecial};
 pub use status::{BranchEnd, RunState};
 pub use tracking::{Modes, Spectrum, Tracker};

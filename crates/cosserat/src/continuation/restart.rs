@@ -5,10 +5,15 @@
 //! equilibrium of the problem as posed (to the corrector's tolerance) and
 //! the guess only chooses which one; with the stored direction of travel,
 //! a branch restarted from one of its own points goes on as the
-//! uninterrupted run did.
+//! uninterrupted run did. A stored branch point restarts the switch onto
+//! the branches that leave it ([`switch_from`]).
 
 use super::driver::follow_from;
-use super::{ContinuationError, ContinuationOptions, Diagram, Family, Point, Progress, Run};
+use super::resume::rebuild_special;
+use super::{
+    drain, Branch, ContinuationError, ContinuationOptions, Diagram, Family, Point, Progress, Run,
+    RunState, SavedDiagram, SpecialKind,
+};
 
 /// Where a continuation starts: the family's (scaled) unknowns at
 /// `ContinuationOptions::start`, and the direction of travel to keep.
@@ -85,4 +90,69 @@ impl Run<'_> {
         self.tracker.reset();
         self.point(x, p, tangent)
     }
+}
+
+/// The branches that leave branch point `special` of a stored diagram,
+/// followed as a new diagram: its branch 0 is the stored branch the point
+/// lies on (replayed from its unknowns), its special point 0 the stored
+/// one (re-measured), and the switched branches are that point's children
+/// — so the new diagram stands alone. Refused for a fold (nothing to
+/// switch onto) or a diagram another family made.
+pub fn switch_from(
+    family: &Family,
+    opts: &ContinuationOptions,
+    saved: &SavedDiagram,
+    special: usize,
+    monitor: &mut dyn FnMut(Progress, &Diagram) -> bool,
+) -> Result<Diagram, ContinuationError> {
+    let refuse = |message: String| ContinuationError::Start {
+        p: opts.start,
+        message,
+    };
+    saved
+        .check(family)
+        .map_err(|m| refuse(format!("the stored diagram does not fit this problem: {m}")))?;
+    let stored = saved.specials.get(special).ok_or_else(|| {
+        refuse(format!(
+            "the diagram has {} special points, no {special}",
+            saved.specials.len()
+        ))
+    })?;
+    if stored.kind != SpecialKind::BranchPoint {
+        return Err(refuse(format!(
+            "special point {special} is a {}: only a branch point has branches to switch onto",
+            stored.kind.name()
+        )));
+    }
+    let mut run = Run::new(family, opts);
+    let parent = &saved.branches[stored.branch];
+    let mut points = Vec::with_capacity(parent.parameter.len());
+    for ((p, x), t) in parent
+        .parameter
+        .iter()
+        .zip(&parent.unknowns)
+        .zip(&parent.tangent)
+    {
+        points.push(run.point(x.clone(), *p, t.clone())?);
+    }
+    let mut point = rebuild_special(&run, stored)?;
+    point.branch = 0;
+    let mut diagram = Diagram {
+        branches: vec![Branch {
+            points,
+            parent: None,
+            stop_reason: parent.stop_reason.clone(),
+            direction: parent.direction,
+            next_step: parent.next_step,
+        }],
+        special_points: vec![point],
+        eigenvalue_names: run.tracker.names(),
+        measure_names: opts.measures.iter().map(super::Measure::name).collect(),
+        nodes: run.tracker.nodes(),
+        stop_reason: RunState::InProgress,
+        warnings: vec![],
+    };
+    let queue = run.switches(&diagram, &[0], 0);
+    drain(&mut run, &mut diagram, queue, monitor);
+    Ok(diagram)
 }

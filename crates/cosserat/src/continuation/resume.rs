@@ -237,7 +237,10 @@ fn depth(diagram: &Diagram, mut branch: usize) -> usize {
 
 /// A saved special point measured as when it was located: with a fresh
 /// tracker, leaving the run's tracker alone.
-fn rebuild_special(run: &Run, s: &SavedSpecial) -> Result<SpecialPoint, ContinuationError> {
+pub(super) fn rebuild_special(
+    run: &Run,
+    s: &SavedSpecial,
+) -> Result<SpecialPoint, ContinuationError> {
     let mut tracker = run.tracker.clone();
     tracker.reset();
     let spectrum = tracker.measure(run.family, &s.unknowns, s.parameter)?;
