@@ -188,6 +188,16 @@ impl Family {
         self.level
     }
 
+    /// The same discretization of another lens (a slice of a
+    /// two-parameter family at a fixed second parameter).
+    #[must_use]
+    pub fn with_lens(&self, lens: Arc<dyn Lens>) -> Family {
+        Family {
+            lens,
+            ..self.clone()
+        }
+    }
+
     /// The parameter's key (`loads.tip_force[2]`, `support.turn.angle`).
     pub fn key(&self) -> String {
         self.lens.key()

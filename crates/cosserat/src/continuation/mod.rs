@@ -22,6 +22,7 @@
 //! location of folds and branch points, `resume` a run continued from a
 //! saved diagram.
 
+mod codim2;
 mod corrector;
 mod diagram;
 mod driver;
@@ -36,6 +37,7 @@ mod resume;
 mod status;
 mod tracking;
 
+pub use codim2::{follow_singular, CurveOptions, CurvePoint, Lens2, ParameterOn, SingularCurve};
 pub use diagram::{Branch, ContinuationError, Diagram, Point, Progress, SpecialKind, SpecialPoint};
 pub use driver::continuation;
 pub use family::{tip_angle, Family, FamilyError, PointError};

@@ -1,0 +1,482 @@
+//! Two-parameter continuation of a singular point (codimension 2): the
+//! curve of folds or branch points of a family in a second parameter —
+//! the critical load as a function of a stiffness, the fold of a
+//! snap-through as a function of the rise.
+//!
+//! The curve is followed by pseudo-arclength on Govaerts' minimally
+//! augmented system (Govaerts, *Numerical Methods for Bifurcations of
+//! Dynamical Equilibria*, SIAM 2000, Sec. 4.3; BifurcationKit's
+//! `FoldProblemMinimallyAugmented`): unknowns z = (x, p₁, p₂),
+//!
+//!   F(x, p₁, p₂) = 0,   g(x, p₁, p₂) = 0,   [F_x b; cᵀ 0] [v; g] = [0; 1],
+//!
+//! where b, c approximate the left and right null vectors of F_x (updated
+//! after every point). g vanishes exactly where F_x is singular, and is a
+//! regular equation there while the kernel is simple, so the singular
+//! point is located to the corrector's tolerance at every point of the
+//! curve. F_x is exact; F_p₁, F_p₂ and the gradient of g are difference
+//! quotients, which only steer Newton (the residual, and so the points,
+//! are exact). A cusp of the curve — where the singular point changes
+//! kind, e.g. two folds merge — is where the curve's projection on the
+//! (p₁, p₂) plane turns back; it is reported between the two points whose
+//! projected tangents point against each other.
+
+use std::sync::Arc;
+
+use nalgebra::{DMatrix, DVector};
+
+use super::{ContinuationError, Family, FamilyError, Lens, PointError};
+use crate::model::Rod;
+
+/// Two numbers of a rod problem, varied together.
+pub trait Lens2: std::fmt::Debug + Send + Sync {
+    /// The keys of the first and the second number.
+    fn keys(&self) -> [String; 2];
+    /// The rod with the numbers set to p.
+    fn rod_at(&self, p: [f64; 2]) -> Result<Rod, FamilyError>;
+}
+
+/// The first parameter of a [`Lens2`] at a fixed second one.
+#[derive(Debug)]
+struct Slice {
+    pair: Arc<dyn Lens2>,
+    second: f64,
+}
+
+impl Lens for Slice {
+    fn key(&self) -> String {
+        self.pair.keys()[0].clone()
+    }
+
+    fn rod_at(&self, p: f64) -> Result<Rod, FamilyError> {
+        self.pair.rod_at([p, self.second])
+    }
+}
+
+/// How the curve is followed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CurveOptions {
+    /// [min, max] of each parameter: the curve ends where it leaves them.
+    pub bounds: [(f64, f64); 2],
+    /// First arclength step, in (x, p₁, p₂).
+    pub step: f64,
+    /// Smallest step before the curve ends.
+    pub min_step: f64,
+    /// Largest step.
+    pub max_step: f64,
+    /// Points per direction at most.
+    pub max_points: usize,
+    /// Newton tolerance on the scaled residual (F, g).
+    pub tolerance: f64,
+}
+
+impl Default for CurveOptions {
+    fn default() -> Self {
+        CurveOptions {
+            bounds: [(f64::NEG_INFINITY, f64::INFINITY); 2],
+            step: 0.05,
+            min_step: 1e-7,
+            max_step: 0.2,
+            max_points: 200,
+            tolerance: 1e-10,
+        }
+    }
+}
+
+/// One point of the curve.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CurvePoint {
+    /// (p₁, p₂).
+    pub parameters: [f64; 2],
+    /// The family's unknowns x.
+    pub unknowns: Vec<f64>,
+    /// The unit tangent of the curve in (x, p₁, p₂).
+    pub tangent: Vec<f64>,
+    /// The null vector v of F_x (unit).
+    pub null_vector: Vec<f64>,
+    /// |g| at the point (zero to the tolerance).
+    pub singularity: f64,
+}
+
+/// A followed curve of singular points.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SingularCurve {
+    /// The two keys.
+    pub keys: [String; 2],
+    /// The points, from one end to the other.
+    pub points: Vec<CurvePoint>,
+    /// Cusps: each lies between point i and i + 1.
+    pub cusps: Vec<usize>,
+    /// Why each end stopped (the first end, then the second).
+    pub ends: [String; 2],
+}
+
+/// The minimally augmented system of one family.
+struct Augmented<'a> {
+    family: &'a Family,
+    pair: Arc<dyn Lens2>,
+    n: usize,
+    /// A branch point: F + ψ b = 0 with the unknown ψ and the phase
+    /// cᵀ(x − x_anchor) = 0, because at a symmetry-breaking branch point
+    /// F_p lies in the range of F_x (on the symmetric branch F_p = 0) and
+    /// the fold system is singular there (Govaerts 2000, Sec. 4.4). A fold
+    /// uses F = 0.
+    branch: bool,
+}
+
+/// F, F_x at z.
+type Evaluated = (DVector<f64>, DMatrix<f64>);
+
+/// A corrected point: z, the Jacobian there, Newton iterations.
+type Corrected = (Vec<f64>, DMatrix<f64>, usize);
+
+impl Augmented<'_> {
+    fn slice(&self, second: f64) -> Family {
+        self.family.with_lens(Arc::new(Slice {
+            pair: Arc::clone(&self.pair),
+            second,
+        }))
+    }
+
+    fn evaluate(&self, z: &[f64]) -> Result<Evaluated, PointError> {
+        let n = self.n;
+        let (mut r, mut fx) = (DVector::zeros(n), DMatrix::zeros(n, n));
+        self.slice(z[n + 1])
+            .residual(&z[..n], z[n], &mut r, &mut fx)?;
+        Ok((r, fx))
+    }
+
+    /// g and v of the bordered system at F_x (None where it is singular:
+    /// a kernel of dimension two, or borders orthogonal to it).
+    fn singularity(
+        fx: &DMatrix<f64>,
+        b: &DVector<f64>,
+        c: &DVector<f64>,
+    ) -> Option<(f64, DVector<f64>)> {
+        let n = fx.nrows();
+        let mut m = DMatrix::zeros(n + 1, n + 1);
+        m.view_mut((0, 0), (n, n)).copy_from(fx);
+        m.view_mut((0, n), (n, 1)).copy_from(b);
+        m.view_mut((n, 0), (1, n)).copy_from(&c.transpose());
+        let mut rhs = DVector::zeros(n + 1);
+        rhs[n] = 1.0;
+        let sol = m
+            .lu()
+            .solve(&rhs)
+            .filter(|s| s.iter().all(|v| v.is_finite()))?;
+        Some((sol[n], sol.rows(0, n).into_owned()))
+    }
+
+    /// Unknowns: x, p₁, p₂ and, at a branch point, ψ.
+    fn unknowns(&self) -> usize {
+        self.n + 2 + usize::from(self.branch)
+    }
+
+    /// The residual (F [+ ψ b], [phase,] g) and its Jacobian in z
+    /// ((m − 1) × m, m = [`Self::unknowns`]); `anchor` is the x the phase
+    /// is measured from.
+    fn system(
+        &self,
+        z: &[f64],
+        b: &DVector<f64>,
+        c: &DVector<f64>,
+        anchor: &[f64],
+    ) -> Result<(DVector<f64>, DMatrix<f64>), PointError> {
+        let n = self.n;
+        let m = self.unknowns();
+        let singular = || PointError::SingularTangent(z[n]);
+        let (mut f, fx) = self.evaluate(z)?;
+        let (g, _) = Self::singularity(&fx, b, c).ok_or_else(singular)?;
+        let mut jac = DMatrix::zeros(m - 1, m);
+        jac.view_mut((0, 0), (n, n)).copy_from(&fx);
+        let fp1 = self.slice(z[n + 1]).parameter_derivative(&z[..n], z[n])?;
+        jac.view_mut((0, n), (n, 1)).copy_from(&fp1);
+        let h2 = 1e-6 * z[n + 1].abs().max(1.0);
+        let (mut up, mut down) = (DVector::zeros(n), DVector::zeros(n));
+        self.slice(z[n + 1] + h2)
+            .residual_only(&z[..n], z[n], &mut up)?;
+        self.slice(z[n + 1] - h2)
+            .residual_only(&z[..n], z[n], &mut down)?;
+        jac.view_mut((0, n + 1), (n, 1))
+            .copy_from(&((up - down) / (2.0 * h2)));
+        let mut r = DVector::zeros(m - 1);
+        if self.branch {
+            f += b * z[n + 2];
+            jac.view_mut((0, n + 2), (n, 1)).copy_from(b);
+            jac.view_mut((n, 0), (1, n)).copy_from(&c.transpose());
+            r[n] = c
+                .iter()
+                .zip(&z[..n])
+                .zip(anchor)
+                .map(|((c, x), a)| c * (x - a))
+                .sum();
+        }
+        let row = m - 2;
+        for j in 0..n + 2 {
+            let eps = 1e-7 * z[j].abs().max(1.0);
+            let mut zj = z.to_vec();
+            zj[j] += eps;
+            let (_, fxj) = self.evaluate(&zj)?;
+            let (gj, _) = Self::singularity(&fxj, b, c).ok_or_else(singular)?;
+            jac[(row, j)] = (gj - g) / eps;
+        }
+        r.rows_mut(0, n).copy_from(&f);
+        r[row] = g;
+        Ok((r, jac))
+    }
+
+    /// The left and right null vectors of F_x (smallest singular vectors).
+    fn null_vectors(fx: &DMatrix<f64>) -> (DVector<f64>, DVector<f64>) {
+        let svd = fx.clone().svd(true, true);
+        let k = svd.singular_values.imin();
+        let u = svd.u.expect("asked for U").column(k).into_owned();
+        let v = svd
+            .v_t
+            .expect("asked for Vᵀ")
+            .row(k)
+            .transpose()
+            .into_owned();
+        (u, v)
+    }
+
+    /// Newton on (F, g) = 0 and ⟨z − z_pred, τ⟩ = 0 from z_pred.
+    fn correct(
+        &self,
+        pred: &[f64],
+        tau: &[f64],
+        borders: (&DVector<f64>, &DVector<f64>),
+        anchor: &[f64],
+        tolerance: f64,
+    ) -> Result<Option<Corrected>, PointError> {
+        let m = self.unknowns();
+        let mut z = pred.to_vec();
+        for iteration in 1..=10 {
+            let (r, jac) = self.system(&z, borders.0, borders.1, anchor)?;
+            let mut a = DMatrix::zeros(m, m);
+            a.view_mut((0, 0), (m - 1, m)).copy_from(&jac);
+            for (j, t) in tau.iter().enumerate() {
+                a[(m - 1, j)] = *t;
+            }
+            let mut rhs = DVector::zeros(m);
+            rhs.rows_mut(0, m - 1).copy_from(&r);
+            rhs[m - 1] = z
+                .iter()
+                .zip(pred)
+                .zip(tau)
+                .map(|((a, b), t)| (a - b) * t)
+                .sum();
+            let Some(dz) = a
+                .lu()
+                .solve(&rhs)
+                .filter(|d| d.iter().all(|v| v.is_finite()))
+            else {
+                return Ok(None);
+            };
+            for (zi, d) in z.iter_mut().zip(dz.iter()) {
+                *zi -= d;
+            }
+            let size = z.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+            if Self::converged(&r, &jac, tolerance) && dz.amax() <= 100.0 * tolerance * size {
+                let (r, jac) = self.system(&z, borders.0, borders.1, anchor)?;
+                if Self::converged(&r, &jac, tolerance) {
+                    return Ok(Some((z, jac, iteration)));
+                }
+            }
+        }
+        Ok(None)
+    }
+
+    /// F within the tolerance (scaled residual, as every Newton here) and
+    /// the point within the tolerance of the singular set: |g| over the
+    /// length of its gradient, a distance in z — g itself has the scale of
+    /// F_x's smallest singular value, which says nothing of how far the
+    /// point is.
+    fn converged(r: &DVector<f64>, jac: &DMatrix<f64>, tolerance: f64) -> bool {
+        let row = r.len() - 1;
+        let gradient = jac.row(row).norm();
+        r.rows(0, row).amax() <= tolerance && r[row].abs() <= tolerance * gradient
+    }
+
+    /// The unit null vector of the (n + 1) × (n + 2) Jacobian, oriented
+    /// along `previous`.
+    fn tangent(jac: &DMatrix<f64>, previous: &[f64]) -> Option<Vec<f64>> {
+        let m = jac.ncols();
+        let mut a = DMatrix::zeros(m, m);
+        a.view_mut((0, 0), (m - 1, m)).copy_from(jac);
+        for (j, t) in previous.iter().enumerate() {
+            a[(m - 1, j)] = *t;
+        }
+        let mut rhs = DVector::zeros(m);
+        rhs[m - 1] = 1.0;
+        let t = a
+            .lu()
+            .solve(&rhs)
+            .filter(|t| t.iter().all(|v| v.is_finite()) && t.norm() > 0.0)?;
+        Some(t.normalize().as_slice().to_vec())
+    }
+}
+
+/// Follows the singular point of `family` at (x, p₁) with the second
+/// parameter at `second`, in both parameters of `pair` (its first
+/// parameter is the family's own), both ways from the start. The start
+/// must be a singular point with a simple kernel: a point of a diagram's
+/// fold or branch point located by det F_x.
+pub fn follow_singular(
+    family: &Family,
+    pair: &Arc<dyn Lens2>,
+    kind: super::SpecialKind,
+    x: &[f64],
+    p: [f64; 2],
+    opts: &CurveOptions,
+) -> Result<SingularCurve, ContinuationError> {
+    let n = family.size();
+    let start_err = |message: String| ContinuationError::Start { p: p[0], message };
+    if x.len() != n {
+        return Err(start_err(format!(
+            "the point has {} unknowns, the family {n}",
+            x.len()
+        )));
+    }
+    let aug = Augmented {
+        family,
+        pair: Arc::clone(pair),
+        n,
+        branch: kind == super::SpecialKind::BranchPoint,
+    };
+    let m = aug.unknowns();
+    let mut z0 = x.to_vec();
+    z0.extend_from_slice(&p);
+    z0.resize(m, 0.0);
+    let (_, fx) = aug.evaluate(&z0)?;
+    let (b, c) = Augmented::null_vectors(&fx);
+    // Land on the curve at the given p₂ (the constraint row fixes p₂).
+    let mut fix = vec![0.0; m];
+    fix[n + 1] = 1.0;
+    let (z, jac, _) = aug
+        .correct(&z0, &fix, (&b, &c), x, opts.tolerance)?
+        .ok_or_else(|| {
+            start_err("no singular point near the given one at this second parameter".into())
+        })?;
+    let tau = Augmented::tangent(&jac, &fix)
+        .ok_or_else(|| start_err("the curve has no tangent at the start".into()))?;
+    let first = curve_point(&aug, &z, tau, &b, &c)?;
+    let mut halves = vec![];
+    let mut ends = [String::new(), String::new()];
+    for (side, sign) in [1.0, -1.0].into_iter().enumerate() {
+        let (points, end) = walk(&aug, &first, sign, opts)?;
+        halves.push(points);
+        ends[side] = end;
+    }
+    let mut points: Vec<CurvePoint> = halves[1].iter().rev().cloned().collect();
+    points.push(first);
+    points.extend(halves[0].iter().cloned());
+    let cusps = (0..points.len().saturating_sub(1))
+        .filter(|&i| projected(&points[i], n).dot(&projected(&points[i + 1], n)) < 0.0)
+        .collect();
+    Ok(SingularCurve {
+        keys: pair.keys(),
+        points,
+        cusps,
+        ends: [ends[1].clone(), ends[0].clone()],
+    })
+}
+
+/// The curve's tangent projected on (p₁, p₂), oriented along the stored
+/// order of the points.
+fn projected(point: &CurvePoint, n: usize) -> nalgebra::Vector2<f64> {
+    nalgebra::Vector2::new(point.tangent[n], point.tangent[n + 1])
+}
+
+fn curve_point(
+    aug: &Augmented,
+    z: &[f64],
+    tangent: Vec<f64>,
+    b: &DVector<f64>,
+    c: &DVector<f64>,
+) -> Result<CurvePoint, PointError> {
+    let n = aug.n;
+    let (_, fx) = aug.evaluate(z)?;
+    let (g, v) = Augmented::singularity(&fx, b, c).ok_or(PointError::SingularTangent(z[n]))?;
+    Ok(CurvePoint {
+        parameters: [z[n], z[n + 1]],
+        unknowns: z[..n].to_vec(),
+        tangent,
+        null_vector: v.normalize().as_slice().to_vec(),
+        singularity: g.abs(),
+    })
+}
+
+/// Steps from `first` along sign·τ until a bound, the point budget or a
+/// step too small; the points in order of travel (tangents oriented along
+/// the whole curve's order) and why it stopped.
+fn walk(
+    aug: &Augmented,
+    first: &CurvePoint,
+    sign: f64,
+    opts: &CurveOptions,
+) -> Result<(Vec<CurvePoint>, String), ContinuationError> {
+    let n = aug.n;
+    let mut points: Vec<CurvePoint> = vec![];
+    let mut ds = opts.step;
+    loop {
+        let last = points.last().unwrap_or(first);
+        let [p1, p2] = last.parameters;
+        let inside = |v: f64, (lo, hi): (f64, f64)| (lo..=hi).contains(&v);
+        let within = inside(p1, opts.bounds[0]) && inside(p2, opts.bounds[1]);
+        if !points.is_empty() && !within {
+            return Ok((points, "left the bounds".into()));
+        }
+        if points.len() >= opts.max_points {
+            return Ok((points, format!("{} points", opts.max_points)));
+        }
+        let tau: Vec<f64> = last.tangent.iter().map(|t| t * sign).collect();
+        let mut z: Vec<f64> = last.unknowns.clone();
+        z.extend_from_slice(&last.parameters);
+        z.resize(aug.unknowns(), 0.0);
+        let pred: Vec<f64> = z.iter().zip(&tau).map(|(a, t)| a + ds * t).collect();
+        // Borders: the last point's null vectors (right v; left from Fᵀ).
+        let (_, fx) = aug.evaluate(&z)?;
+        let (b, c) = Augmented::null_vectors(&fx);
+        if let Some((z, jac, iterations)) =
+            aug.correct(&pred, &tau, (&b, &c), &last.unknowns, opts.tolerance)?
+        {
+            let t = Augmented::tangent(&jac, &tau).ok_or(PointError::SingularTangent(z[n]))?;
+            let stored: Vec<f64> = t.iter().map(|v| v * sign).collect();
+            points.push(curve_point(aug, &z, stored, &b, &c)?);
+            if iterations <= 3 {
+                ds = (ds * 1.5).min(opts.max_step);
+            }
+        } else {
+            ds *= 0.5;
+            if ds < opts.min_step {
+                return Ok((points, format!("step size below {:e}", opts.min_step)));
+            }
+        }
+    }
+}
+
+/// A library [`Parameter`](super::Parameter) of the rod another lens
+/// gives: p₂ sets the second lens's number, p₁ the parameter on that rod.
+#[derive(Debug)]
+pub struct ParameterOn {
+    first: super::Parameter,
+    second: Arc<dyn Lens>,
+}
+
+impl ParameterOn {
+    /// `first` on the rods of `second`.
+    pub fn new(first: super::Parameter, second: Arc<dyn Lens>) -> Self {
+        ParameterOn { first, second }
+    }
+}
+
+impl Lens2 for ParameterOn {
+    fn keys(&self) -> [String; 2] {
+        [self.first.to_string(), self.second.key()]
+    }
+
+    fn rod_at(&self, p: [f64; 2]) -> Result<Rod, FamilyError> {
+        let rod = self.second.rod_at(p[1])?;
+        super::RodLens::new(rod, self.first).rod_at(p[0])
+    }
+}
