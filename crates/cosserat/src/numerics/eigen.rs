@@ -552,6 +552,64 @@ mod tests {
         (k, g)
     }
 
+    /// Two copies of [`laplacian`], their unknowns interleaved (bandwidth
+    /// 2): every eigenvalue is double, λ_k = (4/h²) sin²((2k − 1)π/(4n))
+    /// for u_i = sin(θ i), θ = (2k − 1)π/(2n) (the half mass at the free end
+    /// makes u symmetric about i = n).
+    fn doubled_laplacian(n: usize) -> (SymmetricBanded, SymmetricBanded, Vec<f64>) {
+        let (k1, g1) = laplacian(n);
+        let (mut k, mut g) = (
+            SymmetricBanded::zeros(2 * n, 2),
+            SymmetricBanded::zeros(2 * n, 2),
+        );
+        for i in 0..n {
+            for c in 0..2 {
+                k.add(2 * i + c, 2 * i + c, k1.get(i, i));
+                g.add(2 * i + c, 2 * i + c, g1.get(i, i));
+                if i > 0 {
+                    k.add(2 * i + c, 2 * (i - 1) + c, k1.get(i, i - 1));
+                }
+            }
+        }
+        let h = 1.0 / n as f64;
+        let exact = (1..=3)
+            .map(|j| {
+                let theta = (2 * j - 1) as f64 * std::f64::consts::PI / (4 * n) as f64;
+                4.0 / (h * h) * theta.sin().powi(2)
+            })
+            .collect();
+        (k, g, exact)
+    }
+
+    /// A double eigenvalue: single-vector Lanczos sees one copy of it (the
+    /// Krylov space of one start vector holds one vector of each
+    /// eigenspace), so the lowest four must come with both copies, found
+    /// by deflation and checked by the Sturm count, or an error.
+    #[test]
+    fn lanczos_finds_both_copies_of_a_double_eigenvalue() {
+        let (k, g, exact) = doubled_laplacian(150);
+        let want = [exact[0], exact[0], exact[1], exact[1], exact[2]];
+        for count in 1..=5 {
+            let pairs = lowest_eigenpairs(&k, &g, count).unwrap();
+            for (a, b) in pairs.values.iter().zip(&want) {
+                assert!(
+                    (a - b).abs() <= 1e-9 * b,
+                    "{count}: {:?} vs {want:?}",
+                    pairs.values
+                );
+            }
+        }
+        let pairs = lowest_eigenpairs(&k, &g, 5).unwrap();
+        for (i, u) in pairs.vectors.iter().enumerate() {
+            for (j, v) in pairs.vectors.iter().enumerate() {
+                let (mut gv, delta) = (vec![0.0; v.len()], f64::from(u8::from(i == j)));
+                g.matvec(v, &mut gv);
+                let dot: f64 = u.iter().zip(&gv).map(|(a, b)| a * b).sum();
+                assert!((dot - delta).abs() < 1e-8, "G-orthonormal: {i} {j} {dot}");
+            }
+        }
+    }
+
     #[test]
     fn lanczos_matches_dense_on_a_large_pencil() {
         let (k, g) = laplacian(400);
