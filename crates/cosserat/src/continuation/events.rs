@@ -69,9 +69,9 @@ impl Run<'_> {
         let (wanted, mut missed) = self.detect(a, b, branch, index);
         let mut found = vec![];
         for (kind, block, multiplicity) in wanted {
-            match self.locate(a, b, sign, (branch, index), (kind, block, multiplicity)) {
-                Some(sp) => found.push(sp),
-                None => missed.push(format!(
+            let located = self.locate(a, b, sign, (branch, index), (kind, block, multiplicity));
+            match located.len() {
+                0 => missed.push(format!(
                     "branch {branch}: a {} ({} block, Morse index {} → {}, multiplicity \
                      {multiplicity}) between points {index} and {} at parameter {:.10} … {:.10} \
                      could not be located",
@@ -83,6 +83,7 @@ impl Run<'_> {
                     a.parameter,
                     b.parameter
                 )),
+                _ => found.extend(located),
             }
         }
         (found, missed)
@@ -244,7 +245,9 @@ impl Run<'_> {
     }
 
     /// Locates the event between `a` and `b` by the Illinois method on the
-    /// arclength σ ∈ (0, σ_b), σ_b = τ_aᵀ(z_b − z_a).
+    /// arclength σ ∈ (0, σ_b), σ_b = τ_aᵀ(z_b − z_a): one special point,
+    /// or two or more simple ones where eigenvalues crossing within one
+    /// step did so at distinct parameters, or none (not located).
     fn locate(
         &mut self,
         a: &Point,
@@ -252,17 +255,8 @@ impl Run<'_> {
         sign: f64,
         (branch, index): (usize, usize),
         (kind, block, multiplicity): Wanted,
-    ) -> Option<SpecialPoint> {
-        let t: Vec<f64> = a.tangent.iter().map(|v| v * sign).collect();
-        let mut za = a.unknowns.clone();
-        za.push(a.parameter);
-        let mut zb = b.unknowns.clone();
-        zb.push(b.parameter);
-        let span: f64 = t
-            .iter()
-            .zip(zb.iter().zip(&za))
-            .map(|(t, (y, x))| t * (y - x))
-            .sum();
+    ) -> Vec<SpecialPoint> {
+        let span = span_of(a, b, sign);
         let test = match kind {
             SpecialKind::Fold => Test::Fold,
             SpecialKind::BranchPoint if !self.representable(block) => Test::Eigenvalue(block),
@@ -271,7 +265,14 @@ impl Run<'_> {
                 .bordered_test(a, b, multiplicity)
                 .unwrap_or(Test::Eigenvalue(block)),
         };
-        let best = self.root(a, (sign, b.parameter), span, &test)?;
+        let Some((sigma, best)) = self.root(a, (sign, b.parameter), (0.0, span), &test) else {
+            return vec![];
+        };
+        if let Test::Bordered { right, left, .. } = &test {
+            if !self.degenerate(a, b, &best, right, left) {
+                return self.separate(a, b, sign, (sigma, best), (branch, index), block);
+            }
+        }
         self.special_point(
             a,
             b,
@@ -280,18 +281,90 @@ impl Run<'_> {
             (branch, index),
             (kind, block, multiplicity),
         )
+        .into_iter()
+        .collect()
     }
 
-    /// The root of the test function on σ ∈ (0, span) by Illinois, to the
-    /// event tolerance on the parameter.
-    fn root(&self, a: &Point, (sign, p_b): (f64, f64), span: f64, test: &Test) -> Option<Located> {
-        let f_lo = self.test_at(a, sign, 1e-12 * span, test)?.0;
-        let f_hi = self.test_at(a, sign, span, test)?.0;
-        let mut bracket = Illinois::new(0.0, span, f_lo, f_hi)?;
-        let mut best = self.test_at(a, sign, 0.5 * span, test)?;
+    /// Whether the whole of G vanishes at the located point (relative to
+    /// its change over the step): the kernel of F_x there has the full
+    /// dimension m, not one crossing of several at distinct parameters.
+    fn degenerate(
+        &self,
+        a: &Point,
+        b: &Point,
+        best: &Located,
+        right: &DMatrix<f64>,
+        left: &DMatrix<f64>,
+    ) -> bool {
+        let g = |x: &[f64], p: f64| self.bordered(x, p, right, left);
+        match (
+            g(&a.unknowns, a.parameter),
+            g(&b.unknowns, b.parameter),
+            g(&best.1, best.2),
+        ) {
+            (Some(ga), Some(gb), Some(here)) => here.amax() <= 1e-6 * (gb - ga).amax(),
+            _ => false,
+        }
+    }
+
+    /// Several simple crossings within one step: the located root of one
+    /// entry of G splits the step at σ*, and each part whose Morse index
+    /// changes by one holds a simple branch point, located on det F_x.
+    fn separate(
+        &self,
+        a: &Point,
+        b: &Point,
+        sign: f64,
+        (sigma, best): (f64, Located),
+        at: (usize, usize),
+        block: Block,
+    ) -> Vec<SpecialPoint> {
+        let bi = self.tracker.blocks().iter().position(|&x| x == block);
+        let morse = |x: &[f64], p: f64| -> Option<usize> {
+            let s = self.tracker.evaluate(self.family, x, p).ok()?;
+            Some(s.block_morse[bi?])
+        };
+        let (Some(lo), Some(mid), Some(hi)) = (
+            morse(&a.unknowns, a.parameter),
+            morse(&best.1, best.2),
+            morse(&b.unknowns, b.parameter),
+        ) else {
+            return vec![];
+        };
+        let span = (sigma, span_of(a, b, sign));
+        let mut found = vec![];
+        for (range, jump) in [((0.0, span.0), lo.abs_diff(mid)), (span, mid.abs_diff(hi))] {
+            if jump != 1 {
+                continue;
+            }
+            let Some((_, root)) = self.root(a, (sign, b.parameter), range, &Test::Determinant)
+            else {
+                continue;
+            };
+            let wanted = (SpecialKind::BranchPoint, block, 1);
+            found.extend(self.special_point(a, b, sign, root, at, wanted));
+        }
+        found
+    }
+
+    /// The root σ of the test function on σ ∈ (lo, hi) by Illinois, to
+    /// the event tolerance on the parameter, and the point there.
+    fn root(
+        &self,
+        a: &Point,
+        (sign, p_b): (f64, f64),
+        (lo, hi): (f64, f64),
+        test: &Test,
+    ) -> Option<(f64, Located)> {
+        let span = hi - lo;
+        let f_lo = self.test_at(a, sign, lo + 1e-12 * span, test)?.0;
+        let f_hi = self.test_at(a, sign, hi, test)?.0;
+        let mut bracket = Illinois::new(lo, hi, f_lo, f_hi)?;
+        let mut sigma = 0.5 * (lo + hi);
+        let mut best = self.test_at(a, sign, sigma, test)?;
         let (mut p_lo, mut p_hi) = (a.parameter, p_b);
         for _ in 0..80 {
-            let sigma = bracket.next_point();
+            sigma = bracket.next_point();
             best = self.test_at(a, sign, sigma, test)?;
             match bracket.update(sigma, best.0) {
                 End::Lower => p_lo = best.2,
@@ -305,7 +378,7 @@ impl Run<'_> {
                 break;
             }
         }
-        Some(best)
+        Some((sigma, best))
     }
 
     /// The special point at the located `best`: its spectrum, null mode
@@ -437,10 +510,28 @@ impl Run<'_> {
     }
 }
 
+/// The arclength σ_b = τ_aᵀ(z_b − z_a) from `a` to `b` along a's tangent
+/// (times the direction of travel).
+fn span_of(a: &Point, b: &Point, sign: f64) -> f64 {
+    let n = a.unknowns.len();
+    (0..=n)
+        .map(|i| {
+            let (za, zb) = if i < n {
+                (a.unknowns[i], b.unknowns[i])
+            } else {
+                (a.parameter, b.parameter)
+            };
+            sign * a.tangent[i] * (zb - za)
+        })
+        .sum()
+}
+
 /// Out-of-plane modes of a planar branch, and bending modes of a straight
 /// one, break a symmetry of the branch.
 fn symmetry_breaking(block: Block, point: &Point, mode: &[nalgebra::Vector3<f64>]) -> bool {
-    let straight = point.norm < 1e-8;
+    // Straight: no curvature, or a twisted rod whose centreline is a line
+    // (Greenhill's shaft carries its twist κ3 ≠ 0 before it buckles).
+    let straight = point.norm < 1e-8 || collinear(&point.shape);
     let out_of_plane = mode.iter().map(|w| w[0].abs() + w[2].abs()).sum::<f64>();
     let in_plane = mode.iter().map(|w| w[1].abs()).sum::<f64>();
     match block {
@@ -448,4 +539,18 @@ fn symmetry_breaking(block: Block, point: &Point, mode: &[nalgebra::Vector3<f64>
         Block::InPlane => straight,
         Block::Full => out_of_plane > in_plane || straight,
     }
+}
+
+/// Whether the points lie on the line through the first and the last, to
+/// 1e-8 of its length.
+fn collinear(points: &[nalgebra::Vector3<f64>]) -> bool {
+    let (Some(first), Some(last)) = (points.first(), points.last()) else {
+        return false;
+    };
+    let chord = last - first;
+    let length = chord.norm();
+    length > 0.0
+        && points
+            .iter()
+            .all(|q| (q - first).cross(&chord).norm() <= 1e-8 * length * length)
 }
