@@ -697,7 +697,7 @@ mod tests {
         let h = 1.0 / n as f64;
         let exact = (1..=3)
             .map(|j| {
-                let theta = (2 * j - 1) as f64 * std::f64::consts::PI / (4 * n) as f64;
+                let theta = f64::from(2 * j - 1) * std::f64::consts::PI / (4 * n) as f64;
                 4.0 / (h * h) * theta.sin().powi(2)
             })
             .collect();
