@@ -4,7 +4,8 @@
 //! thrust of the characteristic determinant for clamped ends (Greenhill
 //! 1883; Ziegler 1968, Sec. 2.7: `references::greenhill_clamped`); the
 //! summary prints the multiplicity, the diagram file records it, and the
-//! resume reader reads it back.
+//! resume reader reads it back (and reads a file without it, as older
+//! versions wrote, as simple points).
 mod common;
 
 use common::problems::shipped;
@@ -60,4 +61,21 @@ fn greenhill_diagram_reports_a_double_branch_point() {
     assert_eq!(saved.specials[0].multiplicity, 2);
     // Two kernel directions, both ways: four switched branches.
     assert_eq!(saved.branches.len(), 5);
+    older_files_read_as_simple(&out);
+}
+
+/// A diagram written before the multiplicity was recorded (the dataset
+/// removed, the file sealed again) still reads, its points simple.
+fn older_files_read_as_simple(path: &std::path::Path) {
+    let len = std::fs::metadata(path).unwrap().len();
+    let file = std::fs::OpenOptions::new().write(true).open(path).unwrap();
+    file.set_len(len - 24).unwrap();
+    drop(file);
+    let f = hdf5::File::open_rw(path).unwrap();
+    f.unlink("special_points/multiplicity").unwrap();
+    drop(f);
+    cosserat::output::seal::seal(path).unwrap();
+    let (_, saved) = read_saved(path).unwrap();
+    assert_eq!(saved.specials.len(), 1);
+    assert_eq!(saved.specials[0].multiplicity, 1);
 }
