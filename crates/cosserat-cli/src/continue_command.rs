@@ -320,7 +320,8 @@ fn report(d: &Diagram) {
     }
     for (i, s) in d.special_points.iter().enumerate() {
         println!(
-            "special {i}  {} on branch {} at parameter {:.12}, {} block{}, Morse index {}",
+            "special {i}  {} on branch {} at parameter {:.12}, {} block{}, Morse index {}, \
+             multiplicity {}",
             s.kind.name(),
             s.branch,
             s.point.parameter,
@@ -330,7 +331,8 @@ fn report(d: &Diagram) {
             } else {
                 ""
             },
-            s.point.morse_index
+            s.point.morse_index,
+            s.multiplicity
         );
     }
 }

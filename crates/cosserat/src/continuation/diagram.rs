@@ -77,6 +77,12 @@ pub struct SpecialPoint {
     /// The located singularity: |det F_x| relative to its scale on the
     /// neighbouring points, and the eigenvalue of the block there.
     pub singularity: (f64, f64),
+    /// How many eigenvalues of the second variation cross zero here: the
+    /// change of the block's Morse index across the point (1 for a simple
+    /// fold or branch point; 2 where a pair crosses together, as for the
+    /// bending modes of an isotropic rod, B1 = B2, whose kernel is a
+    /// plane).
+    pub multiplicity: usize,
 }
 
 /// A followed branch.

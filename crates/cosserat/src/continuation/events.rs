@@ -1,6 +1,27 @@
 //! Folds and branch points between two points of a branch: detection,
-//! location by regula falsi (Illinois) in the arclength, classification,
-//! and branch switching.
+//! location by regula falsi (Illinois) in the arclength on a test function
+//! with a simple root, classification, and branch switching.
+//!
+//! A fold is decided by the tangent's parameter component τ_p changing
+//! sign, always, whatever the eigenvalues do; a branch point by a change
+//! of a block's Morse index that no fold explains, its multiplicity the
+//! size of the change. Where the BVP Jacobian sees the bifurcating mode, a
+//! branch point is located on Govaerts' minimally augmented test function
+//! (Govaerts, *Numerical Methods for Bifurcations of Dynamical Equilibria*,
+//! SIAM 2000, Sec. 3.2; the `BorderedArray` branch-point test of
+//! BifurcationKit.jl): with Φ, Ψ (n × m) the right and left singular
+//! vectors of the m smallest singular values of F_x near the point, the
+//! bordered system
+//!
+//!   [F_x Ψ; Φᵀ 0] [V; G] = [0; I_m]
+//!
+//! is regular at the singular point and G (m × m) vanishes there exactly
+//! when dim ker F_x = m. An entry of G that changes sign has a simple
+//! root, where det F_x has a root of order m (a double root for the pair
+//! of an isotropic rod, which bisection on the determinant cannot see).
+//! A simple branch point (m = 1) is located on det F_x itself, whose root
+//! is then simple; modes the model's Jacobian does not see (out of the
+//! plane of a planar model) on the block's eigenvalue nearest zero.
 
 use nalgebra::{DMatrix, DVector};
 
@@ -11,6 +32,27 @@ use crate::stability::Block;
 
 /// A test function along the step from a point: f(σ) and the point there.
 type Located = (f64, Vec<f64>, f64, Vec<f64>);
+
+/// The function whose sign change locates an event.
+enum Test {
+    /// The tangent's parameter component τ_p (folds).
+    Fold,
+    /// The entry `entry` of Govaerts' G with the borders Φ (`right`) and Ψ
+    /// (`left`), fixed for the whole location.
+    Bordered {
+        right: DMatrix<f64>,
+        left: DMatrix<f64>,
+        entry: (usize, usize),
+    },
+    /// det F_x (a simple singularity the model sees: a simple root).
+    Determinant,
+    /// The block's eigenvalue nearest zero (modes the model's Jacobian
+    /// does not see; accurate to the finite-element mesh).
+    Eigenvalue(Block),
+}
+
+/// An event to locate: its kind, block and multiplicity.
+type Wanted = (SpecialKind, Block, usize);
 
 impl Run<'_> {
     /// The special points between consecutive points `a` and `b`, and a
@@ -24,33 +66,15 @@ impl Run<'_> {
         branch: usize,
         index: usize,
     ) -> (Vec<SpecialPoint>, Vec<String>) {
-        let n = a.unknowns.len();
-        let fold = a.tangent[n] * b.tangent[n] < 0.0;
-        let spectra_a = self.block_morse(a);
-        let spectra_b = self.block_morse(b);
-        let blocks: Vec<Block> = self.tracker.blocks().to_vec();
-        let changed: Vec<(Block, usize)> = blocks
-            .iter()
-            .zip(spectra_a.iter().zip(&spectra_b))
-            .filter(|(_, (x, y))| x != y)
-            .map(|(blk, (x, y))| (*blk, x.abs_diff(*y)))
-            .collect();
-        let wanted: Vec<(SpecialKind, Block, usize)> = if fold {
-            let block = changed.first().map_or(blocks[0], |c| c.0);
-            vec![(SpecialKind::Fold, block, 1)]
-        } else {
-            changed
-                .into_iter()
-                .map(|(block, jump)| (SpecialKind::BranchPoint, block, jump))
-                .collect()
-        };
-        let (mut found, mut missed) = (vec![], vec![]);
-        for (kind, block, jump) in wanted {
-            match self.locate(a, b, sign, branch, index, kind, block, jump) {
-                Some(sp) => found.push(sp),
-                None => missed.push(format!(
-                    "branch {branch}: a {} ({} block, Morse index {} → {}) between points {index} \
-                     and {} at parameter {:.10} … {:.10} could not be located",
+        let (wanted, mut missed) = self.detect(a, b, branch, index);
+        let mut found = vec![];
+        for (kind, block, multiplicity) in wanted {
+            let located = self.locate(a, b, sign, (branch, index), (kind, block, multiplicity));
+            match located.len() {
+                0 => missed.push(format!(
+                    "branch {branch}: a {} ({} block, Morse index {} → {}, multiplicity \
+                     {multiplicity}) between points {index} and {} at parameter {:.10} … {:.10} \
+                     could not be located",
                     kind.name(),
                     block.name(),
                     a.morse_index,
@@ -59,9 +83,59 @@ impl Run<'_> {
                     a.parameter,
                     b.parameter
                 )),
+                _ => found.extend(located),
             }
         }
         (found, missed)
+    }
+
+    /// What happened between `a` and `b`: a fold where τ_p changes sign
+    /// (whatever the eigenvalues did), else a branch point in every block
+    /// whose Morse index changed, of multiplicity the change. Eigenvalues
+    /// crossing zero at a fold beyond the one the fold explains are a
+    /// note: a branch point there is not located (undecided), not dropped.
+    fn detect(
+        &mut self,
+        a: &Point,
+        b: &Point,
+        branch: usize,
+        index: usize,
+    ) -> (Vec<Wanted>, Vec<String>) {
+        let n = a.unknowns.len();
+        let fold = a.tangent[n] * b.tangent[n] < 0.0;
+        let spectra_a = self.block_morse(a);
+        let spectra_b = self.block_morse(b);
+        let changed: Vec<(Block, usize)> = self
+            .tracker
+            .blocks()
+            .iter()
+            .zip(spectra_a.iter().zip(&spectra_b))
+            .filter(|(_, (x, y))| x != y)
+            .map(|(blk, (x, y))| (*blk, x.abs_diff(*y)))
+            .collect();
+        if !fold {
+            let wanted = changed
+                .into_iter()
+                .map(|(block, jump)| (SpecialKind::BranchPoint, block, jump))
+                .collect();
+            return (wanted, vec![]);
+        }
+        let block = changed.first().map_or(self.tracker.blocks()[0], |c| c.0);
+        let total: usize = changed.iter().map(|c| c.1).sum();
+        let mut notes = vec![];
+        if total > 1 {
+            notes.push(format!(
+                "branch {branch}: at the fold between points {index} and {} (parameter \
+                 {:.10} … {:.10}) the Morse index changed by {total}: {} more eigenvalue(s) \
+                 crossed zero than the fold explains; a branch point near the fold is not \
+                 located",
+                index + 1,
+                a.parameter,
+                b.parameter,
+                total - 1
+            ));
+        }
+        (vec![(SpecialKind::Fold, block, 1)], notes)
     }
 
     fn block_morse(&mut self, p: &Point) -> Vec<usize> {
@@ -84,71 +158,214 @@ impl Run<'_> {
         )
     }
 
-    /// The test function at arclength σ from `a`: the p-component of the
-    /// tangent (folds), det F_x (simple branch points the model sees), or
-    /// the block eigenvalue nearest zero.
-    fn test_at(
-        &self,
-        a: &Point,
-        sign: f64,
-        sigma: f64,
-        kind: SpecialKind,
-        block: Block,
-        use_det: bool,
-    ) -> Option<Located> {
+    /// The test function at arclength σ from `a`, and the point there.
+    fn test_at(&self, a: &Point, sign: f64, sigma: f64, test: &Test) -> Option<Located> {
         let (x, p, tangent, _) = self.step(a, sign, sigma).ok()??;
         let n = x.len();
-        let value = match kind {
-            SpecialKind::Fold => tangent[n],
-            SpecialKind::BranchPoint if use_det => self.det(&x, p)?,
-            SpecialKind::BranchPoint => {
-                self.tracker.nearest_zero(self.family, &x, p, block).ok()?.0
+        let value = match test {
+            Test::Fold => tangent[n],
+            Test::Determinant => self.det(&x, p)?,
+            Test::Bordered { right, left, entry } => self.bordered(&x, p, right, left)?[*entry],
+            Test::Eigenvalue(block) => {
+                self.tracker
+                    .nearest_zero(self.family, &x, p, *block)
+                    .ok()?
+                    .0
             }
         };
         Some((value, x, p, tangent))
     }
 
-    fn det(&self, x: &[f64], p: f64) -> Option<f64> {
+    fn jacobian(&self, x: &[f64], p: f64) -> Option<DMatrix<f64>> {
         let n = x.len();
         let (mut r, mut j) = (DVector::zeros(n), DMatrix::zeros(n, n));
         self.family.residual(x, p, &mut r, &mut j).ok()?;
-        Some(j.determinant())
+        Some(j)
+    }
+
+    fn det(&self, x: &[f64], p: f64) -> Option<f64> {
+        Some(self.jacobian(x, p)?.determinant())
+    }
+
+    /// Govaerts' G (m × m) at (x, p): [F_x Ψ; Φᵀ 0] [V; G] = [0; I_m].
+    /// None where the bordered matrix is singular (borders that do not
+    /// complement F_x's kernel and range).
+    fn bordered(
+        &self,
+        x: &[f64],
+        p: f64,
+        right: &DMatrix<f64>,
+        left: &DMatrix<f64>,
+    ) -> Option<DMatrix<f64>> {
+        let fx = self.jacobian(x, p)?;
+        let (n, m) = (x.len(), right.ncols());
+        let mut big = DMatrix::zeros(n + m, n + m);
+        big.view_mut((0, 0), (n, n)).copy_from(&fx);
+        big.view_mut((0, n), (n, m)).copy_from(left);
+        big.view_mut((n, 0), (m, n)).copy_from(&right.transpose());
+        let mut rhs = DMatrix::zeros(n + m, m);
+        rhs.view_mut((n, 0), (m, m)).fill_with_identity();
+        let solution = big.lu().solve(&rhs)?;
+        let g = solution.rows(n, m).into_owned();
+        g.iter().all(|v| v.is_finite()).then_some(g)
+    }
+
+    /// The bordered test of multiplicity m for the step from `a` to `b`:
+    /// borders from the singular vectors of F_x at whichever end is nearer
+    /// singular (smaller σ_m/σ_{m+1}), and the entry of G that changes
+    /// sign between the ends with the largest change. None when no entry
+    /// changes sign (the singularity is not the model's: the caller falls
+    /// back on the eigenvalue).
+    fn bordered_test(&self, a: &Point, b: &Point, m: usize) -> Option<Test> {
+        let n = a.unknowns.len();
+        if m == 0 || m >= n {
+            return None;
+        }
+        let mut best: Option<(f64, DMatrix<f64>, DMatrix<f64>)> = None;
+        for end in [a, b] {
+            let svd = self.jacobian(&end.unknowns, end.parameter)?.svd(true, true);
+            let (u, v_t) = (svd.u.as_ref()?, svd.v_t.as_ref()?);
+            let mut idx: Vec<usize> = (0..n).collect();
+            idx.sort_by(|&i, &j| svd.singular_values[i].total_cmp(&svd.singular_values[j]));
+            let ratio = svd.singular_values[idx[m - 1]] / svd.singular_values[idx[m]];
+            if best.as_ref().is_none_or(|b| ratio < b.0) {
+                let right = DMatrix::from_fn(n, m, |r, c| v_t[(idx[c], r)]);
+                let left = DMatrix::from_fn(n, m, |r, c| u[(r, idx[c])]);
+                best = Some((ratio, right, left));
+            }
+        }
+        let (_, right, left) = best?;
+        let ga = self.bordered(&a.unknowns, a.parameter, &right, &left)?;
+        let gb = self.bordered(&b.unknowns, b.parameter, &right, &left)?;
+        let entry = (0..m)
+            .flat_map(|i| (0..m).map(move |j| (i, j)))
+            .filter(|&e| ga[e] * gb[e] < 0.0)
+            .max_by(|&e, &f| (gb[e] - ga[e]).abs().total_cmp(&(gb[f] - ga[f]).abs()))?;
+        Some(Test::Bordered { right, left, entry })
     }
 
     /// Locates the event between `a` and `b` by the Illinois method on the
-    /// arclength σ ∈ (0, σ_b), σ_b = τ_aᵀ(z_b − z_a).
-    #[allow(clippy::too_many_arguments)]
+    /// arclength σ ∈ (0, σ_b), σ_b = τ_aᵀ(z_b − z_a): one special point,
+    /// or two or more simple ones where eigenvalues crossing within one
+    /// step did so at distinct parameters, or none (not located).
     fn locate(
         &mut self,
         a: &Point,
         b: &Point,
         sign: f64,
-        branch: usize,
-        index: usize,
-        kind: SpecialKind,
+        (branch, index): (usize, usize),
+        (kind, block, multiplicity): Wanted,
+    ) -> Vec<SpecialPoint> {
+        let span = span_of(a, b, sign);
+        let test = match kind {
+            SpecialKind::Fold => Test::Fold,
+            SpecialKind::BranchPoint if !self.representable(block) => Test::Eigenvalue(block),
+            SpecialKind::BranchPoint if multiplicity == 1 => Test::Determinant,
+            SpecialKind::BranchPoint => self
+                .bordered_test(a, b, multiplicity)
+                .unwrap_or(Test::Eigenvalue(block)),
+        };
+        let Some((sigma, best)) = self.root(a, (sign, b.parameter), (0.0, span), &test) else {
+            return vec![];
+        };
+        if let Test::Bordered { right, left, .. } = &test {
+            if !self.degenerate(a, b, &best, right, left) {
+                return self.separate(a, b, sign, (sigma, best), (branch, index), block);
+            }
+        }
+        self.special_point(
+            a,
+            b,
+            sign,
+            best,
+            (branch, index),
+            (kind, block, multiplicity),
+        )
+        .into_iter()
+        .collect()
+    }
+
+    /// Whether the whole of G vanishes at the located point (relative to
+    /// its change over the step): the kernel of F_x there has the full
+    /// dimension m, not one crossing of several at distinct parameters.
+    fn degenerate(
+        &self,
+        a: &Point,
+        b: &Point,
+        best: &Located,
+        right: &DMatrix<f64>,
+        left: &DMatrix<f64>,
+    ) -> bool {
+        let g = |x: &[f64], p: f64| self.bordered(x, p, right, left);
+        match (
+            g(&a.unknowns, a.parameter),
+            g(&b.unknowns, b.parameter),
+            g(&best.1, best.2),
+        ) {
+            (Some(ga), Some(gb), Some(here)) => here.amax() <= 1e-6 * (gb - ga).amax(),
+            _ => false,
+        }
+    }
+
+    /// Several simple crossings within one step: the located root of one
+    /// entry of G splits the step at σ*, and each part whose Morse index
+    /// changes by one holds a simple branch point, located on det F_x.
+    fn separate(
+        &self,
+        a: &Point,
+        b: &Point,
+        sign: f64,
+        (sigma, best): (f64, Located),
+        at: (usize, usize),
         block: Block,
-        jump: usize,
-    ) -> Option<SpecialPoint> {
-        let n = a.unknowns.len();
-        let t: Vec<f64> = a.tangent.iter().map(|v| v * sign).collect();
-        let mut za = a.unknowns.clone();
-        za.push(a.parameter);
-        let mut zb = b.unknowns.clone();
-        zb.push(b.parameter);
-        let span: f64 = t
-            .iter()
-            .zip(zb.iter().zip(&za))
-            .map(|(t, (y, x))| t * (y - x))
-            .sum();
-        let use_det = jump == 1 && self.representable(block);
-        let f_lo = self.test_at(a, sign, 1e-12 * span, kind, block, use_det)?.0;
-        let f_hi = self.test_at(a, sign, span, kind, block, use_det)?.0;
-        let mut bracket = Illinois::new(0.0, span, f_lo, f_hi)?;
-        let mut best = self.test_at(a, sign, 0.5 * span, kind, block, use_det)?;
-        let (mut p_lo, mut p_hi) = (a.parameter, b.parameter);
+    ) -> Vec<SpecialPoint> {
+        let bi = self.tracker.blocks().iter().position(|&x| x == block);
+        let morse = |x: &[f64], p: f64| -> Option<usize> {
+            let s = self.tracker.evaluate(self.family, x, p).ok()?;
+            Some(s.block_morse[bi?])
+        };
+        let (Some(lo), Some(mid), Some(hi)) = (
+            morse(&a.unknowns, a.parameter),
+            morse(&best.1, best.2),
+            morse(&b.unknowns, b.parameter),
+        ) else {
+            return vec![];
+        };
+        let span = (sigma, span_of(a, b, sign));
+        let mut found = vec![];
+        for (range, jump) in [((0.0, span.0), lo.abs_diff(mid)), (span, mid.abs_diff(hi))] {
+            if jump != 1 {
+                continue;
+            }
+            let Some((_, root)) = self.root(a, (sign, b.parameter), range, &Test::Determinant)
+            else {
+                continue;
+            };
+            let wanted = (SpecialKind::BranchPoint, block, 1);
+            found.extend(self.special_point(a, b, sign, root, at, wanted));
+        }
+        found
+    }
+
+    /// The root σ of the test function on σ ∈ (lo, hi) by Illinois, to
+    /// the event tolerance on the parameter, and the point there.
+    fn root(
+        &self,
+        a: &Point,
+        (sign, p_b): (f64, f64),
+        (lo, hi): (f64, f64),
+        test: &Test,
+    ) -> Option<(f64, Located)> {
+        let span = hi - lo;
+        let f_lo = self.test_at(a, sign, lo + 1e-12 * span, test)?.0;
+        let f_hi = self.test_at(a, sign, hi, test)?.0;
+        let mut bracket = Illinois::new(lo, hi, f_lo, f_hi)?;
+        let mut sigma = 0.5 * (lo + hi);
+        let mut best = self.test_at(a, sign, sigma, test)?;
+        let (mut p_lo, mut p_hi) = (a.parameter, p_b);
         for _ in 0..80 {
-            let sigma = bracket.next_point();
-            best = self.test_at(a, sign, sigma, kind, block, use_det)?;
+            sigma = bracket.next_point();
+            best = self.test_at(a, sign, sigma, test)?;
             match bracket.update(sigma, best.0) {
                 End::Lower => p_lo = best.2,
                 End::Upper => p_hi = best.2,
@@ -161,7 +378,20 @@ impl Run<'_> {
                 break;
             }
         }
-        let (_, x, p, tangent) = best;
+        Some((sigma, best))
+    }
+
+    /// The special point at the located `best`: its spectrum, null mode
+    /// and the size of the singularity there.
+    fn special_point(
+        &self,
+        a: &Point,
+        b: &Point,
+        sign: f64,
+        (_, x, p, tangent): Located,
+        (branch, index): (usize, usize),
+        (kind, block, multiplicity): Wanted,
+    ) -> Option<SpecialPoint> {
         let stored: Vec<f64> = tangent.iter().map(|v| v * sign).collect();
         let (eigenvalue, null_mode) = self.tracker.nearest_zero(self.family, &x, p, block).ok()?;
         // |det F_x| relative to its size at the two neighbours; NaN (not a
@@ -176,7 +406,6 @@ impl Run<'_> {
         tracker.reset();
         let spectrum = tracker.measure(self.family, &x, p).ok()?;
         let point = self.point_from(x, p, stored, spectrum).ok()?;
-        let _ = n;
         Some(SpecialPoint {
             kind,
             branch,
@@ -187,87 +416,122 @@ impl Run<'_> {
             null_mode,
             children: vec![],
             singularity: ((det_here / det_scale).abs(), eigenvalue),
+            multiplicity,
         })
     }
 
-    /// New branches from a simple branch point the model represents: the
-    /// null vector of [F_x F_p] orthogonal to the tangent, both ways.
-    /// `neighbour` is a regular point of the same branch: its Jacobian sets
-    /// the scale against which the null space of [F_x F_p] is judged.
+    /// New branches from a branch point the model represents: the null
+    /// space of [F_x F_p] there has dimension m + 1 (the branch tangent τ
+    /// and the m-dimensional kernel of F_x, m the multiplicity); each of m
+    /// orthonormal directions of it orthogonal to τ is followed both ways.
+    /// For the pair of an isotropic rod any two independent directions
+    /// give congruent branches (turned about the axis). `neighbour` is a
+    /// regular point of the same branch: its Jacobian sets the scale
+    /// against which the null space of [F_x F_p] is judged.
     pub(super) fn switch(&mut self, sp: &SpecialPoint, neighbour: &Point) -> Vec<(Point, f64)> {
         if sp.kind != SpecialKind::BranchPoint || !self.representable(sp.block) {
             return vec![];
         }
-        let x = &sp.point.unknowns;
-        let p = sp.point.parameter;
-        let n = x.len();
-        let (mut r, mut fx) = (DVector::zeros(n), DMatrix::zeros(n, n));
-        if self.family.residual(x, p, &mut r, &mut fx).is_err() {
-            return vec![];
-        }
-        let Ok(fp) = self.family.parameter_derivative(x, p) else {
+        let Some(directions) = self.kernel_directions(sp, neighbour) else {
             return vec![];
         };
-        let mut e = DMatrix::zeros(n, n + 1);
-        e.view_mut((0, 0), (n, n)).copy_from(&fx);
-        e.view_mut((0, n), (n, 1)).copy_from(&fp);
-        // Null space of E: eigenvectors of EᵀE with the two smallest
-        // eigenvalues; the new direction is the part orthogonal to τ.
-        let ete = e.transpose() * &e;
-        let eig = ete.symmetric_eigen();
-        let mut idx: Vec<usize> = (0..=n).collect();
-        idx.sort_by(|&a, &b| eig.eigenvalues[a].total_cmp(&eig.eigenvalues[b]));
-        let (mut rn, mut jn) = (DVector::zeros(n), DMatrix::zeros(n, n));
-        if self
-            .family
-            .residual(&neighbour.unknowns, neighbour.parameter, &mut rn, &mut jn)
-            .is_err()
-        {
-            return vec![];
-        }
-        let scale = jn
-            .norm_squared()
-            .max(eig.eigenvalues[idx[n]].abs())
-            .max(f64::MIN_POSITIVE);
-        if eig.eigenvalues[idx[1]].abs() > 1e-6 * scale {
-            return vec![];
-        }
-        let tau = DVector::from_column_slice(&sp.point.tangent);
-        let mut best: Option<DVector<f64>> = None;
-        for &i in &idx[..2] {
-            let v: DVector<f64> = eig.eigenvectors.column(i).into_owned();
-            let w = &v - &tau * tau.dot(&v);
-            if best.as_ref().is_none_or(|b| w.norm() > b.norm()) {
-                best = Some(w);
-            }
-        }
-        let phi = best.expect("two null vectors").normalize();
+        let (x, p) = (&sp.point.unknowns, sp.point.parameter);
+        let n = x.len();
         let eps = 0.5 * self.opts.step;
         let mut z = x.clone();
         z.push(p);
         let mut starts = vec![];
-        for dir in [1.0, -1.0] {
-            let t: Vec<f64> = phi.iter().map(|v| v * dir).collect();
-            let pred: Vec<f64> = z.iter().zip(&t).map(|(a, b)| a + eps * b).collect();
-            let Ok(Some((zn, _, _))) = self.correct(&pred, &t) else {
-                continue;
-            };
-            let Ok(tangent) = self.tangent(&zn[..n], zn[n], &t) else {
-                continue;
-            };
-            self.tracker.reset();
-            if let Ok(pt) = self.point(zn[..n].to_vec(), zn[n], tangent) {
-                starts.push((pt, 1.0));
+        for phi in &directions {
+            for dir in [1.0, -1.0] {
+                let t: Vec<f64> = phi.iter().map(|v| v * dir).collect();
+                let pred: Vec<f64> = z.iter().zip(&t).map(|(a, b)| a + eps * b).collect();
+                let Ok(Some((zn, _, _))) = self.correct(&pred, &t) else {
+                    continue;
+                };
+                let Ok(tangent) = self.tangent(&zn[..n], zn[n], &t) else {
+                    continue;
+                };
+                self.tracker.reset();
+                if let Ok(pt) = self.point(zn[..n].to_vec(), zn[n], tangent) {
+                    starts.push((pt, 1.0));
+                }
             }
         }
         starts
     }
+
+    /// m orthonormal directions of the null space of E = [F_x F_p] at the
+    /// branch point, orthogonal to the branch tangent: the m + 1
+    /// eigenvectors of EᵀE with the smallest eigenvalues (all of them
+    /// ≤ 1e-6 of the neighbour's ‖F_x‖², else None: the kernel is not
+    /// that large), their τ-components removed, then the m leading left
+    /// singular vectors of what remains.
+    fn kernel_directions(&self, sp: &SpecialPoint, neighbour: &Point) -> Option<Vec<DVector<f64>>> {
+        let (x, p, m) = (
+            &sp.point.unknowns,
+            sp.point.parameter,
+            sp.multiplicity.max(1),
+        );
+        let n = x.len();
+        if m > n {
+            return None;
+        }
+        let fx = self.jacobian(x, p)?;
+        let fp = self.family.parameter_derivative(x, p).ok()?;
+        let mut e = DMatrix::zeros(n, n + 1);
+        e.view_mut((0, 0), (n, n)).copy_from(&fx);
+        e.view_mut((0, n), (n, 1)).copy_from(&fp);
+        let eig = (e.transpose() * &e).symmetric_eigen();
+        let mut idx: Vec<usize> = (0..=n).collect();
+        idx.sort_by(|&a, &b| eig.eigenvalues[a].total_cmp(&eig.eigenvalues[b]));
+        let jn = self.jacobian(&neighbour.unknowns, neighbour.parameter)?;
+        let scale = jn
+            .norm_squared()
+            .max(eig.eigenvalues[idx[n]].abs())
+            .max(f64::MIN_POSITIVE);
+        if eig.eigenvalues[idx[m]].abs() > 1e-6 * scale {
+            return None;
+        }
+        let tau = DVector::from_column_slice(&sp.point.tangent);
+        let projected = DMatrix::from_fn(n + 1, m + 1, |r, c| {
+            let v = eig.eigenvectors.column(idx[c]);
+            v[r] - tau[r] * tau.dot(&v)
+        });
+        let svd = projected.svd(true, false);
+        let u = svd.u.as_ref()?;
+        let mut order: Vec<usize> = (0..=m).collect();
+        order.sort_by(|&a, &b| svd.singular_values[b].total_cmp(&svd.singular_values[a]));
+        Some(
+            order[..m]
+                .iter()
+                .map(|&c| u.column(c).into_owned().normalize())
+                .collect(),
+        )
+    }
+}
+
+/// The arclength σ_b = τ_aᵀ(z_b − z_a) from `a` to `b` along a's tangent
+/// (times the direction of travel).
+fn span_of(a: &Point, b: &Point, sign: f64) -> f64 {
+    let n = a.unknowns.len();
+    (0..=n)
+        .map(|i| {
+            let (za, zb) = if i < n {
+                (a.unknowns[i], b.unknowns[i])
+            } else {
+                (a.parameter, b.parameter)
+            };
+            sign * a.tangent[i] * (zb - za)
+        })
+        .sum()
 }
 
 /// Out-of-plane modes of a planar branch, and bending modes of a straight
 /// one, break a symmetry of the branch.
 fn symmetry_breaking(block: Block, point: &Point, mode: &[nalgebra::Vector3<f64>]) -> bool {
-    let straight = point.norm < 1e-8;
+    // Straight: no curvature, or a twisted rod whose centreline is a line
+    // (Greenhill's shaft carries its twist κ3 ≠ 0 before it buckles).
+    let straight = point.norm < 1e-8 || collinear(&point.shape);
     let out_of_plane = mode.iter().map(|w| w[0].abs() + w[2].abs()).sum::<f64>();
     let in_plane = mode.iter().map(|w| w[1].abs()).sum::<f64>();
     match block {
@@ -275,4 +539,18 @@ fn symmetry_breaking(block: Block, point: &Point, mode: &[nalgebra::Vector3<f64>
         Block::InPlane => straight,
         Block::Full => out_of_plane > in_plane || straight,
     }
+}
+
+/// Whether the points lie on the line through the first and the last, to
+/// 1e-8 of its length.
+fn collinear(points: &[nalgebra::Vector3<f64>]) -> bool {
+    let (Some(first), Some(last)) = (points.first(), points.last()) else {
+        return false;
+    };
+    let chord = last - first;
+    let length = chord.norm();
+    length > 0.0
+        && points
+            .iter()
+            .all(|q| (q - first).cross(&chord).norm() <= 1e-8 * length * length)
 }

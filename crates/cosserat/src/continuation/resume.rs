@@ -46,6 +46,8 @@ pub struct SavedSpecial {
     pub symmetry_breaking: bool,
     /// Relative det F_x and eigenvalue there.
     pub singularity: (f64, f64),
+    /// Eigenvalues crossing zero there ([`SpecialPoint::multiplicity`]).
+    pub multiplicity: usize,
     /// Parameter.
     pub parameter: f64,
     /// Unknowns.
@@ -258,5 +260,6 @@ pub(super) fn rebuild_special(
         symmetry_breaking: s.symmetry_breaking,
         children: vec![],
         singularity: s.singularity,
+        multiplicity: s.multiplicity,
     })
 }

@@ -186,9 +186,16 @@ pub fn lowest_eigenpairs_constrained(
         g.matvec(x, y);
         bordered.solve(&s_inv, y);
     };
-    shift_invert_lanczos(k.size(), count, sigma, apply, g, |ritz| {
-        verify(k, g, c, ritz)
-    })
+    let below = |s: f64| count_below_constrained(k, g, c, s);
+    shift_invert_lanczos(
+        k.size(),
+        count,
+        sigma,
+        apply,
+        g,
+        |ritz| verify(k, g, c, ritz),
+        below,
+    )
 }
 
 /// A shift below the constrained spectrum: [`shift_below`] on the

@@ -42,6 +42,19 @@ pub enum EigenError {
         /// Lanczos steps taken.
         steps: usize,
     },
+    /// The Sturm count finds more eigenvalues below the highest returned
+    /// one than Lanczos returned (copies of a multiple eigenvalue, or a
+    /// tight cluster), and deflation did not recover them.
+    #[error(
+        "Lanczos missed {missing} eigenvalue(s) below {below} (a multiple or clustered \
+         eigenvalue) and deflation did not find them"
+    )]
+    Incomplete {
+        /// How many the count says are missing (0 when it could not count).
+        missing: usize,
+        /// The value below which they were counted.
+        below: f64,
+    },
 }
 
 /// Size up to which the dense solver is used.
@@ -196,12 +209,33 @@ pub fn lowest_eigenpairs_near(
         g.matvec(x, y);
         shifted.solve_in_place(y);
     };
-    shift_invert_lanczos(k.size(), count, sigma, apply, g, |ritz| verify(k, g, ritz))
+    let below = |s: f64| count_below(k, g, s);
+    shift_invert_lanczos(
+        k.size(),
+        count,
+        sigma,
+        apply,
+        g,
+        |ritz| verify(k, g, ritz),
+        below,
+    )
 }
 
 /// Shift-invert Lanczos with the operator `apply` = (K − σG)⁻¹G (or its
 /// constrained form), more steps until `verify` passes every Ritz pair or
-/// the Krylov space is the whole space.
+/// the Krylov space is the whole space; then checked complete by the
+/// Sturm count `below` (the inertia of K − sG).
+///
+/// One start vector spans one vector of each eigenspace (its Krylov space
+/// is invariant), so the second copy of a double eigenvalue — the bending
+/// pair of an isotropic rod, B1 = B2 — appears only through round-off, and
+/// a tight cluster converges late: every returned pair may verify while a
+/// copy is missing. The count below the highest returned value (less a
+/// relative 1e-6 of its distance to the shift) must equal the number
+/// returned below it; where it is larger, Lanczos is run again on the
+/// G-orthogonal complement of the pairs found (deflation, Parlett ch. 13)
+/// and the lowest `count` of all pairs kept, up to `count` times; else
+/// [`EigenError::Incomplete`] — never a spectrum with a gap.
 pub(super) fn shift_invert_lanczos(
     n: usize,
     count: usize,
@@ -209,6 +243,69 @@ pub(super) fn shift_invert_lanczos(
     mut apply: impl FnMut(&[f64], &mut [f64]),
     g: &SymmetricBanded,
     verify: impl Fn(Eigenpairs) -> Result<Eigenpairs, EigenError>,
+    below: impl Fn(f64) -> Inertia,
+) -> Result<Eigenpairs, EigenError> {
+    let mut pairs = converged_lanczos(n, count, sigma, &mut apply, g, &verify, &[])?;
+    for _ in 0..=count {
+        let missing = missing_below(&pairs, sigma, &below)?;
+        if missing.0 == 0 {
+            return Ok(pairs);
+        }
+        let more = converged_lanczos(n, missing.0, sigma, &mut apply, g, &verify, &pairs.vectors)?;
+        pairs = lowest_of(pairs, more, count);
+    }
+    let (missing, below) = missing_below(&pairs, sigma, &below)?;
+    Err(EigenError::Incomplete { missing, below })
+}
+
+/// How many eigenvalues the Sturm count finds below the highest returned
+/// value (less 1e-6 of its distance to the shift and of its size) that
+/// were not returned, and that value.
+fn missing_below(
+    pairs: &Eigenpairs,
+    sigma: f64,
+    below: impl Fn(f64) -> Inertia,
+) -> Result<(usize, f64), EigenError> {
+    let Some(&top) = pairs.values.last() else {
+        return Ok((0, sigma));
+    };
+    let level = top - 1e-6 * ((top - sigma).abs() + top.abs());
+    let returned = pairs.values.iter().filter(|&&v| v < level).count();
+    match below(level) {
+        Inertia::Below(counted) => Ok((counted.saturating_sub(returned), level)),
+        Inertia::Undecided(_) => Err(EigenError::Incomplete {
+            missing: 0,
+            below: level,
+        }),
+    }
+}
+
+/// The `count` lowest of two sets of pairs.
+fn lowest_of(a: Eigenpairs, b: Eigenpairs, count: usize) -> Eigenpairs {
+    let mut all: Vec<(f64, Vec<f64>)> = a
+        .values
+        .into_iter()
+        .zip(a.vectors)
+        .chain(b.values.into_iter().zip(b.vectors))
+        .collect();
+    all.sort_by(|x, y| x.0.total_cmp(&y.0));
+    all.truncate(count);
+    Eigenpairs {
+        values: all.iter().map(|p| p.0).collect(),
+        vectors: all.into_iter().map(|p| p.1).collect(),
+    }
+}
+
+/// Lanczos on the G-orthogonal complement of `locked`, more steps until
+/// `verify` passes every Ritz pair or the Krylov space is the whole space.
+fn converged_lanczos(
+    n: usize,
+    count: usize,
+    sigma: f64,
+    apply: &mut impl FnMut(&[f64], &mut [f64]),
+    g: &SymmetricBanded,
+    verify: &impl Fn(Eigenpairs) -> Result<Eigenpairs, EigenError>,
+    locked: &[Vec<f64>],
 ) -> Result<Eigenpairs, EigenError> {
     let mut steps = 3 * count + 40;
     loop {
@@ -216,8 +313,8 @@ pub(super) fn shift_invert_lanczos(
             n,
             count,
             steps,
-            &mut apply,
-            g,
+            &mut *apply,
+            (g, locked),
             |theta| sigma + 1.0 / theta,
             |a, b| b.total_cmp(&a),
         );
@@ -329,19 +426,35 @@ pub(super) fn row_sum_norm(a: &SymmetricBanded) -> f64 {
 }
 
 /// Lanczos on an operator self-adjoint in the `metric` inner product, with
-/// full reorthogonalization; Ritz values θ are mapped by `to_lambda` and the
-/// `count` best (by `order` on θ) are returned, sorted by λ.
+/// full reorthogonalization, on the metric-orthogonal complement of
+/// `locked` (invariant vectors already found: deflation); Ritz values θ
+/// are mapped by `to_lambda` and the `count` best (by `order` on θ) are
+/// returned, sorted by λ.
 pub(super) fn lanczos(
     n: usize,
     count: usize,
     steps: usize,
     mut apply: impl FnMut(&[f64], &mut [f64]),
-    metric: &SymmetricBanded,
+    (metric, locked): (&SymmetricBanded, &[Vec<f64>]),
     to_lambda: impl Fn(f64) -> f64,
     order: impl Fn(f64, f64) -> std::cmp::Ordering,
 ) -> Eigenpairs {
-    let steps = n.min(steps);
+    let steps = n.saturating_sub(locked.len()).min(steps).max(1);
     let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+    let m_locked: Vec<Vec<f64>> = locked
+        .iter()
+        .map(|l| {
+            let mut ml = vec![0.0; n];
+            metric.matvec(l, &mut ml);
+            ml
+        })
+        .collect();
+    let deflate = |w: &mut [f64]| {
+        for (l, ml) in locked.iter().zip(&m_locked) {
+            let c = dot(ml, w);
+            w.iter_mut().zip(l).for_each(|(a, b)| *a -= c * b);
+        }
+    };
     // q_j and M q_j, so that every inner product is a plain dot product.
     let (mut q, mut mq): (Vec<Vec<f64>>, Vec<Vec<f64>>) = (vec![], vec![]);
     let (mut alpha, mut beta) = (Vec::new(), Vec::new());
@@ -349,6 +462,7 @@ pub(super) fn lanczos(
     let mut v: Vec<f64> = (0..n)
         .map(|i| 1.0 + 0.5 * ((i as f64) * 0.618).sin())
         .collect();
+    deflate(&mut v);
     let mut mv = vec![0.0; n];
     metric.matvec(&v, &mut mv);
     let norm = dot(&v, &mv).sqrt();
@@ -367,6 +481,7 @@ pub(super) fn lanczos(
         apply(&q[j], &mut w);
         alpha.push(dot(&mq[j], &w));
         for _ in 0..2 {
+            deflate(&mut w);
             for (qi, mqi) in q.iter().zip(&mq) {
                 let c = dot(mqi, &w);
                 w.iter_mut().zip(qi).for_each(|(a, b)| *a -= c * b);
@@ -499,7 +614,15 @@ pub fn smallest_positive_load_factor(
             k1.matvec(x, y);
             f.solve_in_place(y);
         };
-        lanczos(k0.size(), 1, 60, apply, k0, |mu| mu, |a, b| a.total_cmp(&b))
+        lanczos(
+            k0.size(),
+            1,
+            60,
+            apply,
+            (k0, &[]),
+            |mu| mu,
+            |a, b| a.total_cmp(&b),
+        )
     };
     let mu = pairs.values[0];
     if !mu.is_finite() || pairs.vectors[0].iter().any(|v| !v.is_finite()) {
@@ -550,6 +673,98 @@ mod tests {
             g.add(i, i, if i + 1 == n { h / 2.0 } else { h });
         }
         (k, g)
+    }
+
+    /// Two copies of [`laplacian`], their unknowns interleaved (bandwidth
+    /// 2): every eigenvalue is double, λ_k = (4/h²) sin²((2k − 1)π/(4n))
+    /// for u_i = sin(θ i), θ = (2k − 1)π/(2n) (the half mass at the free end
+    /// makes u symmetric about i = n).
+    fn doubled_laplacian(n: usize) -> (SymmetricBanded, SymmetricBanded, Vec<f64>) {
+        let (k1, g1) = laplacian(n);
+        let (mut k, mut g) = (
+            SymmetricBanded::zeros(2 * n, 2),
+            SymmetricBanded::zeros(2 * n, 2),
+        );
+        for i in 0..n {
+            for c in 0..2 {
+                k.add(2 * i + c, 2 * i + c, k1.get(i, i));
+                g.add(2 * i + c, 2 * i + c, g1.get(i, i));
+                if i > 0 {
+                    k.add(2 * i + c, 2 * (i - 1) + c, k1.get(i, i - 1));
+                }
+            }
+        }
+        let h = 1.0 / n as f64;
+        let exact = (1..=3)
+            .map(|j| {
+                let theta = f64::from(2 * j - 1) * std::f64::consts::PI / (4 * n) as f64;
+                4.0 / (h * h) * theta.sin().powi(2)
+            })
+            .collect();
+        (k, g, exact)
+    }
+
+    /// A double eigenvalue: single-vector Lanczos sees one copy of it (the
+    /// Krylov space of one start vector holds one vector of each
+    /// eigenspace), so the lowest four must come with both copies, found
+    /// by deflation and checked by the Sturm count, or an error.
+    #[test]
+    fn lanczos_finds_both_copies_of_a_double_eigenvalue() {
+        let (k, g, exact) = doubled_laplacian(150);
+        let want = [exact[0], exact[0], exact[1], exact[1], exact[2]];
+        for count in 1..=5 {
+            let pairs = lowest_eigenpairs(&k, &g, count).unwrap();
+            for (a, b) in pairs.values.iter().zip(&want) {
+                assert!(
+                    (a - b).abs() <= 1e-9 * b,
+                    "{count}: {:?} vs {want:?}",
+                    pairs.values
+                );
+            }
+        }
+        let pairs = lowest_eigenpairs(&k, &g, 5).unwrap();
+        for (i, u) in pairs.vectors.iter().enumerate() {
+            for (j, v) in pairs.vectors.iter().enumerate() {
+                let (mut gv, delta) = (vec![0.0; v.len()], f64::from(u8::from(i == j)));
+                g.matvec(v, &mut gv);
+                let dot: f64 = u.iter().zip(&gv).map(|(a, b)| a * b).sum();
+                assert!((dot - delta).abs() < 1e-8, "G-orthonormal: {i} {j} {dot}");
+            }
+        }
+    }
+
+    /// The Sturm check sees a copy missing from a spectrum that skips it
+    /// (every pair returned being a true one), and Lanczos deflated by the
+    /// copy found returns the other copy of the same eigenvalue.
+    #[test]
+    fn a_missing_copy_is_counted_and_found_by_deflation() {
+        let (k, g, exact) = doubled_laplacian(150);
+        let pairs = lowest_eigenpairs(&k, &g, 3).unwrap();
+        let gapped = Eigenpairs {
+            values: vec![pairs.values[0], pairs.values[2]],
+            vectors: vec![pairs.vectors[0].clone(), pairs.vectors[2].clone()],
+        };
+        let below = |s: f64| count_below(&k, &g, s);
+        assert_eq!(missing_below(&gapped, 0.0, below).unwrap().0, 1);
+        assert_eq!(missing_below(&pairs, 0.0, below).unwrap().0, 0);
+        let sigma = 0.5 * exact[0];
+        let shifted = k.combine(1.0, &g, -sigma).ldlt().unwrap();
+        let apply = |x: &[f64], y: &mut [f64]| {
+            g.matvec(x, y);
+            shifted.solve_in_place(y);
+        };
+        let locked = [pairs.vectors[0].clone()];
+        let to_lambda = |theta: f64| sigma + 1.0 / theta;
+        let other = lanczos(300, 1, 300, apply, (&g, &locked), to_lambda, |a, b| {
+            b.total_cmp(&a)
+        });
+        assert!((other.values[0] - exact[0]).abs() <= 1e-9 * exact[0]);
+        let (mut gv, mut overlap) = (vec![0.0; 300], 0.0);
+        g.matvec(&other.vectors[0], &mut gv);
+        for (a, b) in locked[0].iter().zip(&gv) {
+            overlap += a * b;
+        }
+        assert!(overlap.abs() < 1e-8, "the other copy: overlap {overlap}");
     }
 
     #[test]

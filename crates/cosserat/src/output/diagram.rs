@@ -8,7 +8,8 @@
 //! `direction` (±1: travel along or against the stored tangents) and
 //! `next_step` (the arclength step a resumed run goes on with); `/special_points/kind` (strings), `branch`, `index`,
 //! `parameter`, `tip_position` (s×3), `measures` (s×k), `block`, `symmetry_breaking`,
-//! `null_vectors` (s×nodes×3), `singularity` (s×2); `/warnings` (events
+//! `null_vectors` (s×nodes×3), `singularity` (s×2), `multiplicity` (s:
+//! eigenvalues crossing zero; absent in older files, read as 1); `/warnings` (events
 //! detected but not located, as text); the problem text as the
 //! root attribute `problem`, the run's `stop_reason` and the parameter name
 //! as root attributes.
@@ -172,6 +173,11 @@ fn write_special_points(file: &hdf5::File, d: &Diagram) -> hdf5::Result<()> {
         .flat_map(|s| [s.singularity.0, s.singularity.1])
         .collect();
     array(&g, "singularity", &[sp.len(), 2], &sing)?;
+    integers(
+        &g,
+        "multiplicity",
+        &sp.iter().map(|s| s.multiplicity as u64).collect::<Vec<_>>(),
+    )?;
     let nodes = d.nodes.len();
     let null: Vec<f64> = sp
         .iter()
@@ -242,6 +248,13 @@ pub fn read_saved(path: &Path) -> hdf5::Result<(String, SavedDiagram)> {
     let sym = g.dataset("symmetry_breaking")?.read_raw::<u64>()?;
     let parameter = g.dataset("parameter")?.read_raw::<f64>()?;
     let sing = rows(&g, "singularity")?;
+    // Files written before the multiplicity was recorded hold simple
+    // points only: the Morse index changed by one, or the change was not
+    // located at all.
+    let multiplicity = match g.dataset("multiplicity") {
+        Ok(ds) => ds.read_raw::<u64>()?,
+        Err(_) => vec![1; kinds.len()],
+    };
     let (x, t) = (rows(&g, "unknowns")?, rows(&g, "tangent")?);
     let count = kinds.len();
     let lengths = [
@@ -251,6 +264,7 @@ pub fn read_saved(path: &Path) -> hdf5::Result<(String, SavedDiagram)> {
         sym.len(),
         parameter.len(),
         sing.len(),
+        multiplicity.len(),
         x.len(),
         t.len(),
     ];
@@ -278,6 +292,7 @@ pub fn read_saved(path: &Path) -> hdf5::Result<(String, SavedDiagram)> {
             block,
             symmetry_breaking: sym[i] == 1,
             singularity: (sing[i][0], sing[i][1]),
+            multiplicity: multiplicity[i] as usize,
             parameter: parameter[i],
             unknowns: x[i].clone(),
             tangent: t[i].clone(),

@@ -1,0 +1,81 @@
+//! `cosserat continue problems/greenhill.toml`: Greenhill's isotropic
+//! shaft under thrust and a twisting couple M L/B = 2 loses stability at a
+//! branch point of multiplicity 2 (the bending pair, B1 = B2), at the
+//! thrust of the characteristic determinant for clamped ends (Greenhill
+//! 1883; Ziegler 1968, Sec. 2.7: `references::greenhill_clamped`); the
+//! summary prints the multiplicity, the diagram file records it, and the
+//! resume reader reads it back (and reads a file without it, as older
+//! versions wrote, as simple points).
+mod common;
+
+use common::problems::shipped;
+use common::run::{scratch, BIN};
+use cosserat::output::read_saved;
+use cosserat::references::greenhill_clamped;
+
+#[test]
+fn greenhill_diagram_reports_a_double_branch_point() {
+    let dir = scratch("greenhill", "double");
+    let out = dir.join("greenhill.h5");
+    let o = std::process::Command::new(BIN)
+        .args([
+            "continue",
+            &shipped("greenhill"),
+            "-o",
+            out.to_str().unwrap(),
+            "--set",
+            "continuation.max_points=12",
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with("special 0"))
+        .unwrap_or_else(|| panic!("no special point: {stdout}"));
+    assert!(line.contains("branch_point"), "{line}");
+    assert!(line.ends_with("multiplicity 2"), "{line}");
+    let printed: f64 = line
+        .split("at parameter ")
+        .nth(1)
+        .and_then(|r| r.split(',').next())
+        .unwrap()
+        .parse()
+        .unwrap();
+    let reference = greenhill_clamped(2.0);
+    // Printed to 12 decimals; located to 1e-10.
+    assert!(
+        (printed - reference).abs() <= 1e-10 * reference,
+        "{printed} vs {reference}"
+    );
+    let f = hdf5::File::open(&out).unwrap();
+    let multiplicity = f
+        .dataset("special_points/multiplicity")
+        .unwrap()
+        .read_raw::<u64>()
+        .unwrap();
+    assert_eq!(multiplicity, vec![2]);
+    drop(f);
+    let (_, saved) = read_saved(&out).unwrap();
+    assert_eq!(saved.specials[0].multiplicity, 2);
+    // Two kernel directions, both ways: four switched branches.
+    assert_eq!(saved.branches.len(), 5);
+    older_files_read_as_simple(&out);
+}
+
+/// A diagram written before the multiplicity was recorded (the dataset
+/// removed, the file sealed again) still reads, its points simple.
+fn older_files_read_as_simple(path: &std::path::Path) {
+    let len = std::fs::metadata(path).unwrap().len();
+    let file = std::fs::OpenOptions::new().write(true).open(path).unwrap();
+    file.set_len(len - 24).unwrap();
+    drop(file);
+    let f = hdf5::File::open_rw(path).unwrap();
+    f.unlink("special_points/multiplicity").unwrap();
+    drop(f);
+    cosserat::output::seal::seal(path).unwrap();
+    let (_, saved) = read_saved(path).unwrap();
+    assert_eq!(saved.specials.len(), 1);
+    assert_eq!(saved.specials[0].multiplicity, 1);
+}
