@@ -59,7 +59,8 @@ fn held_tip_position_follows_the_clamped_elastica() {
 /// An end turned through more than a full turn: the straight twisted rod
 /// between two clamps loses stability at the end rotation θ = 2x₁ B/C
 /// (tan x₁ = x₁), 1.43 turns at B = C; with C = B/2 the critical angle
-/// doubles. The branch point is where the Morse index first changes.
+/// doubles. The Morse index changes across it by two (the isotropic
+/// bending pair), and the double branch point is located to 1e-10.
 #[test]
 fn end_rotation_runs_through_turns_to_the_twisted_rod_instability() {
     for (c, bound) in [(1.0, 12.6), (0.5, 20.0)] {
@@ -85,12 +86,17 @@ fn end_rotation_runs_through_turns_to_the_twisted_rod_instability() {
             before < exact && exact < after,
             "C = {c}: [{before}, {after}] ∌ {exact}"
         );
+        let special = d
+            .special_points
+            .iter()
+            .find(|s| s.kind == SpecialKind::BranchPoint && s.branch == 0)
+            .expect("the branch point is reported");
+        let located = special.point.parameter;
         assert!(
-            d.special_points
-                .iter()
-                .any(|s| s.kind == SpecialKind::BranchPoint && s.branch == 0),
-            "C = {c}: the branch point is reported"
+            (located - exact).abs() <= 1e-10 * exact,
+            "C = {c}: located at {located}, closed form {exact}"
         );
+        assert_eq!(special.multiplicity, 2, "the isotropic rod's bending pair");
         // The straight twisted rod: every point is straight (tip on the axis).
         for p in &straight.points {
             assert!(p.tip.position[0].hypot(p.tip.position[1]) < 1e-9);

@@ -96,6 +96,7 @@ pub(super) fn drain(
             return;
         }
         queue.extend(run.switches(diagram, &outcome.special_points, depth));
+        run.report_unswitched(diagram);
     }
     diagram.stop_reason = RunState::Completed;
 }
@@ -121,6 +122,15 @@ impl Run<'_> {
         }
         out
     }
+
+    /// Moves the switch failures into the diagram's warnings (once each).
+    pub(super) fn report_unswitched(&mut self, diagram: &mut Diagram) {
+        for w in self.unswitched.drain(..) {
+            if !diagram.warnings.contains(&w) {
+                diagram.warnings.push(w);
+            }
+        }
+    }
 }
 
 /// What following one branch produced.
@@ -136,6 +146,9 @@ pub(super) struct Run<'a> {
     pub(super) opts: &'a ContinuationOptions,
     pub(super) tracker: Tracker,
     pub(super) total_points: usize,
+    /// Branch points whose switch started fewer branches than asked, and
+    /// why (moved to the diagram's warnings).
+    pub(super) unswitched: Vec<String>,
 }
 
 impl<'a> Run<'a> {
@@ -149,6 +162,7 @@ impl<'a> Run<'a> {
             opts,
             tracker: Tracker::new(family, blocks, opts.stability),
             total_points: 0,
+            unswitched: vec![],
         }
     }
 

@@ -432,7 +432,14 @@ impl Run<'_> {
         if sp.kind != SpecialKind::BranchPoint || !self.representable(sp.block) {
             return vec![];
         }
+        let at = format!(
+            "branch point at parameter {:.10} on branch {} (multiplicity {})",
+            sp.point.parameter, sp.branch, sp.multiplicity
+        );
         let Some(directions) = self.kernel_directions(sp, neighbour) else {
+            self.unswitched.push(format!(
+                "{at}: not switched: [F_x F_p] has no null space of that dimension there"
+            ));
             return vec![];
         };
         let (x, p) = (&sp.point.unknowns, sp.point.parameter);
@@ -456,6 +463,15 @@ impl Run<'_> {
                     starts.push((pt, 1.0));
                 }
             }
+        }
+        let asked = 2 * directions.len();
+        if starts.len() < asked {
+            self.unswitched.push(format!(
+                "{at}: {} of {asked} switched branches started; the corrector did not converge \
+                 off the others (a branch of symmetric copies, e.g. rotations about an \
+                 isotropic rod's axis, keeps a zero eigenvalue and needs a phase condition)",
+                starts.len()
+            ));
         }
         starts
     }

@@ -153,6 +153,7 @@ pub fn switch_from(
         warnings: vec![],
     };
     let queue = run.switches(&diagram, &[0], 0);
+    run.report_unswitched(&mut diagram);
     drain(&mut run, &mut diagram, queue, monitor);
     Ok(diagram)
 }

@@ -212,6 +212,7 @@ pub fn resume(
             }
         }
     }
+    run.report_unswitched(&mut diagram);
     drain(&mut run, &mut diagram, queue, monitor);
     Ok(diagram)
 }
