@@ -46,12 +46,11 @@ pub(super) enum Linearization {
 impl Linearization {
     /// The zero F_x of the family's shape.
     fn of(family: &Family) -> Self {
-        match family.staircase() {
-            Some(a) => Linearization::Staircase(a),
-            None => {
-                let n = family.size();
-                Linearization::Dense(DMatrix::zeros(n, n))
-            }
+        if let Some(a) = family.staircase() {
+            Linearization::Staircase(a)
+        } else {
+            let n = family.size();
+            Linearization::Dense(DMatrix::zeros(n, n))
         }
     }
 

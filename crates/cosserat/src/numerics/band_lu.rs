@@ -167,8 +167,9 @@ impl BandLu {
             b[j] /= self.data[self.at(j, j)];
             let bj = b[j];
             if bj != 0.0 {
-                for i in j.saturating_sub(kv)..j {
-                    b[i] -= self.data[self.at(i, j)] * bj;
+                let top = j.saturating_sub(kv);
+                for (i, bi) in b[top..j].iter_mut().enumerate() {
+                    *bi -= self.data[self.at(top + i, j)] * bj;
                 }
             }
         }
