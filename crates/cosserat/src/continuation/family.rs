@@ -17,8 +17,8 @@ use crate::numerics::integrator::{IntegrationError, Tolerances};
 use crate::numerics::staircase::Staircase;
 
 /// The most segments of the multiple shooting that solves the start of a
-/// branch ([`Family::method`]).
-pub const START_SEGMENTS: usize = 32;
+/// branch ([`Family::method`]): its dense Newton costs O(K³).
+const START_SEGMENTS: usize = 32;
 
 /// Which number of the rod the parameter sets.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -221,7 +221,7 @@ impl Family {
 
     /// The BVP method that solves the start of a branch: shooting for a
     /// single-shooting family, otherwise multiple shooting on at most
-    /// [`START_SEGMENTS`] equal segments (its dense Newton costs O(K³), so
+    /// 32 equal segments (`START_SEGMENTS`) (its dense Newton costs O(K³), so
     /// a fine family is started from a coarse solve):
     /// [`Family::start_unknowns`] carries its solution onto the family's
     /// nodes, and Newton at the start value (O(K), banded) then moves it
