@@ -272,6 +272,17 @@ impl StaircaseLu {
         }
     }
 
+    /// det A of the plain factors as (sign, ln |det A|) (see
+    /// [`BandLu::log_determinant`]): the O(N) determinant a branch-point
+    /// test needs. None after a bordered or failed factorization.
+    pub fn log_determinant(&self) -> Option<(f64, f64)> {
+        if self.factored && !self.bordered {
+            self.lu.log_determinant()
+        } else {
+            None
+        }
+    }
+
     /// b ← A⁻¹ b with the plain factors; false where A was singular.
     pub fn solve(&mut self, b: &mut [f64]) -> bool {
         if !self.factored || self.bordered {

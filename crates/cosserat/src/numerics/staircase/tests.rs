@@ -79,6 +79,10 @@ fn the_plain_solve_equals_dense_lu() {
         assert!(lu.solve(&mut x));
         let dense = a.to_dense().lu().solve(&DVector::from_vec(b)).unwrap();
         assert_close(&x, &dense, 1e-10);
+        let (sign, log) = lu.log_determinant().unwrap();
+        let det = a.to_dense().determinant();
+        assert_eq!(sign, det.signum());
+        assert!((log - det.abs().ln()).abs() <= 1e-10 * log.abs().max(1.0));
     }
 }
 
