@@ -8,6 +8,14 @@
 //! whose Jacobian [F_x F_p; τ₀ᵀ] stays regular at a fold, where F_x alone
 //! is singular. The new tangent is the null vector of [F_x F_p] oriented
 //! along τ₀. Newton at a fixed p starts branches and lands them on bounds.
+//!
+//! Every linear solve uses the structure of the discretization
+//! ([`Linearization`]): single shooting's few unknowns by dense LU (the
+//! truncated SVD at a singular bordered matrix); multiple shooting and
+//! collocation, whose F_x is almost block diagonal, by band LU of F_x or of
+//! the banded embedding of the bordered matrix
+//! ([`crate::numerics::staircase`]), with its banded least squares at a
+//! singular one — O(N) work and memory per step.
 
 use nalgebra::{DMatrix, DVector};
 
@@ -105,9 +113,9 @@ impl BorderedFactors {
         }
     }
 
-    /// The solution of the factored system for `rhs` (length N + 1); the
-    /// least-squares solution where the bordered matrix is singular (an
-    /// exact branch point), None where none is finite.
+    /// The solution of the factored system for `rhs` (length N + 1) into
+    /// `z`; the least-squares solution where the bordered matrix is
+    /// singular (an exact branch point), false where none is finite.
     fn solve(
         &mut self,
         fx: &Linearization,
@@ -115,11 +123,20 @@ impl BorderedFactors {
         row: &[f64],
         corner: f64,
         rhs: &[f64],
-    ) -> Option<Vec<f64>> {
+        z: &mut [f64],
+    ) -> bool {
         match fx {
             Linearization::Dense(_) => {
-                let a = self.dense.clone()?;
-                bordered_solve(a, &DVector::from_column_slice(rhs)).map(|z| z.as_slice().to_vec())
+                let Some(a) = self.dense.clone() else {
+                    return false;
+                };
+                match bordered_solve(a, &DVector::from_column_slice(rhs)) {
+                    Some(d) => {
+                        z.copy_from_slice(d.as_slice());
+                        true
+                    }
+                    None => false,
+                }
             }
             Linearization::Staircase(a) => {
                 let border = Border {
@@ -128,9 +145,16 @@ impl BorderedFactors {
                     corner,
                 };
                 if self.factored {
-                    self.lu.solve_bordered(a, &border, rhs)
+                    self.lu.solve_bordered(a, &border, rhs, z)
                 } else {
-                    least_squares(a, &border, rhs).filter(|z| z.iter().all(|v| v.is_finite()))
+                    match least_squares(a, &border, rhs).filter(|y| y.iter().all(|v| v.is_finite()))
+                    {
+                        Some(y) => {
+                            z.copy_from_slice(&y);
+                            true
+                        }
+                        None => false,
+                    }
                 }
             }
         }
@@ -276,16 +300,14 @@ impl System for PseudoArclength<'_> {
         let n = self.r.len();
         self.rhs.iter_mut().zip(f).for_each(|(r, v)| *r = -v);
         let (row, corner) = self.tangent.split_at(n);
-        match self
-            .bordered
-            .solve(&self.fx, self.fp.as_slice(), row, corner[0], &self.rhs)
-        {
-            Some(d) => {
-                delta.copy_from_slice(&d);
-                true
-            }
-            None => false,
-        }
+        self.bordered.solve(
+            &self.fx,
+            self.fp.as_slice(),
+            row,
+            corner[0],
+            &self.rhs,
+            delta,
+        )
     }
 
     fn residual_scales(&self) -> Vec<f64> {
@@ -356,11 +378,11 @@ impl Run<'_> {
         rhs[n] = 1.0;
         let mut factors = BorderedFactors::default();
         factors.factor(fx, fp.as_slice(), row, corner[0]);
-        let t = factors
-            .solve(fx, fp.as_slice(), row, corner[0], &rhs)
-            .map(DVector::from_vec)
-            .filter(|t| t.iter().all(|v| v.is_finite()) && t.norm() > 0.0)
-            .ok_or(PointError::SingularTangent(p))?;
+        let mut t = DVector::zeros(n + 1);
+        let solved = factors.solve(fx, fp.as_slice(), row, corner[0], &rhs, t.as_mut_slice());
+        if !solved || !t.iter().all(|v| v.is_finite()) || t.norm() == 0.0 {
+            return Err(PointError::SingularTangent(p));
+        }
         let t = t.normalize();
         Ok(t.as_slice().to_vec())
     }

@@ -199,6 +199,7 @@ impl Staircase {
 }
 
 /// Where block j's unknowns and equations start in the embedding.
+#[derive(Debug, Clone, Default)]
 struct Embedding {
     unknown: Vec<usize>,
     equation: Vec<usize>,
@@ -234,8 +235,11 @@ pub struct StaircaseLu {
     factored: bool,
     /// The embedding's right-hand side and solution (bordered solves).
     work: Vec<f64>,
-    /// The residual of the refinement step.
+    /// The residual and the correction of the refinement step.
     residual: Vec<f64>,
+    correction: Vec<f64>,
+    /// Where the blocks start in the embedding.
+    layout: Embedding,
 }
 
 impl StaircaseLu {
@@ -253,6 +257,7 @@ impl StaircaseLu {
                 a.entries(|i, j, v| lu.add(i, j, v));
             }
             Some(border) => {
+                self.layout = Embedding::new(a);
                 let (kl, ku) = bandwidths(|put| a.embedded_entries(border, put));
                 lu.reset(a.size() + 2 * a.segments(), kl, ku);
                 a.embedded_entries(border, |i, j, v| lu.add(i, j, v));
@@ -293,40 +298,49 @@ impl StaircaseLu {
     }
 
     /// z = M⁻¹ (f, g) for M = [A b; cᵀ d] with the bordered factors of the
-    /// same A and border, refined once on M; where M is singular (a zero
-    /// pivot or a solution 10¹² times the data), the regularized least
-    /// squares solution instead ([`least_squares`]). None where neither
-    /// is finite.
+    /// same A and border, refined once on M, into `z` (length N + 1);
+    /// where M is singular (a zero pivot or a solution 10¹² times the
+    /// data), the regularized least-squares solution instead
+    /// ([`least_squares`]). False where neither is finite.
     pub fn solve_bordered(
         &mut self,
         a: &Staircase,
         border: &Border,
         rhs: &[f64],
-    ) -> Option<Vec<f64>> {
+        z: &mut [f64],
+    ) -> bool {
+        let finite = |z: &[f64]| z.iter().all(|v| v.is_finite());
         let scale = rhs.iter().fold(f64::MIN_POSITIVE, |m, v| m.max(v.abs()));
         if self.factored && self.bordered {
-            let mut z = self.embedded_solve(a, rhs);
+            self.embedded_solve(a, rhs, z);
             let mut r = std::mem::take(&mut self.residual);
-            bordered_residual(a, border, &z, rhs, &mut r);
-            let dz = self.embedded_solve(a, &r);
+            let mut dz = std::mem::take(&mut self.correction);
+            dz.resize(z.len(), 0.0);
+            bordered_residual(a, border, z, rhs, &mut r);
+            self.embedded_solve(a, &r, &mut dz);
             z.iter_mut().zip(&dz).for_each(|(a, b)| *a += b);
-            self.residual = r;
+            (self.residual, self.correction) = (r, dz);
             let size = z.iter().fold(0.0, |m: f64, v| m.max(v.abs()));
-            if z.iter().all(|v| v.is_finite()) && size * self.lu.magnitude() < 1e12 * scale {
-                return Some(z);
+            if finite(z) && size * self.lu.magnitude() < 1e12 * scale {
+                return true;
             }
         }
-        least_squares(a, border, rhs).filter(|z| z.iter().all(|v| v.is_finite()))
+        match least_squares(a, border, rhs).filter(|y| finite(y)) {
+            Some(y) => {
+                z.copy_from_slice(&y);
+                true
+            }
+            None => false,
+        }
     }
 
-    /// M⁻¹ (f, g) through the embedding, without refinement.
-    fn embedded_solve(&mut self, a: &Staircase, rhs: &[f64]) -> Vec<f64> {
-        let layout = Embedding::new(a);
+    /// M⁻¹ (f, g) through the embedding into `z`, without refinement.
+    fn embedded_solve(&mut self, a: &Staircase, rhs: &[f64], z: &mut [f64]) {
         self.work.clear();
         self.work.resize(self.lu.size(), 0.0);
-        scatter(a, &layout, rhs, &mut self.work);
+        scatter(a, &self.layout, rhs, &mut self.work);
         self.lu.solve(&mut self.work);
-        gather(a, &layout, &self.work)
+        gather(a, &self.layout, &self.work, z);
     }
 }
 
@@ -336,24 +350,21 @@ fn scatter(a: &Staircase, layout: &Embedding, rhs: &[f64], work: &mut [f64]) {
     let n = a.size();
     for (j, block) in a.blocks.iter().enumerate() {
         let e = layout.equation[j];
-        for i in 0..block.nrows() {
-            work[e + 1 + i] = rhs[a.dim * j + i];
-        }
+        let rows = block.nrows();
+        work[e + 1..e + 1 + rows].copy_from_slice(&rhs[a.dim * j..a.dim * j + rows]);
     }
     let last = work.len() - 1;
     work[last] = rhs[n];
 }
 
-/// (x, π_{K−1}) of the embedding's solution.
-fn gather(a: &Staircase, layout: &Embedding, work: &[f64]) -> Vec<f64> {
-    let mut z = Vec::with_capacity(a.size() + 1);
+/// (x, π_{K−1}) of the embedding's solution into z.
+fn gather(a: &Staircase, layout: &Embedding, work: &[f64], z: &mut [f64]) {
     for (j, block) in a.blocks.iter().enumerate() {
-        let u = layout.unknown[j];
-        z.extend_from_slice(&work[u..u + block.ncols()]);
+        let (u, c0, cols) = (layout.unknown[j], a.column_of(j), block.ncols());
+        z[c0..c0 + cols].copy_from_slice(&work[u..u + cols]);
     }
     let k = a.segments() - 1;
-    z.push(work[layout.unknown[k] + a.blocks[k].ncols()]);
-    z
+    z[a.size()] = work[layout.unknown[k] + a.blocks[k].ncols()];
 }
 
 /// r = (f, g) − M z.
@@ -424,7 +435,9 @@ pub fn least_squares(a: &Staircase, border: &Border, rhs: &[f64]) -> Option<Vec<
     dy.iter_mut().zip(&y).for_each(|(d, v)| *d -= mu * v);
     ldlt.solve_in_place(&mut dy);
     y.iter_mut().zip(&dy).for_each(|(a, b)| *a += b);
-    Some(gather(a, &layout, &y))
+    let mut z = vec![0.0; a.size() + 1];
+    gather(a, &layout, &y, &mut z);
+    Some(z)
 }
 
 #[cfg(test)]
