@@ -371,7 +371,7 @@ impl NonlinearSystem for ShootingSystem<'_> {
     ) -> Result<(), IntegrationError> {
         let mut a = self.staircase();
         self.evaluate_staircase(x, r, &mut a)?;
-        jac.copy_from(&a.to_dense());
+        a.write_dense(jac);
         Ok(())
     }
 }

@@ -134,8 +134,14 @@ impl Staircase {
     pub fn to_dense(&self) -> DMatrix<f64> {
         let n = self.size();
         let mut a = DMatrix::zeros(n, n);
-        self.entries(|i, j, v| a[(i, j)] += v);
+        self.write_dense(&mut a);
         a
+    }
+
+    /// The dense matrix into `out` (N × N), without another N × N copy.
+    pub fn write_dense(&self, out: &mut DMatrix<f64>) {
+        out.fill(0.0);
+        self.entries(|i, j, v| out[(i, j)] += v);
     }
 
     /// Every stored entry (i, j, Aᵢⱼ), row by row.
