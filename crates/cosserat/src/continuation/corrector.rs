@@ -40,21 +40,33 @@ fn bordered_solve(a: DMatrix<f64>, rhs: &DVector<f64>) -> Option<DVector<f64>> {
     svd.solve(rhs, tol).ok().filter(finite)
 }
 
+/// The most unknowns solved dense. Below it a dense LU of the bordered
+/// matrix costs about one evaluation of F, and small studies keep the
+/// results of the dense solver with its truncated SVD bit for bit: the
+/// arm's loading path (Sec. 4.4, 125 unknowns) runs its correctors at the
+/// noise floor of the integrated residual near λ = 0.976, where round-off
+/// in the solve decides whether a step converges (measured: accurate
+/// staircase solves, residual 1e-26 against right-hand sides 1e-10, still
+/// end that branch at λ = 0.9757 instead of 1).
+const DENSE_UP_TO: usize = 200;
+
 /// F_x at a point in the shape of the family's discretization: dense for
-/// single shooting, almost block diagonal ([`Staircase`]) for multiple
-/// shooting and collocation, so that every step costs O(N) there.
+/// single shooting and small systems, almost block diagonal
+/// ([`Staircase`]) for multiple shooting and collocation beyond
+/// [`DENSE_UP_TO`] unknowns, so that every step costs O(N) there.
 #[derive(Debug, Clone)]
 pub(super) enum Linearization {
-    /// The small dense F_x of single shooting.
+    /// The small dense F_x of single shooting or of a coarse mesh.
     Dense(DMatrix<f64>),
     /// The block-banded F_x of K > 1 segments or intervals.
     Staircase(Staircase),
 }
 
 impl Linearization {
-    /// The zero F_x of the family's shape.
+    /// The zero F_x of the family's shape: a staircase above
+    /// [`DENSE_UP_TO`] unknowns, dense below.
     fn of(family: &Family) -> Self {
-        if let Some(a) = family.staircase() {
+        if let Some(a) = family.staircase().filter(|a| a.size() > DENSE_UP_TO) {
             Linearization::Staircase(a)
         } else {
             let n = family.size();
