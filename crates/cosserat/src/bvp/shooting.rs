@@ -17,6 +17,7 @@ use super::gauss_step::gauss_step;
 use super::newton::NonlinearSystem;
 use crate::equations::{RodEquations, RodSample};
 use crate::numerics::integrator::{Dop853, IntegrationError, IntegrationStats, Tolerances};
+use crate::numerics::staircase::Staircase;
 
 /// The shooting formulation of a rod BVP on K segments.
 pub struct ShootingSystem<'a> {
@@ -174,6 +175,48 @@ impl<'a> ShootingSystem<'a> {
         x
     }
 
+    /// The unknowns of the same BVP on `segments` equal segments, from
+    /// unknowns `x` on this system's: the free values kept, each new
+    /// interior node state integrated (DOP853, projected onto orthonormal
+    /// directors) from the start of the segment of this system that holds
+    /// it. O(segments) work: a fine mesh started from a coarse solve.
+    pub fn refined_unknowns(
+        &mut self,
+        x: &[f64],
+        segments: usize,
+    ) -> Result<Vec<f64>, IntegrationError> {
+        let (n, p) = (self.eq.dim(), self.eq.unknowns());
+        let length = self.eq.length();
+        let fine: Vec<f64> = (1..segments.max(1))
+            .map(|i| length * i as f64 / segments as f64)
+            .collect();
+        let mut out = Vec::with_capacity(p + n * fine.len());
+        out.extend_from_slice(&x[..p]);
+        for j in 0..self.segments {
+            let (a, b) = (self.node(j), self.node(j + 1));
+            let stops: Vec<f64> = fine.iter().copied().filter(|&s| s >= a && s < b).collect();
+            if stops.is_empty() {
+                continue;
+            }
+            let mut y = self.node_state(x, j);
+            let eq = self.eq;
+            let stats = self.dop.integrate(
+                |s, y: &[f64], d: &mut [f64]| eq.rhs(s, y, d),
+                a,
+                b,
+                &mut y,
+                n,
+                &self.tol,
+                &stops,
+                |_, y| out.extend_from_slice(&y[..n]),
+                |y| eq.project(y),
+            )?;
+            self.stats += stats;
+        }
+        debug_assert_eq!(out.len(), p + n * fine.len());
+        Ok(out)
+    }
+
     /// The residual alone (no sensitivities, so the Kirchhoff model
     /// integrates 12 instead of 48 equations): what finite differences in a
     /// parameter need.
@@ -194,6 +237,60 @@ impl<'a> ShootingSystem<'a> {
                 for i in 0..p {
                     r[n * (k - 1) + i] = g[i];
                 }
+            }
+        }
+        Ok(())
+    }
+
+    /// The zero Jacobian of this system in its almost block diagonal
+    /// shape: the free values u and K − 1 node states as unknowns,
+    /// K − 1 matching blocks and the tip conditions as rows.
+    pub fn staircase(&self) -> Staircase {
+        Staircase::zeros(self.eq.unknowns(), self.eq.dim(), self.segments)
+    }
+
+    /// The residual and its exact Jacobian in the almost block diagonal
+    /// shape of [`ShootingSystem::staircase`]: segment j contributes
+    /// ∂r_j/∂x_j = W Φ_j (W the inverse state scales) and
+    /// ∂r_j/∂x_{j+1} = −W, the last segment g'(Y(L)) Φ. O(K) memory, so
+    /// continuation on fine collocation meshes never forms the dense
+    /// matrix of [`NonlinearSystem::evaluate`].
+    pub fn evaluate_staircase(
+        &mut self,
+        x: &[f64],
+        r: &mut DVector<f64>,
+        a: &mut Staircase,
+    ) -> Result<(), IntegrationError> {
+        let (n, p, k) = (self.eq.dim(), self.eq.unknowns(), self.segments);
+        for j in 0..k {
+            let start = self.node_state(x, j);
+            let phi0 = if j == 0 {
+                self.eq.initial_sensitivity()
+            } else {
+                DMatrix::identity(n, n)
+            };
+            let (end, phi) = self.segment(j, &start, &phi0)?;
+            if j + 1 < k {
+                let next = self.node_state(x, j + 1);
+                let block = a.block_mut(j);
+                for i in 0..n {
+                    let w = 1.0 / self.scales[i];
+                    r[n * j + i] = (end[i] - next[i]) * w;
+                    for c in 0..phi.ncols() {
+                        block[(i, c)] = phi[(i, c)] * w;
+                    }
+                }
+                for (d, s) in a.coupling_mut(j).iter_mut().zip(&self.scales) {
+                    *d = -1.0 / s;
+                }
+            } else {
+                let mut g = vec![0.0; p];
+                self.eq.tip_residual(&end, &mut g);
+                let gj = self.eq.tip_residual_jacobian(&end) * &phi;
+                for i in 0..p {
+                    r[n * (k - 1) + i] = g[i];
+                }
+                a.block_mut(j).copy_from(&gj);
             }
         }
         Ok(())
@@ -272,40 +369,9 @@ impl NonlinearSystem for ShootingSystem<'_> {
         r: &mut DVector<f64>,
         jac: &mut DMatrix<f64>,
     ) -> Result<(), IntegrationError> {
-        let (n, p, k) = (self.eq.dim(), self.eq.unknowns(), self.segments);
-        jac.fill(0.0);
-        for j in 0..k {
-            let start = self.node_state(x, j);
-            let phi0 = if j == 0 {
-                self.eq.initial_sensitivity()
-            } else {
-                DMatrix::identity(n, n)
-            };
-            let (col, cols) = if j == 0 { (0, p) } else { (p + n * (j - 1), n) };
-            let (end, phi) = self.segment(j, &start, &phi0)?;
-            if j + 1 < k {
-                let next = self.node_state(x, j + 1);
-                for i in 0..n {
-                    let w = 1.0 / self.scales[i];
-                    r[n * j + i] = (end[i] - next[i]) * w;
-                    for c in 0..cols {
-                        jac[(n * j + i, col + c)] = phi[(i, c)] * w;
-                    }
-                    jac[(n * j + i, p + n * j + i)] = -w;
-                }
-            } else {
-                let mut g = vec![0.0; p];
-                self.eq.tip_residual(&end, &mut g);
-                let gj = self.eq.tip_residual_jacobian(&end) * &phi;
-                let row = n * (k - 1);
-                for i in 0..p {
-                    r[row + i] = g[i];
-                    for c in 0..cols {
-                        jac[(row + i, col + c)] = gj[(i, c)];
-                    }
-                }
-            }
-        }
+        let mut a = self.staircase();
+        self.evaluate_staircase(x, r, &mut a)?;
+        a.write_dense(jac);
         Ok(())
     }
 }

@@ -8,14 +8,25 @@
 //! whose Jacobian [F_x F_p; τ₀ᵀ] stays regular at a fold, where F_x alone
 //! is singular. The new tangent is the null vector of [F_x F_p] oriented
 //! along τ₀. Newton at a fixed p starts branches and lands them on bounds.
+//!
+//! Every linear solve uses the structure of the discretization
+//! ([`Linearization`]): single shooting's few unknowns by dense LU (the
+//! truncated SVD at a singular bordered matrix); multiple shooting and
+//! collocation, whose F_x is almost block diagonal, by band LU of F_x or of
+//! the banded embedding of the bordered matrix
+//! ([`crate::numerics::staircase`]), with its banded least squares at a
+//! singular one — O(N) work and memory per step.
 
 use nalgebra::{DMatrix, DVector};
 
 use super::{Family, Point, PointError, Run};
+use crate::numerics::dense::DenseLu;
 use crate::numerics::newton::{self, Damping, NewtonError, Options, System};
+use crate::numerics::staircase::{least_squares, Border, Staircase, StaircaseLu};
 
-/// Solves the bordered system by LU, or — where it is singular, exactly at
-/// a branch point — by the truncated SVD (the minimum-norm correction).
+/// Solves the dense bordered system by LU, or — where it is singular,
+/// exactly at a branch point — by the truncated SVD (the minimum-norm
+/// correction). Single shooting only: its systems have a few unknowns.
 fn bordered_solve(a: DMatrix<f64>, rhs: &DVector<f64>) -> Option<DVector<f64>> {
     let finite = |v: &DVector<f64>| v.iter().all(|x| x.is_finite());
     if let Some(x) = a.clone().lu().solve(rhs).filter(finite) {
@@ -29,15 +40,149 @@ fn bordered_solve(a: DMatrix<f64>, rhs: &DVector<f64>) -> Option<DVector<f64>> {
     svd.solve(rhs, tol).ok().filter(finite)
 }
 
+/// The most unknowns solved dense. Below it a dense LU of the bordered
+/// matrix costs about one evaluation of F, and small studies keep the
+/// results of the dense solver with its truncated SVD bit for bit: the
+/// arm's loading path (Sec. 4.4, 125 unknowns) runs its correctors at the
+/// noise floor of the integrated residual near λ = 0.976, where round-off
+/// in the solve decides whether a step converges (measured: accurate
+/// staircase solves, residual 1e-26 against right-hand sides 1e-10, still
+/// end that branch at λ = 0.9757 instead of 1).
+const DENSE_UP_TO: usize = 200;
+
+/// F_x at a point in the shape of the family's discretization: dense for
+/// single shooting and small systems, almost block diagonal
+/// ([`Staircase`]) for multiple shooting and collocation beyond
+/// [`DENSE_UP_TO`] unknowns, so that every step costs O(N) there.
+#[derive(Debug, Clone)]
+pub(super) enum Linearization {
+    /// The small dense F_x of single shooting or of a coarse mesh.
+    Dense(DMatrix<f64>),
+    /// The block-banded F_x of K > 1 segments or intervals.
+    Staircase(Staircase),
+}
+
+impl Linearization {
+    /// The zero F_x of the family's shape: a staircase above
+    /// [`DENSE_UP_TO`] unknowns, dense below.
+    fn of(family: &Family) -> Self {
+        if let Some(a) = family.staircase().filter(|a| a.size() > DENSE_UP_TO) {
+            Linearization::Staircase(a)
+        } else {
+            let n = family.size();
+            Linearization::Dense(DMatrix::zeros(n, n))
+        }
+    }
+
+    /// F(x, p) into `r` and F_x into self.
+    fn evaluate(
+        &mut self,
+        family: &Family,
+        x: &[f64],
+        p: f64,
+        r: &mut DVector<f64>,
+    ) -> Result<(), PointError> {
+        match self {
+            Linearization::Dense(fx) => family.residual(x, p, r, fx),
+            Linearization::Staircase(a) => family.residual_staircase(x, p, r, a),
+        }
+    }
+}
+
+/// The bordered matrix [F_x column; rowᵀ corner] factored in the shape of
+/// F_x, and its solves (the corrector's Newton steps and the tangent).
+#[derive(Debug, Clone, Default)]
+struct BorderedFactors {
+    lu: StaircaseLu,
+    factored: bool,
+    dense: Option<DMatrix<f64>>,
+}
+
+impl BorderedFactors {
+    /// Prepares the solves with [fx column; rowᵀ corner].
+    fn factor(&mut self, fx: &Linearization, column: &[f64], row: &[f64], corner: f64) {
+        match fx {
+            Linearization::Dense(fx) => {
+                let n = fx.nrows();
+                let a = self
+                    .dense
+                    .get_or_insert_with(|| DMatrix::zeros(n + 1, n + 1));
+                a.view_mut((0, 0), (n, n)).copy_from(fx);
+                for k in 0..n {
+                    a[(k, n)] = column[k];
+                    a[(n, k)] = row[k];
+                }
+                a[(n, n)] = corner;
+            }
+            Linearization::Staircase(a) => {
+                let border = Border {
+                    column,
+                    row,
+                    corner,
+                };
+                self.factored = self.lu.factor(a, Some(&border)).is_ok();
+            }
+        }
+    }
+
+    /// The solution of the factored system for `rhs` (length N + 1) into
+    /// `z`; the least-squares solution where the bordered matrix is
+    /// singular (an exact branch point), false where none is finite.
+    fn solve(
+        &mut self,
+        fx: &Linearization,
+        column: &[f64],
+        row: &[f64],
+        corner: f64,
+        rhs: &[f64],
+        z: &mut [f64],
+    ) -> bool {
+        match fx {
+            Linearization::Dense(_) => {
+                let Some(a) = self.dense.clone() else {
+                    return false;
+                };
+                match bordered_solve(a, &DVector::from_column_slice(rhs)) {
+                    Some(d) => {
+                        z.copy_from_slice(d.as_slice());
+                        true
+                    }
+                    None => false,
+                }
+            }
+            Linearization::Staircase(a) => {
+                let border = Border {
+                    column,
+                    row,
+                    corner,
+                };
+                if self.factored {
+                    self.lu.solve_bordered(a, &border, rhs, z)
+                } else {
+                    match least_squares(a, &border, rhs).filter(|y| y.iter().all(|v| v.is_finite()))
+                    {
+                        Some(y) => {
+                            z.copy_from_slice(&y);
+                            true
+                        }
+                        None => false,
+                    }
+                }
+            }
+        }
+    }
+}
+
 /// F(x, p) = 0 in x at a fixed parameter value p, for
 /// [`crate::numerics::newton`]: the family's residual and F_x, solved by
-/// dense LU.
+/// dense LU (single shooting) or band LU of the staircase.
 struct FixedParameter<'a> {
     family: &'a Family,
     p: f64,
     r: DVector<f64>,
-    fx: DMatrix<f64>,
-    lu: crate::numerics::dense::DenseLu,
+    fx: Linearization,
+    dense: DenseLu,
+    banded: StaircaseLu,
 }
 
 impl<'a> FixedParameter<'a> {
@@ -46,8 +191,9 @@ impl<'a> FixedParameter<'a> {
             family,
             p,
             r: DVector::zeros(n),
-            fx: DMatrix::zeros(n, n),
-            lu: crate::numerics::dense::DenseLu::default(),
+            fx: Linearization::of(family),
+            dense: DenseLu::default(),
+            banded: StaircaseLu::default(),
         }
     }
 }
@@ -60,18 +206,29 @@ impl System for FixedParameter<'_> {
     }
 
     fn residual(&mut self, x: &[f64], r: &mut [f64]) -> Result<(), PointError> {
-        self.family.residual(x, self.p, &mut self.r, &mut self.fx)?;
+        self.fx.evaluate(self.family, x, self.p, &mut self.r)?;
         r.copy_from_slice(self.r.as_slice());
         Ok(())
     }
 
     fn linearize(&mut self, _x: &[f64]) -> bool {
-        self.lu.factor(&self.fx);
-        true
+        match &self.fx {
+            Linearization::Dense(fx) => {
+                self.dense.factor(fx);
+                true
+            }
+            Linearization::Staircase(a) => self.banded.factor(a, None).is_ok(),
+        }
     }
 
     fn solve(&mut self, f: &[f64], delta: &mut [f64]) -> bool {
-        self.lu.newton_step(f, delta)
+        match &self.fx {
+            Linearization::Dense(_) => self.dense.newton_step(f, delta),
+            Linearization::Staircase(_) => {
+                delta.iter_mut().zip(f).for_each(|(d, v)| *d = -v);
+                self.banded.solve(delta)
+            }
+        }
     }
 }
 
@@ -94,8 +251,9 @@ struct PseudoArclength<'a> {
     tolerance: f64,
     r: DVector<f64>,
     /// F_x at the last evaluated point (the corrected one on success).
-    fx: DMatrix<f64>,
-    bordered: DMatrix<f64>,
+    fx: Linearization,
+    bordered: BorderedFactors,
+    rhs: Vec<f64>,
 }
 
 impl<'a> PseudoArclength<'a> {
@@ -114,8 +272,9 @@ impl<'a> PseudoArclength<'a> {
             fp,
             tolerance,
             r: DVector::zeros(n),
-            fx: DMatrix::zeros(n, n),
-            bordered: DMatrix::zeros(n + 1, n + 1),
+            fx: Linearization::of(family),
+            bordered: BorderedFactors::default(),
+            rhs: vec![0.0; n + 1],
         }
     }
 }
@@ -129,8 +288,7 @@ impl System for PseudoArclength<'_> {
 
     fn residual(&mut self, z: &[f64], r: &mut [f64]) -> Result<(), PointError> {
         let n = self.r.len();
-        self.family
-            .residual(&z[..n], z[n], &mut self.r, &mut self.fx)?;
+        self.fx.evaluate(self.family, &z[..n], z[n], &mut self.r)?;
         let arc: f64 = self
             .tangent
             .iter()
@@ -144,24 +302,24 @@ impl System for PseudoArclength<'_> {
 
     fn linearize(&mut self, _z: &[f64]) -> bool {
         let n = self.r.len();
-        let a = &mut self.bordered;
-        a.view_mut((0, 0), (n, n)).copy_from(&self.fx);
-        a.view_mut((0, n), (n, 1)).copy_from(&self.fp);
-        for (k, v) in self.tangent.iter().enumerate() {
-            a[(n, k)] = *v;
-        }
+        let (row, corner) = self.tangent.split_at(n);
+        self.bordered
+            .factor(&self.fx, self.fp.as_slice(), row, corner[0]);
         true
     }
 
     fn solve(&mut self, f: &[f64], delta: &mut [f64]) -> bool {
-        let rhs = -DVector::from_column_slice(f);
-        match bordered_solve(self.bordered.clone(), &rhs) {
-            Some(d) => {
-                delta.copy_from_slice(d.as_slice());
-                true
-            }
-            None => false,
-        }
+        let n = self.r.len();
+        self.rhs.iter_mut().zip(f).for_each(|(r, v)| *r = -v);
+        let (row, corner) = self.tangent.split_at(n);
+        self.bordered.solve(
+            &self.fx,
+            self.fp.as_slice(),
+            row,
+            corner[0],
+            &self.rhs,
+            delta,
+        )
     }
 
     fn residual_scales(&self) -> Vec<f64> {
@@ -175,7 +333,7 @@ impl System for PseudoArclength<'_> {
 const ARC_TOLERANCE: f64 = 1e-13;
 
 /// A converged corrector: (x, p), its iterations and F_x there.
-pub(super) type Corrected = (Vec<f64>, usize, DMatrix<f64>);
+pub(super) type Corrected = (Vec<f64>, usize, Linearization);
 
 /// A corrected step: unknowns, parameter, tangent, corrector iterations.
 pub(super) type Stepped = (Vec<f64>, f64, Vec<f64>, usize);
@@ -211,33 +369,32 @@ impl Run<'_> {
         p: f64,
         previous: &[f64],
     ) -> Result<Vec<f64>, PointError> {
-        let n = x.len();
-        let (mut r, mut fx) = (DVector::zeros(n), DMatrix::zeros(n, n));
-        self.family.residual(x, p, &mut r, &mut fx)?;
+        let mut fx = Linearization::of(self.family);
+        fx.evaluate(self.family, x, p, &mut DVector::zeros(x.len()))?;
         self.tangent_from(&fx, x, p, previous)
     }
 
-    /// The tangent with F_x already known at (x, p).
+    /// The tangent with F_x already known at (x, p): the solution of
+    /// [F_x F_p; previousᵀ] t = (0, 1), normalized.
     pub(super) fn tangent_from(
         &self,
-        fx: &DMatrix<f64>,
+        fx: &Linearization,
         x: &[f64],
         p: f64,
         previous: &[f64],
     ) -> Result<Vec<f64>, PointError> {
         let n = x.len();
         let fp = self.family.parameter_derivative(x, p)?;
-        let mut a = DMatrix::zeros(n + 1, n + 1);
-        a.view_mut((0, 0), (n, n)).copy_from(fx);
-        a.view_mut((0, n), (n, 1)).copy_from(&fp);
-        for (k, v) in previous.iter().enumerate() {
-            a[(n, k)] = *v;
-        }
-        let mut rhs = DVector::zeros(n + 1);
+        let (row, corner) = previous.split_at(n);
+        let mut rhs = vec![0.0; n + 1];
         rhs[n] = 1.0;
-        let t = bordered_solve(a, &rhs)
-            .filter(|t| t.iter().all(|v| v.is_finite()) && t.norm() > 0.0)
-            .ok_or(PointError::SingularTangent(p))?;
+        let mut factors = BorderedFactors::default();
+        factors.factor(fx, fp.as_slice(), row, corner[0]);
+        let mut t = DVector::zeros(n + 1);
+        let solved = factors.solve(fx, fp.as_slice(), row, corner[0], &rhs, t.as_mut_slice());
+        if !solved || !t.iter().all(|v| v.is_finite()) || t.norm() == 0.0 {
+            return Err(PointError::SingularTangent(p));
+        }
         let t = t.normalize();
         Ok(t.as_slice().to_vec())
     }

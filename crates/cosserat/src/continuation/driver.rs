@@ -186,7 +186,10 @@ impl<'a> Run<'a> {
         let raw = solve(&rod, &model, &solver)
             .map_err(|e| start_err(e.to_string()))?
             .unknowns;
-        let x = self.family.scaled(&raw);
+        let x = self
+            .family
+            .start_unknowns(&raw, p)
+            .map_err(|e| start_err(e.to_string()))?;
         let x = self
             .newton_at_fixed_p(x, p)
             .map_err(|e| start_err(e.to_string()))?;

@@ -18,6 +18,11 @@ use crate::bvp::{equations, ShootingSystem};
 use crate::equations::RodSample;
 use crate::model::{ModelLevel, Rod};
 use crate::numerics::integrator::{IntegrationError, Tolerances};
+use crate::numerics::staircase::Staircase;
+
+/// The most segments of the multiple shooting that solves the start of a
+/// branch ([`Family::method`]): its dense Newton costs O(K³).
+const START_SEGMENTS: usize = 32;
 
 /// A rod whose one number is the parameter: a [`Lens`] gives the rod at
 /// p, the family discretizes its equilibrium equations.
@@ -168,14 +173,33 @@ impl Family {
         Family::of_lens(lens, base, level, segments, tolerances)
     }
 
-    /// The BVP method of the family's discretization, or, for collocation,
-    /// the multiple shooting on the same nodes whose solution starts the
-    /// branch (Newton then moves it onto the collocation equations).
+    /// The BVP method that solves the start of a branch: shooting for a
+    /// single-shooting family, otherwise multiple shooting on at most
+    /// 32 equal segments (`START_SEGMENTS`) (its dense Newton costs O(K³), so
+    /// a fine family is started from a coarse solve):
+    /// [`Family::start_unknowns`] carries its solution onto the family's
+    /// nodes, and Newton at the start value (O(K), banded) then moves it
+    /// onto the family's equations (collocation or finer shooting).
     pub fn method(&self) -> crate::bvp::Method {
-        match self.segments {
+        match self.segments.min(START_SEGMENTS) {
             1 => crate::bvp::Method::Shooting,
             segments => crate::bvp::Method::MultipleShooting { segments },
         }
+    }
+
+    /// The family's (scaled) unknowns at p from the raw unknowns of a
+    /// solve by [`Family::method`]: the same vector when the segments
+    /// agree, otherwise the node states integrated from the coarse
+    /// solution ([`ShootingSystem::refined_unknowns`]), O(K).
+    pub fn start_unknowns(&self, raw: &[f64], p: f64) -> Result<Vec<f64>, PointError> {
+        let coarse = self.segments.min(START_SEGMENTS);
+        if coarse == self.segments {
+            return Ok(self.scaled(raw));
+        }
+        let rod = self.rod_at(p)?;
+        let eq = equations(&rod, self.level);
+        let mut sys = ShootingSystem::new(eq.as_ref(), coarse, self.tolerances);
+        Ok(self.scaled(&sys.refined_unknowns(raw, self.segments)?))
     }
 
     /// The length of the base rod (the problem's `rod.length`).
@@ -264,6 +288,36 @@ impl Family {
         for (mut column, w) in jac.column_iter_mut().zip(self.weights()) {
             column *= w;
         }
+        Ok(())
+    }
+
+    /// The zero F_x in the almost block diagonal shape of multiple
+    /// shooting and collocation (K > 1 segments or intervals), for
+    /// [`Family::residual_staircase`]; None for single shooting, whose
+    /// F_x is small and dense ([`Family::residual`]).
+    pub fn staircase(&self) -> Option<Staircase> {
+        if self.segments == 1 {
+            return None;
+        }
+        let eq = equations(&self.base, self.level);
+        Some(self.system(eq.as_ref()).staircase())
+    }
+
+    /// F(x, p) and F_x as [`Family::residual`], with F_x in the shape of
+    /// [`Family::staircase`]: O(K) memory and work, what every
+    /// continuation step on a fine mesh uses.
+    pub fn residual_staircase(
+        &self,
+        x: &[f64],
+        p: f64,
+        r: &mut DVector<f64>,
+        jac: &mut Staircase,
+    ) -> Result<(), PointError> {
+        let rod = self.rod_at(p)?;
+        let eq = equations(&rod, self.level);
+        let mut sys = self.system(eq.as_ref());
+        sys.evaluate_staircase(&self.unscaled(x), r, jac)?;
+        jac.scale_columns(&self.weights());
         Ok(())
     }
 

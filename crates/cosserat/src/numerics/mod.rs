@@ -1,7 +1,9 @@
 //! Numerical building blocks with nothing of rods in them: Gauss–Legendre
 //! quadrature tables ([`quadrature`]), scalar root finding and
 //! one-dimensional search ([`scalar`]), symmetric banded matrices with
-//! their LDLᵀ factorization and inertia ([`banded`]), the DOP853
+//! their LDLᵀ factorization and inertia ([`banded`]), general banded LU
+//! ([`band_lu`]) and the plain or bordered solves of the almost block
+//! diagonal Jacobians of multiple shooting ([`staircase`]), the DOP853
 //! integrator ([`integrator`]), the damped Newton method with its
 //! convergence test ([`newton`]) and a dense LU for its small systems
 //! ([`dense`]), and the eigensolvers of symmetric-definite banded pencils
@@ -11,6 +13,7 @@
 //! `stability::{banded, eigen, constrained}`, `bvp::integrator` and
 //! `bvp::newton::Convergence` remain as re-exports.
 
+pub mod band_lu;
 pub mod banded;
 pub mod constrained;
 pub mod dense;
@@ -19,3 +22,4 @@ pub mod integrator;
 pub mod newton;
 pub mod quadrature;
 pub mod scalar;
+pub mod staircase;
