@@ -28,6 +28,7 @@ use nalgebra::{DMatrix, DVector};
 use super::{Point, Run, SpecialKind, SpecialPoint};
 use crate::model::ModelLevel;
 use crate::numerics::scalar::{End, Illinois};
+use crate::numerics::staircase::StaircaseLu;
 use crate::stability::Block;
 
 /// A test function along the step from a point: f(σ) and the point there.
@@ -183,7 +184,24 @@ impl Run<'_> {
         Some(j)
     }
 
+    /// det F_x, dense up to [`super::corrector::DENSE_UP_TO`] unknowns;
+    /// above, from the O(N) staircase factors as sign · |det|^(1/N) (the
+    /// geometric mean of the pivots: the same sign and root, without the
+    /// overflow of a product of thousands of pivots).
     fn det(&self, x: &[f64], p: f64) -> Option<f64> {
+        let n = x.len();
+        if n > super::corrector::DENSE_UP_TO {
+            if let Some(mut a) = self.family.staircase() {
+                let mut r = DVector::zeros(n);
+                self.family.residual_staircase(x, p, &mut r, &mut a).ok()?;
+                let mut lu = StaircaseLu::default();
+                if lu.factor(&a, None).is_err() {
+                    return Some(0.0);
+                }
+                let (sign, log) = lu.log_determinant()?;
+                return Some(sign * (log / n as f64).exp());
+            }
+        }
         Some(self.jacobian(x, p)?.determinant())
     }
 
