@@ -223,7 +223,7 @@ impl<'a> ShootingSystem<'a> {
                 .collect();
             let mut y = self.node_state(x, j);
             let eq = self.eq;
-            let stats = self.dop.integrate(
+            let stats = self.dop.integrate_sampled(
                 |s, y: &[f64], d: &mut [f64]| eq.rhs(s, y, d),
                 a,
                 b,
