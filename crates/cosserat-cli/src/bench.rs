@@ -1,7 +1,7 @@
 //! `cosserat bench work-precision`: error against wall time for every
 //! method and order on scenes with independent references.
 //! `cosserat bench continue PROBLEM`: the wall time of a problem's whole
-//! bifurcation diagram beside its summary (see [`continue_diagram`]).
+//! bifurcation diagram beside its summary.
 //!
 //! Scenes: the planar cantilever under a tip force k = F L²/B = 3 and 10
 //! (reference: the elliptic-integral closed form of Bisshopp & Drucker,
@@ -39,11 +39,11 @@ pub enum BenchCommand {
         #[arg(short, long, default_value = "work-precision")]
         output: PathBuf,
     },
-    /// Wall time of a problem's whole [continuation] diagram (median, min,
+    /// Wall time of a problem's whole `[continuation]` diagram (median, min,
     /// max after one warm-up run) with the diagram's branches and special
     /// points, so that speed and accuracy are read together.
     Continue {
-        /// The problem file (TOML) with a [continuation] table.
+        /// The problem file (TOML) with a `[continuation]` table.
         problem: PathBuf,
         /// Override any key of the problem file, e.g. --set continuation.elements=32.
         #[arg(long = "set", value_name = "KEY=VALUE")]

@@ -26,7 +26,7 @@ use crate::stability::{
 };
 
 /// Tracked modes: per block, the eigenvector of each tracked eigenvalue (in
-/// tracked order), then the [`GUARD`] next Ritz vectors that keep the warm
+/// tracked order), then the `GUARD` (2) next Ritz vectors that keep the warm
 /// start of the next point converging fast.
 pub type Modes = Vec<Vec<Vec<f64>>>;
 
