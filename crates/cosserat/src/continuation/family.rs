@@ -427,7 +427,7 @@ impl Family {
         let rod = self.rod_at(p)?;
         let eq = equations(&rod, self.level);
         let mut sys = self.system(eq.as_ref());
-        Ok(sys.sample(&self.unscaled(x), points)?.0)
+        Ok(sys.sample_interpolated(&self.unscaled(x), points)?.0)
     }
 
     /// The tip sample (position, directors) at (x, p).

@@ -191,50 +191,20 @@ impl Dop853 {
         P: FnMut(&mut [f64]),
     {
         let span = (s0, s1, controlled);
-        self.drive(f, span, y, tol, stops, Stops::Landed, observe, project)
+        self.integrate_serving(f, span, y, tol, stops, Stops::Landed, observe, project)
     }
 
-    /// As [`Dop853::integrate`], but the steps ignore `stops`: the state
-    /// at each stop inside a step comes from DOP853's continuous extension
-    /// of order 7 (Hairer, Nørsett & Wanner, Sec. II.6 and dop853.f,
-    /// `contd8`; three more evaluations per step that holds a stop), then
-    /// `project`ed, so that many output points cost no more steps than the
-    /// tolerance needs.
+    /// As [`Dop853::integrate`] with `span` = (s0, s1, controlled), the
+    /// `stops` served as `serve` says: [`Stops::Landed`] is `integrate`;
+    /// with [`Stops::Interpolated`] the steps ignore the stops and the
+    /// state at each stop inside a step comes from DOP853's continuous
+    /// extension of order 7 (Hairer, Nørsett & Wanner, Sec. II.6;
+    /// dop853.f, `contd8`; four more evaluations per step that holds a
+    /// stop, one of them the next step's first stage), then `project`ed,
+    /// so that many output points cost no more steps than the tolerance
+    /// needs. A stop at a step's end is the state itself.
     #[allow(clippy::too_many_arguments)]
-    pub fn integrate_sampled<F, O, P>(
-        &mut self,
-        f: F,
-        s0: f64,
-        s1: f64,
-        y: &mut [f64],
-        controlled: usize,
-        tol: &Tolerances,
-        stops: &[f64],
-        observe: O,
-        project: P,
-    ) -> Result<IntegrationStats, IntegrationError>
-    where
-        F: FnMut(f64, &[f64], &mut [f64]),
-        O: FnMut(f64, &[f64]),
-        P: FnMut(&mut [f64]),
-    {
-        let span = (s0, s1, controlled);
-        self.drive(
-            f,
-            span,
-            y,
-            tol,
-            stops,
-            Stops::Interpolated,
-            observe,
-            project,
-        )
-    }
-
-    /// The step loop of both ways to serve `stops`; `span` is (s0, s1,
-    /// controlled components).
-    #[allow(clippy::too_many_arguments)]
-    fn drive<F, O, P>(
+    pub fn integrate_serving<F, O, P>(
         &mut self,
         mut f: F,
         span: (f64, f64, usize),
@@ -312,7 +282,12 @@ impl Dop853 {
                     stats.evaluations += self.extend(&mut f, start, step, y);
                     let mut dense = self.dense.take().expect("built by interpolant");
                     for &t in &stops[next_stop..next_stop + inside] {
-                        observe(t, dense.at((t - start) / step, &mut project));
+                        // The step's end is the state itself, as when landed.
+                        if t == s {
+                            observe(t, y);
+                        } else {
+                            observe(t, dense.at((t - start) / step, &mut project));
+                        }
                     }
                     // f(s, y) is the extension's first extra stage.
                     self.k[0].copy_from_slice(dense.end_slope());
@@ -431,9 +406,9 @@ impl Dop853 {
     }
 }
 
-/// How [`Dop853::drive`] serves the output points.
+/// How [`Dop853::integrate_serving`] serves the output points.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Stops {
+pub enum Stops {
     /// Steps land on every stop.
     Landed,
     /// Stops inside a step are read from the continuous extension.
