@@ -258,8 +258,12 @@ impl Tracker {
             .position(|&b| b == block)
             .expect("a tracked block");
         let (k, g, constraints) = &mats[bi];
-        let pairs = self.pairs(bi, k, g, constraints, None)?;
-        let i = (0..self.opts.eigenvalues().min(pairs.values.len()))
+        // The full solve, never the warm start: the located point and its
+        // null mode (sign included) must not depend on the path that led
+        // there, so that a resumed diagram is the uninterrupted one.
+        let pairs = lowest_eigenpairs_constrained(k, g, constraints, self.opts.eigenvalues(), None)
+            .map_err(|e| PointError::Eigen(e.to_string()))?;
+        let i = (0..pairs.values.len())
             .min_by(|&a, &b| pairs.values[a].abs().total_cmp(&pairs.values[b].abs()))
             .expect("at least one eigenvalue");
         Ok((
