@@ -142,10 +142,16 @@ impl Ritz {
     fn project(&mut self) -> Option<()> {
         let p = self.basis.len();
         let (w, kw, gw) = (&self.basis, &self.k_basis, &self.g_basis);
-        let sym =
-            |a: &[Vec<f64>], i: usize, j: usize| 0.5 * (dot(&w[i], &a[j]) + dot(&w[j], &a[i]));
-        let kr = DMatrix::from_fn(p, p, |i, j| sym(kw, i, j));
-        let gr = DMatrix::from_fn(p, p, |i, j| sym(gw, i, j));
+        // One product per pair i ≤ j; the lower triangle mirrors it.
+        let (mut kr, mut gr) = (DMatrix::zeros(p, p), DMatrix::zeros(p, p));
+        for i in 0..p {
+            for j in i..p {
+                kr[(i, j)] = dot(&w[i], &kw[j]);
+                kr[(j, i)] = kr[(i, j)];
+                gr[(i, j)] = dot(&w[i], &gw[j]);
+                gr[(j, i)] = gr[(i, j)];
+            }
+        }
         let l_inv = gr.cholesky()?.l().try_inverse()?;
         let c = &l_inv * kr * l_inv.transpose();
         let eig = ((&c + c.transpose()) * 0.5).symmetric_eigen();
