@@ -204,14 +204,13 @@ mod tests {
         let mut y = [1.0];
         let mut dop = Dop853::new(1);
         let sampled = dop
-            .integrate_sampled(
+            .integrate_serving(
                 rhs,
-                0.0,
-                1.0,
+                (0.0, 1.0, 1),
                 &mut y,
-                1,
                 &tol,
                 &stops,
+                super::super::Stops::Interpolated,
                 |s, y| seen.push((s, y[0])),
                 |_| {},
             )
