@@ -1,5 +1,7 @@
 //! `cosserat bench work-precision`: error against wall time for every
 //! method and order on scenes with independent references.
+//! `cosserat bench continue PROBLEM`: the wall time of a problem's whole
+//! bifurcation diagram beside its summary.
 //!
 //! Scenes: the planar cantilever under a tip force k = F L²/B = 3 and 10
 //! (reference: the elliptic-integral closed form of Bisshopp & Drucker,
@@ -37,6 +39,19 @@ pub enum BenchCommand {
         #[arg(short, long, default_value = "work-precision")]
         output: PathBuf,
     },
+    /// Wall time of a problem's whole `[continuation]` diagram (median, min,
+    /// max after one warm-up run) with the diagram's branches and special
+    /// points, so that speed and accuracy are read together.
+    Continue {
+        /// The problem file (TOML) with a `[continuation]` table.
+        problem: PathBuf,
+        /// Override any key of the problem file, e.g. --set continuation.elements=32.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+        /// Timed runs after the warm-up.
+        #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..))]
+        repeat: u32,
+    },
 }
 
 /// Runs a benchmark; the exit code of the command.
@@ -49,7 +64,91 @@ pub fn run(command: BenchCommand) -> ExitCode {
                 ExitCode::from(3)
             }
         },
+        BenchCommand::Continue {
+            problem,
+            set,
+            repeat,
+        } => continue_diagram(&problem, &set, repeat as usize),
     }
+}
+
+/// `cosserat bench continue`: one warm-up run of the problem's diagram
+/// (detection, location, switching, every branch to its end), then
+/// `repeat` timed runs in this process; prints the median, min and max
+/// wall time and the diagram of the last run (branches with their points
+/// and stop reasons, special points with their parameter to 12 digits).
+/// Exit 2 for a bad problem, 3 when the diagram cannot start.
+fn continue_diagram(path: &Path, set: &[String], repeat: usize) -> ExitCode {
+    use crate::exit::{fail, BAD_INPUT, NO_RESULT};
+    use cosserat::continuation::continuation;
+    let problem = match cosserat::input::Problem::from_path(path, set) {
+        Ok(p) => p,
+        Err(e) => return fail(BAD_INPUT, format!("{}: {e}", path.display())),
+    };
+    let Some((family, opts)) = &problem.continuation else {
+        return fail(
+            BAD_INPUT,
+            format!(
+                "{}: continuation: the problem has no [continuation] table",
+                path.display()
+            ),
+        );
+    };
+    let mut times = Vec::with_capacity(repeat);
+    let mut last = None;
+    for run in 0..=repeat {
+        let t = Instant::now();
+        let diagram = match continuation(family, opts, &mut |_, _| true) {
+            Ok(d) => d,
+            Err(e) => return fail(NO_RESULT, e),
+        };
+        if run > 0 {
+            times.push(t.elapsed().as_secs_f64());
+        }
+        last = Some(diagram);
+    }
+    let diagram = last.expect("at least the warm-up run");
+    times.sort_by(f64::total_cmp);
+    println!("problem   {}", path.display());
+    println!(
+        "time      median {:.3} ms, min {:.3} ms, max {:.3} ms over {repeat} runs (after 1 warm-up)",
+        median(times.clone()) * 1e3,
+        times[0] * 1e3,
+        times[times.len() - 1] * 1e3
+    );
+    print!("{}", diagram_summary(&diagram));
+    ExitCode::SUCCESS
+}
+
+/// Branches and special points of a diagram, one line each.
+fn diagram_summary(d: &cosserat::continuation::Diagram) -> String {
+    let mut out = String::new();
+    for w in &d.warnings {
+        let _ = writeln!(out, "warning   {w}");
+    }
+    for (i, b) in d.branches.iter().enumerate() {
+        let (first, last) = (b.points.first(), b.points.last());
+        let _ = writeln!(
+            out,
+            "branch {i}  {} points, parameter {:.12} → {:.12}; {}",
+            b.points.len(),
+            first.map_or(f64::NAN, |p| p.parameter),
+            last.map_or(f64::NAN, |p| p.parameter),
+            b.stop_reason
+        );
+    }
+    for (i, s) in d.special_points.iter().enumerate() {
+        let _ = writeln!(
+            out,
+            "special {i}  {} on branch {} at parameter {:.12}, {} block, Morse index {}",
+            s.kind.name(),
+            s.branch,
+            s.point.parameter,
+            s.block.name(),
+            s.point.morse_index
+        );
+    }
+    out
 }
 
 /// One point of a work-precision curve.

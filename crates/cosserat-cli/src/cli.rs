@@ -182,7 +182,8 @@ pub enum Command {
         #[arg(long)]
         force: bool,
     },
-    /// Benchmarks: `cosserat bench work-precision [-o DIR]`.
+    /// Benchmarks: `cosserat bench work-precision [-o DIR]`,
+    /// `cosserat bench continue PROBLEM [--set KEY=VALUE ...] [--repeat N]`.
     Bench {
         /// Which benchmark.
         #[command(subcommand)]

@@ -167,3 +167,32 @@ fn interrupted_run_resumes_to_the_same_diagram() {
     assert_eq!(left.len(), 2, "no lock or temporary file left: {left:?}");
     std::fs::remove_dir_all(dir).unwrap();
 }
+
+/// `cosserat bench continue` prints its timing and the diagram it timed:
+/// the median, and the in-plane branch point of the Euler column at
+/// π²/4 (Euler 1744) to the 12 digits it prints. No timing is asserted.
+#[test]
+fn bench_continue_names_the_median_and_the_special_points() {
+    let file = shipped("euler_column");
+    let o = std::process::Command::new(BIN)
+        .args(["bench", "continue", &file, "--repeat", "2"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("median"), "{text}");
+    assert!(text.contains("over 2 runs"), "{text}");
+    let in_plane = text
+        .lines()
+        .find(|l| l.starts_with("special") && l.contains("branch_point") && l.contains("in_plane"))
+        .unwrap_or_else(|| panic!("no in-plane branch point in\n{text}"));
+    let p: f64 = in_plane
+        .split("at parameter ")
+        .nth(1)
+        .and_then(|r| r.split(',').next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no parameter in {in_plane}"));
+    let euler = std::f64::consts::PI.powi(2) / 4.0;
+    assert!((p - euler).abs() < 1e-10, "{p} against π²/4 = {euler}");
+    assert!(text.contains("out_of_plane"), "{text}");
+}

@@ -16,7 +16,7 @@ use super::collocation::Tableau;
 use super::gauss_step::gauss_step;
 use super::newton::NonlinearSystem;
 use crate::equations::{RodEquations, RodSample};
-use crate::numerics::integrator::{Dop853, IntegrationError, IntegrationStats, Tolerances};
+use crate::numerics::integrator::{Dop853, IntegrationError, IntegrationStats, Stops, Tolerances};
 use crate::numerics::staircase::Staircase;
 
 /// The shooting formulation of a rod BVP on K segments.
@@ -308,6 +308,26 @@ impl<'a> ShootingSystem<'a> {
         x: &[f64],
         points: &[f64],
     ) -> Result<(Vec<RodSample>, f64), IntegrationError> {
+        self.sample_served(x, points, Stops::Landed)
+    }
+
+    /// As [`ShootingSystem::sample`], the points between steps read from
+    /// the integrator's continuous extension ([`Stops::Interpolated`]):
+    /// many points for the cost of the steps the tolerance needs.
+    pub fn sample_interpolated(
+        &mut self,
+        x: &[f64],
+        points: &[f64],
+    ) -> Result<(Vec<RodSample>, f64), IntegrationError> {
+        self.sample_served(x, points, Stops::Interpolated)
+    }
+
+    fn sample_served(
+        &mut self,
+        x: &[f64],
+        points: &[f64],
+        serve: Stops,
+    ) -> Result<(Vec<RodSample>, f64), IntegrationError> {
         let n = self.eq.dim();
         let mut samples = Vec::with_capacity(points.len());
         for j in 0..self.segments {
@@ -320,14 +340,13 @@ impl<'a> ShootingSystem<'a> {
                 .collect();
             let mut y = self.node_state(x, j);
             let eq = self.eq;
-            let stats = self.dop.integrate(
+            let stats = self.dop.integrate_serving(
                 |s, y: &[f64], d: &mut [f64]| eq.rhs(s, y, d),
-                a,
-                b,
+                (a, b, n),
                 &mut y,
-                n,
                 &self.tol,
                 &stops,
+                serve,
                 |s, y| samples.push(eq.sample(s, y)),
                 |y| eq.project(y),
             )?;

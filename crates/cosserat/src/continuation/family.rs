@@ -37,6 +37,8 @@ pub struct Family {
     /// intervals (one Gauss step each) rather than integrated segments.
     stages: Option<usize>,
     tolerances: Tolerances,
+    /// The unknowns' scales, computed once ([`Family::cached_weights`]).
+    weights: std::sync::OnceLock<Vec<f64>>,
 }
 
 /// Why a rod could not be built at a parameter value.
@@ -117,6 +119,7 @@ impl Family {
             segments: segments.max(1),
             stages: None,
             tolerances,
+            weights: std::sync::OnceLock::new(),
         }
     }
 
@@ -264,12 +267,18 @@ impl Family {
 
     /// The family's unknowns of raw shooting unknowns.
     pub fn scaled(&self, raw: &[f64]) -> Vec<f64> {
-        raw.iter().zip(self.weights()).map(|(v, w)| v / w).collect()
+        raw.iter()
+            .zip(self.cached_weights())
+            .map(|(v, w)| v / w)
+            .collect()
     }
 
     /// The raw shooting unknowns of the family's unknowns.
     pub fn unscaled(&self, x: &[f64]) -> Vec<f64> {
-        x.iter().zip(self.weights()).map(|(v, w)| v * w).collect()
+        x.iter()
+            .zip(self.cached_weights())
+            .map(|(v, w)| v * w)
+            .collect()
     }
 
     /// F(x, p) and F_x (with respect to the family's scaled unknowns), the
@@ -285,8 +294,8 @@ impl Family {
         let eq = equations(&rod, self.level);
         let mut sys = self.system(eq.as_ref());
         sys.evaluate(&self.unscaled(x), r, jac)?;
-        for (mut column, w) in jac.column_iter_mut().zip(self.weights()) {
-            column *= w;
+        for (mut column, w) in jac.column_iter_mut().zip(self.cached_weights()) {
+            column *= *w;
         }
         Ok(())
     }
@@ -317,7 +326,7 @@ impl Family {
         let eq = equations(&rod, self.level);
         let mut sys = self.system(eq.as_ref());
         sys.evaluate_staircase(&self.unscaled(x), r, jac)?;
-        jac.scale_columns(&self.weights());
+        jac.scale_columns(self.cached_weights());
         Ok(())
     }
 
@@ -361,7 +370,7 @@ impl Family {
         let rod = self.rod_at(p)?;
         let eq = equations(&rod, self.level);
         let mut sys = self.system(eq.as_ref());
-        Ok(sys.sample(&self.unscaled(x), points)?.0)
+        Ok(sys.sample_interpolated(&self.unscaled(x), points)?.0)
     }
 
     /// The tip sample (position, directors) at (x, p).
@@ -396,4 +405,17 @@ pub enum PointError {
 pub fn tip_angle(clamp: &Matrix3<f64>, tip: &RodSample) -> f64 {
     let t0 = clamp.column(2);
     tip.directors[2].dot(&t0).clamp(-1.0, 1.0).acos()
+}
+
+/// What the residual evaluation computes once per family instead of at
+/// every call.
+impl Family {
+    /// [`Family::weights`], computed on first use: they depend on the base
+    /// rod, the level and the segments only, none of which changes after
+    /// construction, and each computation builds the equations and their
+    /// state scales (65 evaluations of the energy for the intrinsic
+    /// moment) — twice per residual with its Jacobian before.
+    fn cached_weights(&self) -> &[f64] {
+        self.weights.get_or_init(|| self.weights())
+    }
 }

@@ -4,12 +4,20 @@
 //! tracker matches each new eigenvector to the previous one it overlaps
 //! most in the G (L²) inner product, so that a column of the diagram is one
 //! mode.
+//!
+//! Each point's eigenpairs start from the previous point's vectors
+//! ([`crate::numerics::subspace`]: a few shift-invert sweeps with
+//! Rayleigh–Ritz, certified by one Sturm count); the full solve runs only at
+//! the first point of a branch, on a constrained pencil, and where the warm
+//! start cannot vouch for its pairs.
 
 use nalgebra::Vector3;
 
 use super::family::{Family, PointError};
 use crate::equations::RodSample;
 use crate::numerics::banded::SymmetricBanded;
+use crate::numerics::eigen::Eigenpairs;
+use crate::numerics::subspace::lowest_eigenpairs_from;
 use crate::stability::constrained::{
     count_below_constrained, lowest_eigenpairs_constrained, Constraints,
 };
@@ -17,15 +25,21 @@ use crate::stability::{
     coefficients, support_constraints, Block, FiniteElements, StabilityOptions,
 };
 
-/// Tracked modes: per block, per tracked eigenvalue, its eigenvector.
+/// Tracked modes: per block, the eigenvector of each tracked eigenvalue (in
+/// tracked order), then the `GUARD` (2) next Ritz vectors that keep the warm
+/// start of the next point converging fast.
 pub type Modes = Vec<Vec<Vec<f64>>>;
+
+/// Ritz vectors carried beyond the tracked ones: the warm start's error in
+/// λ_i shrinks by (λ_i − σ)/(λ_{count+GUARD+1} − σ) per sweep.
+pub const GUARD: usize = 2;
 
 /// The measured spectrum at one point.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Spectrum {
     /// Tracked eigenvalues, block after block.
     pub values: Vec<f64>,
-    /// Eigenvectors per block, in tracked order.
+    /// Eigenvectors per block, in tracked order, then the guard vectors.
     pub vectors: Modes,
     /// Morse index per block.
     pub block_morse: Vec<usize>,
@@ -176,13 +190,12 @@ impl Tracker {
                     // One tracked eigenvalue: it is both of the lowest two.
                     (b[0], *b.get(1).unwrap_or(&b[0]))
                 });
-            let pairs =
-                lowest_eigenpairs_constrained(k, g, constraints, self.opts.eigenvalues(), near)
-                    .map_err(|e| PointError::Eigen(e.to_string()))?;
+            let pairs = self.pairs(bi, k, g, constraints, near)?;
+            let count = self.opts.eigenvalues();
             // Every block fills its `eigenvalues` columns of the diagram; a
             // mesh with fewer unknowns than that cannot (the eigensolver
             // returns at most the block's dimension).
-            if pairs.values.len() != self.opts.eigenvalues() {
+            if pairs.values.len() < count {
                 return Err(PointError::Eigen(format!(
                     "the {} block has only {} eigenvalues on {} elements of order {}, \
                      {} are tracked: lower continuation.eigenvalues or raise continuation.elements",
@@ -193,15 +206,17 @@ impl Tracker {
                     self.opts.eigenvalues()
                 )));
             }
+            let (tracked, guard) = pairs.vectors.split_at(count);
             let order = match &self.previous {
-                Some(prev) => match_modes(&prev[bi], &pairs.vectors, g),
-                None => (0..pairs.values.len()).collect(),
+                Some(prev) => match_modes(&prev[bi][..count.min(prev[bi].len())], tracked, g),
+                None => (0..count).collect(),
             };
             values.extend(order.iter().map(|&i| pairs.values[i]));
             vectors.push(
                 order
                     .iter()
-                    .map(|&i| pairs.vectors[i].clone())
+                    .map(|&i| tracked[i].clone())
+                    .chain(guard.iter().cloned())
                     .collect::<Vec<_>>(),
             );
             block_morse.push(
@@ -243,6 +258,9 @@ impl Tracker {
             .position(|&b| b == block)
             .expect("a tracked block");
         let (k, g, constraints) = &mats[bi];
+        // The full solve, never the warm start: the located point and its
+        // null mode (sign included) must not depend on the path that led
+        // there, so that a resumed diagram is the uninterrupted one.
         let pairs = lowest_eigenpairs_constrained(k, g, constraints, self.opts.eigenvalues(), None)
             .map_err(|e| PointError::Eigen(e.to_string()))?;
         let i = (0..pairs.values.len())
@@ -252,6 +270,39 @@ impl Tracker {
             pairs.values[i],
             fe.nodal_rotations(block, &pairs.vectors[i]),
         ))
+    }
+}
+
+impl Tracker {
+    /// The lowest `eigenvalues` + [`GUARD`] eigenpairs of block `bi`
+    /// (fewer when the block has fewer unknowns), in increasing order:
+    /// warm-started from the previous point's vectors when there are such
+    /// and the pencil is unconstrained, else — or when the warm start
+    /// cannot vouch for its pairs — the full solve, its shift placed by
+    /// `near` (the previous lowest two eigenvalues).
+    fn pairs(
+        &self,
+        bi: usize,
+        k: &SymmetricBanded,
+        g: &SymmetricBanded,
+        constraints: &Constraints,
+        near: Option<(f64, f64)>,
+    ) -> Result<Eigenpairs, PointError> {
+        let count = self.opts.eigenvalues();
+        let warm = self
+            .previous
+            .as_ref()
+            .and_then(|prev| prev.get(bi))
+            .filter(|_| constraints.count() == 0)
+            .and_then(|start| lowest_eigenpairs_from(k, g, count, start));
+        match warm {
+            Some(pairs) => Ok(pairs),
+            // With the guard vectors when they converge too; else the
+            // tracked ones alone (the next point then solves in full again).
+            None => lowest_eigenpairs_constrained(k, g, constraints, count + GUARD, near)
+                .or_else(|_| lowest_eigenpairs_constrained(k, g, constraints, count, near))
+                .map_err(|e| PointError::Eigen(e.to_string())),
+        }
     }
 }
 

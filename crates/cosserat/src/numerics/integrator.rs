@@ -13,6 +13,8 @@
 // The tableau is kept digit for digit as published (dop853.f).
 #![allow(clippy::excessive_precision)]
 
+mod dense;
+
 /// Tolerances and limits of one integration.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Tolerances {
@@ -144,6 +146,8 @@ pub struct Dop853 {
     k: Vec<Vec<f64>>,
     stage: Vec<f64>,
     next: Vec<f64>,
+    /// The continuous extension, built on the first interpolated stop.
+    dense: Option<dense::Interpolant>,
 }
 
 impl Dop853 {
@@ -153,6 +157,7 @@ impl Dop853 {
             k: vec![vec![0.0; n]; 12],
             stage: vec![0.0; n],
             next: vec![0.0; n],
+            dense: None,
         }
     }
 
@@ -170,13 +175,43 @@ impl Dop853 {
     #[allow(clippy::too_many_arguments)]
     pub fn integrate<F, O, P>(
         &mut self,
-        mut f: F,
+        f: F,
         s0: f64,
         s1: f64,
         y: &mut [f64],
         controlled: usize,
         tol: &Tolerances,
         stops: &[f64],
+        observe: O,
+        project: P,
+    ) -> Result<IntegrationStats, IntegrationError>
+    where
+        F: FnMut(f64, &[f64], &mut [f64]),
+        O: FnMut(f64, &[f64]),
+        P: FnMut(&mut [f64]),
+    {
+        let span = (s0, s1, controlled);
+        self.integrate_serving(f, span, y, tol, stops, Stops::Landed, observe, project)
+    }
+
+    /// As [`Dop853::integrate`] with `span` = (s0, s1, controlled), the
+    /// `stops` served as `serve` says: [`Stops::Landed`] is `integrate`;
+    /// with [`Stops::Interpolated`] the steps ignore the stops and the
+    /// state at each stop inside a step comes from DOP853's continuous
+    /// extension of order 7 (Hairer, Nørsett & Wanner, Sec. II.6;
+    /// dop853.f, `contd8`; four more evaluations per step that holds a
+    /// stop, one of them the next step's first stage), then `project`ed,
+    /// so that many output points cost no more steps than the tolerance
+    /// needs. A stop at a step's end is the state itself.
+    #[allow(clippy::too_many_arguments)]
+    pub fn integrate_serving<F, O, P>(
+        &mut self,
+        mut f: F,
+        span: (f64, f64, usize),
+        y: &mut [f64],
+        tol: &Tolerances,
+        stops: &[f64],
+        serve: Stops,
         mut observe: O,
         mut project: P,
     ) -> Result<IntegrationStats, IntegrationError>
@@ -185,6 +220,7 @@ impl Dop853 {
         O: FnMut(f64, &[f64]),
         P: FnMut(&mut [f64]),
     {
+        let (s0, s1, controlled) = span;
         let n = y.len();
         self.resize(n);
         let mut stats = IntegrationStats::default();
@@ -206,7 +242,10 @@ impl Dop853 {
                     steps: tol.max_steps,
                 });
             }
-            let target = stops.get(next_stop).copied().unwrap_or(s1).min(s1);
+            let target = match serve {
+                Stops::Landed => stops.get(next_stop).copied().unwrap_or(s1).min(s1),
+                Stops::Interpolated => s1,
+            };
             let lands = s + h >= target - 1e-14 * target.abs().max(1.0);
             let step = if lands { target - s } else { h };
             if step.abs() <= 10.0 * f64::EPSILON * s.abs().max(1.0) && !lands {
@@ -227,14 +266,37 @@ impl Dop853 {
             let factor = (0.9 * err.powf(-1.0 / 8.0)).clamp(0.333, 6.0);
             if err <= 1.0 {
                 stats.accepted += 1;
+                let start = s;
                 s = if lands { target } else { s + step };
+                let inside = stops[next_stop..].partition_point(|&t| t <= s);
+                if serve == Stops::Interpolated && inside > 0 {
+                    // The extension needs y and f at the step's start.
+                    self.interpolant(n).start(y);
+                }
                 y.copy_from_slice(&self.next);
                 project(y);
                 if y.iter().any(|v| !v.is_finite()) {
                     return Err(IntegrationError::NotFinite { s });
                 }
-                f(s, y, &mut self.k[0]);
-                stats.evaluations += 1;
+                if serve == Stops::Interpolated && inside > 0 {
+                    stats.evaluations += self.extend(&mut f, start, step, y);
+                    let mut dense = self.dense.take().expect("built by interpolant");
+                    for &t in &stops[next_stop..next_stop + inside] {
+                        // The step's end is the state itself, as when landed.
+                        if t == s {
+                            observe(t, y);
+                        } else {
+                            observe(t, dense.at((t - start) / step, &mut project));
+                        }
+                    }
+                    // f(s, y) is the extension's first extra stage.
+                    self.k[0].copy_from_slice(dense.end_slope());
+                    self.dense = Some(dense);
+                    next_stop += inside;
+                } else {
+                    f(s, y, &mut self.k[0]);
+                    stats.evaluations += 1;
+                }
                 if lands && next_stop < stops.len() && target == stops[next_stop] {
                     observe(s, y);
                     next_stop += 1;
@@ -342,6 +404,15 @@ impl Dop853 {
         }
         h.abs() * err5 * (1.0 / (controlled as f64 * deno)).sqrt()
     }
+}
+
+/// How [`Dop853::integrate_serving`] serves the output points.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Stops {
+    /// Steps land on every stop.
+    Landed,
+    /// Stops inside a step are read from the continuous extension.
+    Interpolated,
 }
 
 /// y += a x.

@@ -8,7 +8,8 @@
 //! convergence test ([`newton`]) and a dense LU for its small systems
 //! ([`dense`]), and the eigensolvers of symmetric-definite banded pencils
 //! (K, G): inertia counts, shift-invert Lanczos ([`eigen`]), and the pencil
-//! restricted to the null space of a few constraints ([`constrained`]).
+//! restricted to the null space of a few constraints ([`constrained`]),
+//! and their warm start from a nearby pencil's eigenvectors ([`subspace`]).
 //! The stages above use them; nothing here imports a stage.
 //! `stability::{banded, eigen, constrained}`, `bvp::integrator` and
 //! `bvp::newton::Convergence` remain as re-exports.
@@ -23,3 +24,4 @@ pub mod newton;
 pub mod quadrature;
 pub mod scalar;
 pub mod staircase;
+pub mod subspace;

@@ -1,0 +1,294 @@
+//! The lowest eigenpairs of a symmetric-definite banded pencil (K, G)
+//! warm-started from the eigenvectors of a nearby pencil (the previous
+//! point of a continuation branch): shift-invert subspace iteration with
+//! Rayleigh–Ritz (Bathe & Wilson, Int. J. Numer. Meth. Eng. 5, 1973;
+//! Saad, *Numerical Methods for Large Eigenvalue Problems*, 2nd ed.,
+//! Sec. 5.2), certified by one Sturm count.
+//!
+//! From p = `count` + guard vectors V: the Ritz values θ of (VᵀKV, VᵀGV)
+//! place a shift σ below θ₁, and each sweep is
+//!
+//!   W = (K − σG)⁻¹ G V,   (WᵀKW) s = θ (WᵀGW) s,   V ← W S,
+//!
+//! p banded solves and a p × p dense pencil: O(n) per sweep. The error of
+//! λ_i shrinks by (λ_i − σ)/(λ_{p+1} − σ) per sweep, so from a nearby
+//! start a few sweeps reach round-off. The first `count` pairs are accepted
+//! when their backward error ‖Kv − λGv‖/((‖K‖ + |λ|‖G‖)‖v‖) is at most
+//! [`TOLERANCE`], and they are the `count` lowest only if exactly `count`
+//! eigenvalues lie below τ, halfway from λ_count to the next Ritz value
+//! (Sylvester's inertia of K − τG): converged, G-orthogonal pairs below τ
+//! are then all of them. Anything else — a factorization that breaks down,
+//! no convergence in [`SWEEPS`] sweeps, another count — is `None`, and the
+//! caller runs the full solve ([`super::eigen`]); a warm start never
+//! decides alone.
+
+use nalgebra::DMatrix;
+
+use super::banded::SymmetricBanded;
+use super::eigen::{count_below, diagonal_ratio, row_sum_norm, Eigenpairs, Inertia};
+
+/// Backward error every accepted pair meets, as the Lanczos of
+/// [`super::eigen`]; the eigenvalues, Rayleigh quotients, err by its
+/// square.
+pub const ACCEPT: f64 = 1e-8;
+
+/// Backward error the sweeps aim at (events locate zeros of these
+/// eigenvalues): they stop there, or once a sweep no longer gains a
+/// factor 10 (round-off of the shifted solves, ~1e-11 for pairs far from
+/// the shift).
+pub const TOLERANCE: f64 = 1e-13;
+
+/// Sweeps at most before the warm start gives up.
+pub const SWEEPS: usize = 12;
+
+/// The `count` lowest eigenpairs of K v = λ G v from the start vectors
+/// `start` (more than `count` of them, the extra ones guarding the
+/// convergence of λ_count), or None when the warm start cannot vouch for
+/// them (see the module documentation). On success all p Ritz pairs are
+/// returned in increasing order: the first `count` verified and certified
+/// the lowest, the rest the guard vectors of the next warm start.
+pub fn lowest_eigenpairs_from(
+    k: &SymmetricBanded,
+    g: &SymmetricBanded,
+    count: usize,
+    start: &[Vec<f64>],
+) -> Option<Eigenpairs> {
+    let n = k.size();
+    let p = start.len();
+    if count == 0 || p <= count || p > n || start.iter().any(|v| v.len() != n) {
+        return None;
+    }
+    let scale = diagonal_ratio(k, g);
+    let norms = (row_sum_norm(k), row_sum_norm(g));
+    let mut ritz = Ritz::new(n, p);
+    ritz.basis.clone_from_slice(start);
+    for ((w, kw), gw) in ritz
+        .basis
+        .iter()
+        .zip(&mut ritz.k_basis)
+        .zip(&mut ritz.g_basis)
+    {
+        k.matvec(w, kw);
+        g.matvec(w, gw);
+    }
+    ritz.project()?;
+    let margin = (0.5 * (ritz.values[1] - ritz.values[0]))
+        .max(1e-3 * ritz.values[0].abs())
+        .max(1e-8 * scale);
+    let sigma = ritz.values[0] - margin;
+    let shifted = k.combine(1.0, g, -sigma).ldlt().ok()?;
+    if shifted.negative_pivots() != 0 {
+        return None;
+    }
+    let mut error = f64::INFINITY;
+    for _ in 0..SWEEPS {
+        // W = (K − σG)⁻¹ G V, G V known from the last projection, and
+        // K W = (K − σG) W + σ G W = G V + σ G W without a product by K.
+        for (((w, kw), gw), gv) in ritz
+            .basis
+            .iter_mut()
+            .zip(&mut ritz.k_basis)
+            .zip(&mut ritz.g_basis)
+            .zip(&ritz.gv)
+        {
+            w.copy_from_slice(gv);
+            shifted.solve_in_place(w);
+            g.matvec(w, gw);
+            kw.iter_mut()
+                .zip(gv.iter().zip(gw.iter()))
+                .for_each(|(a, (b, c))| *a = b + sigma * c);
+        }
+        ritz.project()?;
+        let last = error;
+        error = ritz.backward_error(count, norms);
+        if error <= ACCEPT && (error <= TOLERANCE || error > 0.1 * last) {
+            return certified(k, g, count, ritz.into_pairs(), scale);
+        }
+    }
+    None
+}
+
+/// Rayleigh–Ritz on a basis W: the Ritz values and vectors V = W S with
+/// their products K V and G V formed from K W and G W (no further
+/// products), in buffers kept across sweeps.
+struct Ritz {
+    basis: Vec<Vec<f64>>,
+    k_basis: Vec<Vec<f64>>,
+    g_basis: Vec<Vec<f64>>,
+    values: Vec<f64>,
+    v: Vec<Vec<f64>>,
+    kv: Vec<Vec<f64>>,
+    gv: Vec<Vec<f64>>,
+}
+
+impl Ritz {
+    fn new(n: usize, p: usize) -> Self {
+        let block = || vec![vec![0.0; n]; p];
+        Ritz {
+            basis: block(),
+            k_basis: block(),
+            g_basis: block(),
+            values: vec![0.0; p],
+            v: block(),
+            kv: block(),
+            gv: block(),
+        }
+    }
+
+    /// The Ritz pairs of (K, G) on span(basis) (with K and G times the
+    /// basis already in `k_basis`, `g_basis`), in increasing order, with
+    /// G-orthonormal vectors; None when the basis is (numerically)
+    /// dependent.
+    fn project(&mut self) -> Option<()> {
+        let p = self.basis.len();
+        let (w, kw, gw) = (&self.basis, &self.k_basis, &self.g_basis);
+        // One product per pair i ≤ j; the lower triangle mirrors it.
+        let (mut kr, mut gr) = (DMatrix::zeros(p, p), DMatrix::zeros(p, p));
+        for i in 0..p {
+            for j in i..p {
+                kr[(i, j)] = dot(&w[i], &kw[j]);
+                kr[(j, i)] = kr[(i, j)];
+                gr[(i, j)] = dot(&w[i], &gw[j]);
+                gr[(j, i)] = gr[(i, j)];
+            }
+        }
+        let l_inv = gr.cholesky()?.l().try_inverse()?;
+        let c = &l_inv * kr * l_inv.transpose();
+        let eig = ((&c + c.transpose()) * 0.5).symmetric_eigen();
+        if eig.eigenvalues.iter().any(|v| !v.is_finite()) {
+            return None;
+        }
+        let mut order: Vec<usize> = (0..p).collect();
+        order.sort_by(|&a, &b| eig.eigenvalues[a].total_cmp(&eig.eigenvalues[b]));
+        let s = l_inv.transpose() * &eig.eigenvectors;
+        for (slot, &col) in order.iter().enumerate() {
+            self.values[slot] = eig.eigenvalues[col];
+            combine(w, s.column(col).as_slice(), &mut self.v[slot]);
+            combine(kw, s.column(col).as_slice(), &mut self.kv[slot]);
+            combine(gw, s.column(col).as_slice(), &mut self.gv[slot]);
+        }
+        Some(())
+    }
+
+    /// The largest backward error ‖Kv − λGv‖/((‖K‖ + |λ|‖G‖)‖v‖) of the
+    /// first `count` pairs (`norms`: max row sums of K and G).
+    fn backward_error(&self, count: usize, norms: (f64, f64)) -> f64 {
+        (0..count)
+            .map(|i| {
+                let lambda = self.values[i];
+                let r = self.kv[i]
+                    .iter()
+                    .zip(&self.gv[i])
+                    .map(|(a, b)| (a - lambda * b).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+                let v = dot(&self.v[i], &self.v[i]).sqrt();
+                r / ((norms.0 + lambda.abs() * norms.1) * v).max(f64::MIN_POSITIVE)
+            })
+            .fold(0.0, f64::max)
+    }
+
+    fn into_pairs(self) -> Eigenpairs {
+        Eigenpairs {
+            values: self.values,
+            vectors: self.v,
+        }
+    }
+}
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// out = Σ_j s_j w_j.
+fn combine(w: &[Vec<f64>], s: &[f64], out: &mut [f64]) {
+    out.fill(0.0);
+    for (wj, sj) in w.iter().zip(s) {
+        out.iter_mut().zip(wj).for_each(|(o, x)| *o += sj * x);
+    }
+}
+
+/// The pairs, if exactly `count` eigenvalues lie below τ halfway between
+/// λ_count and the next Ritz value (which bounds λ_{count+1} from above),
+/// and the half gap is well above the pairs' error.
+fn certified(
+    k: &SymmetricBanded,
+    g: &SymmetricBanded,
+    count: usize,
+    pairs: Eigenpairs,
+    scale: f64,
+) -> Option<Eigenpairs> {
+    let (last, next) = (pairs.values[count - 1], pairs.values[count]);
+    let tau = 0.5 * (last + next);
+    if tau - last <= 1e-9 * scale {
+        return None;
+    }
+    (count_below(k, g, tau) == Inertia::Below(count)).then_some(pairs)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::numerics::eigen::lowest_eigenpairs;
+
+    /// −u'' = λ u on (0, 1), u(0) = 0, u'(1) = 0 by linear elements:
+    /// λ_j → ((2j − 1)π/2)², with a load term −q u'' shifting it.
+    fn column(n: usize, q: f64) -> (SymmetricBanded, SymmetricBanded) {
+        let h = 1.0 / n as f64;
+        let (mut k, mut g) = (SymmetricBanded::zeros(n, 1), SymmetricBanded::zeros(n, 1));
+        for e in 0..n {
+            // Element between nodes e and e + 1 (node 0 clamped: index e − 1).
+            let nodes = [e.checked_sub(1), Some(e)];
+            for (a, ia) in nodes.iter().enumerate() {
+                for (b, ib) in nodes.iter().enumerate() {
+                    if let (Some(i), Some(j)) = (ia, ib) {
+                        if i >= j {
+                            let same = a == b;
+                            let stiff = if same { 1.0 } else { -1.0 } * (1.0 - q) / h;
+                            let mass = if same { h / 3.0 } else { h / 6.0 };
+                            k.add(*i, *j, stiff);
+                            g.add(*i, *j, mass);
+                        }
+                    }
+                }
+            }
+        }
+        (k, g)
+    }
+
+    /// The discrete eigenvalues of [`column`]: the modes sin(iθ_j) at the
+    /// nodes, θ_j = (2j − 1)π/(2n), give
+    /// λ_j = (1 − q) 6(1 − cos θ_j)/(h²(2 + cos θ_j)).
+    fn column_eigenvalue(n: usize, q: f64, j: usize) -> f64 {
+        let h = 1.0 / n as f64;
+        let theta = (2 * j - 1) as f64 * std::f64::consts::PI / (2 * n) as f64;
+        (1.0 - q) * 6.0 * (1.0 - theta.cos()) / (h * h * (2.0 + theta.cos()))
+    }
+
+    #[test]
+    fn warm_start_finds_the_next_pencils_eigenvalues() {
+        let (k0, g) = column(120, 0.0);
+        let start = lowest_eigenpairs(&k0, &g, 4).unwrap();
+        let (k1, _) = column(120, 0.02);
+        let warm = lowest_eigenpairs_from(&k1, &g, 2, &start.vectors).unwrap();
+        for j in 1..=2 {
+            let exact = column_eigenvalue(120, 0.02, j);
+            let rel = (warm.values[j - 1] - exact).abs() / exact;
+            assert!(
+                rel < 1e-12,
+                "λ{j}: warm {} exact {exact}",
+                warm.values[j - 1]
+            );
+        }
+    }
+
+    #[test]
+    fn a_start_that_misses_the_lowest_mode_is_refused() {
+        // Start vectors spanning modes 2..5 of the pencil only: the Sturm
+        // count at τ finds the lowest eigenvalue they miss.
+        let (k, g) = column(120, 0.0);
+        let modes = lowest_eigenpairs(&k, &g, 5).unwrap();
+        let warm = lowest_eigenpairs_from(&k, &g, 2, &modes.vectors[1..]);
+        assert!(warm.is_none());
+    }
+}
