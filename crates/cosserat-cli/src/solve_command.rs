@@ -8,7 +8,7 @@ use cosserat::bvp::{solve, Equilibrium};
 use cosserat::input::Problem;
 use cosserat::output::target::{claim, Claim};
 use cosserat::output::{write_equilibrium, write_stability, StabilityResult};
-use cosserat::stability::{analyze, critical_load, CriticalLoad, Stability};
+use cosserat::stability::{critical_load, CriticalLoad, Stability};
 
 use crate::exit::{fail, BAD_INPUT, NO_RESULT, OUTPUT};
 use crate::signals;
@@ -105,13 +105,22 @@ pub fn run_stability(path: &Path, output: Option<&Path>, set: &[String], force: 
             Ok(eq) => eq,
             Err(e) => return solve_failed(&e),
         };
-        match analyze(&problem.rod, &eq, &problem.options, opts) {
-            Ok(st) => {
-                report_spectrum(&st);
-                StabilityResult::Equilibrium(Box::new(eq), st)
-            }
+        // The verdict is decided on meshes that resolve the shape and agree
+        // ([`cosserat::stability::decide`]), never read off one mesh.
+        let decision = match cosserat::stability::decide(&problem.rod, &eq, &problem.options, opts)
+        {
+            Ok(d) => d,
             Err(e) => return fail(NO_RESULT, e),
-        }
+        };
+        let Some(st) = decision.stability.clone() else {
+            let reason = match &decision.verdict {
+                cosserat::stability::Verdict::Undecided { reason } => reason.clone(),
+                _ => "no mesh was analysed".into(),
+            };
+            return fail(NO_RESULT, format!("stability undecided: {reason}"));
+        };
+        report_decision(&st, &decision);
+        StabilityResult::Equilibrium(Box::new(eq), st)
     };
     if let Some(out) = output {
         if let Err(e) = write_stability(out, &problem.text, &result, true) {
@@ -122,7 +131,13 @@ pub fn run_stability(path: &Path, output: Option<&Path>, set: &[String], force: 
     ExitCode::SUCCESS
 }
 
-fn report_spectrum(st: &Stability) {
+/// The spectrum on the finest mesh used and the decided verdict.
+fn report_decision(st: &Stability, decision: &cosserat::stability::Decision) {
+    use cosserat::stability::Verdict;
+    println!(
+        "decided   on {} elements, eigenvalue error ≤ {:.1e}",
+        decision.elements, decision.eigenvalue_error
+    );
     for b in &st.blocks {
         let values: Vec<String> = b.eigenvalues.iter().map(|v| format!("{v:+.6e}")).collect();
         println!(
@@ -133,10 +148,11 @@ fn report_spectrum(st: &Stability) {
         );
     }
     println!("morse     {}", st.morse_index);
-    println!(
-        "verdict   {}",
-        if st.stable { "stable" } else { "unstable" }
-    );
+    match &decision.verdict {
+        Verdict::Stable => println!("verdict   stable"),
+        Verdict::Unstable { .. } => println!("verdict   unstable"),
+        Verdict::Undecided { reason } => println!("verdict   undecided: {reason}"),
+    }
 }
 
 fn report_critical(c: &CriticalLoad) {

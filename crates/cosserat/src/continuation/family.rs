@@ -392,6 +392,23 @@ pub enum PointError {
     /// The eigensolver failed.
     #[error("eigenvalues: {0}")]
     Eigen(String),
+    /// The tracked second variation's mesh does not resolve the shape: the
+    /// material frame turns more than
+    /// [`crate::stability::MAX_TURN_PER_ELEMENT`] across an element, where
+    /// eigenvalues of two such meshes agree and are both wrong.
+    #[error(
+        "at p = {p} the material frame turns {turn:.2} rad across one element of the tracked \
+         second variation: its eigenvalues decide nothing there; set continuation.elements to \
+         at least {elements}"
+    )]
+    Unresolved {
+        /// The parameter value.
+        p: f64,
+        /// The largest turn per element (rad).
+        turn: f64,
+        /// Elements that would resolve it.
+        elements: f64,
+    },
     /// Newton at fixed parameter did not converge.
     #[error("Newton did not converge at p = {0}")]
     NoConvergence(f64),

@@ -135,6 +135,19 @@ impl Tracker {
             .partition(|(_, tag)| tag.1);
         let samples: Vec<RodSample> = samples.into_iter().map(|(s, _)| s).collect();
         let shape: Vec<RodSample> = shape.into_iter().map(|(s, _)| s).collect();
+        let turn = fe.h()
+            * samples
+                .iter()
+                .map(|s| s.curvature.norm())
+                .fold(0.0, f64::max);
+        if turn.is_nan() || turn > crate::stability::MAX_TURN_PER_ELEMENT {
+            return Err(PointError::Unresolved {
+                p,
+                turn,
+                elements: (turn / crate::stability::TURN_PER_ELEMENT * self.opts.elements() as f64)
+                    .ceil(),
+            });
+        }
         let norm = samples
             .iter()
             .zip(fe.quadrature_weights())

@@ -317,6 +317,21 @@ pub fn decide(
     opts: &StabilityOptions,
 ) -> Result<Decision, StabilityError> {
     let mut opts = *opts;
+    let needed = resolved_elements(rod, eq, solver, &opts)?;
+    if needed > MAX_RESOLVED_ELEMENTS {
+        return Ok(undecided(
+            format!(
+                "the material frame turns too fast to be resolved: {needed} elements would be \
+                 needed to keep the turn per element within {TURN_PER_ELEMENT} rad, more than \
+                 {MAX_RESOLVED_ELEMENTS}"
+            ),
+            None,
+            opts.elements,
+        ));
+    }
+    if needed > opts.elements {
+        opts = opts.with_elements(needed)?;
+    }
     let mut previous: Option<Stability> = None;
     let mut last_error = f64::INFINITY;
     for _ in 0..=REFINEMENTS {
@@ -370,6 +385,52 @@ pub fn decide(
     );
     decision.eigenvalue_error = last_error;
     Ok(decision)
+}
+
+/// The largest turn of the material frame across one element (rad) that
+/// the elements resolve: the second variation is written in the material
+/// frame, so a mode that is smooth in space oscillates there at the
+/// frame's rate |κ| (a twisted shaft: κ3 = M/C). Two meshes that both turn
+/// the frame several radians per element agree with each other and are
+/// both wrong (a Greenhill shaft with C = B/100 read as stable), so the
+/// first mesh is made fine enough before meshes are compared.
+pub const TURN_PER_ELEMENT: f64 = 0.5;
+
+/// The turn per element beyond which a single mesh's eigenvalues are not
+/// trusted at all (continuation's tracked spectrum ends its branch there,
+/// naming the mesh it needs).
+pub const MAX_TURN_PER_ELEMENT: f64 = 1.0;
+
+/// The most elements [`decide`] starts from for the resolution above (then
+/// doubled up to [`REFINEMENTS`] times); beyond it the verdict is
+/// undecided.
+pub const MAX_RESOLVED_ELEMENTS: usize = 20_000;
+
+/// Elements that keep the frame's turn per element within
+/// [`TURN_PER_ELEMENT`]: L max|κ| / θ, max|κ| over 8 samples per element of
+/// `opts`' mesh (at least 64).
+fn resolved_elements(
+    rod: &Rod,
+    eq: &Equilibrium,
+    solver: &SolverOptions,
+    opts: &StabilityOptions,
+) -> Result<usize, StabilityError> {
+    let count = (8 * opts.elements).max(64);
+    let length = rod.length();
+    let points: Vec<f64> = (0..=count)
+        .map(|i| length * i as f64 / count as f64)
+        .collect();
+    let kappa = eq
+        .resample(rod, solver, &points)?
+        .iter()
+        .map(|s| s.curvature.norm())
+        .fold(0.0, f64::max);
+    let needed = (length * kappa / TURN_PER_ELEMENT).ceil();
+    // A non-finite curvature is no mesh: refuse rather than saturate.
+    if !needed.is_finite() {
+        return Ok(usize::MAX);
+    }
+    Ok(needed.min(usize::MAX as f64) as usize)
 }
 
 fn undecided(reason: String, stability: Option<Stability>, elements: usize) -> Decision {
