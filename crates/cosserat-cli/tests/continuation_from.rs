@@ -194,3 +194,36 @@ fn a_stored_branch_point_is_switched_again() {
         assert!(stderr(&o).contains("special points"), "{}", stderr(&o));
     }
 }
+
+/// Hostile `--from` paths: a device, a directory, a file that is not HDF5,
+/// a missing file — each refused by name with exit code 2, nothing
+/// written, nothing read without end.
+#[test]
+fn hostile_stored_diagrams_are_refused() {
+    let dir = scratch("from", "hostile");
+    let out = dir.join("out.h5");
+    let garbage = dir.join("garbage.h5");
+    std::fs::write(&garbage, b"not an hdf5 file").unwrap();
+    let euler = shipped("euler_column");
+    let missing = dir.join("missing.h5");
+    for from in [
+        std::path::Path::new("/dev/zero"),
+        dir.as_path(),
+        garbage.as_path(),
+        missing.as_path(),
+    ] {
+        let o = run(&[
+            "continue",
+            &euler,
+            "-o",
+            out.to_str().unwrap(),
+            "--from",
+            from.to_str().unwrap(),
+            "--point",
+            "0/0",
+        ]);
+        assert_eq!(o.status.code(), Some(2), "{}", from.display());
+        assert!(stderr(&o).contains("not a diagram file"), "{}", stderr(&o));
+        assert!(!out.exists(), "nothing written");
+    }
+}
