@@ -84,6 +84,11 @@ pub enum Command {
         /// special/K to switch at the stored branch point K.
         #[arg(long, value_name = "B/I", requires = "from")]
         point: Option<String>,
+        /// Follow the stored special point (--point special/K) in the
+        /// second parameter of [continuation.curve] instead of switching:
+        /// the output is a curve file.
+        #[arg(long, requires = "point")]
+        curve: bool,
         /// Override any key of the problem file.
         #[arg(long = "set", value_name = "KEY=VALUE")]
         set: Vec<String>,

@@ -46,6 +46,8 @@ pub struct ContinueArgs<'a> {
     pub resume: bool,
     /// Start from a stored point: the diagram file and `B/I`.
     pub from: Option<(&'a Path, &'a str)>,
+    /// Follow the stored special point in two parameters.
+    pub curve: bool,
 }
 
 /// The problem, and the stored start when `--from` is given (its
@@ -93,6 +95,9 @@ pub fn run_continue(args: &ContinueArgs) -> ExitCode {
         Ok(c) => c,
         Err(code) => return code,
     };
+    if args.curve {
+        return crate::curve_command::run_curve(&problem, stored.as_ref(), output);
+    }
     let saved = match saved_diagram(&problem.text, output, force, resume) {
         Ok(saved) => saved,
         Err(code) => return code,

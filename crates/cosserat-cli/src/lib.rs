@@ -34,6 +34,7 @@ pub mod arm_chart;
 pub mod bench;
 pub mod cli;
 pub mod continue_command;
+pub mod curve_command;
 pub mod exit;
 pub mod optimize_command;
 pub mod plot;
@@ -78,6 +79,7 @@ pub fn run(cli: Cli) -> ExitCode {
             resume,
             from,
             point,
+            curve,
             set,
             force,
         } => continue_command::run_continue(&continue_command::ContinueArgs {
@@ -88,6 +90,7 @@ pub fn run(cli: Cli) -> ExitCode {
             force,
             resume,
             from: from.as_deref().zip(point.as_deref()),
+            curve,
         }),
         Command::Optimize {
             problem,

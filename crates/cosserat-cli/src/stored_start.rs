@@ -148,7 +148,7 @@ fn switch_start(
     Ok(StoredStart {
         sets: vec![format!("continuation.start={value}")],
         summary: format!(
-            "{} special point {special}: {} at {old_key} = {value}, switched",
+            "{} special point {special}: {} at {old_key} = {value}",
             file.display(),
             saved.specials[special].kind.name()
         ),

@@ -227,3 +227,68 @@ fn hostile_stored_diagrams_are_refused() {
         assert!(!out.exists(), "nothing written");
     }
 }
+
+/// `--curve`: Euler's stored branch point followed in the rod length stays
+/// on F = π²B/(4L²) at every point of the curve file.
+#[test]
+fn a_stored_branch_point_is_followed_in_a_second_parameter() {
+    let dir = scratch("from", "curve");
+    let full = dir.join("full.h5");
+    let curve = dir.join("curve.h5");
+    let euler = shipped("euler_column");
+    let o = run(&["continue", &euler, "-o", full.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let set = "continuation.curve={parameter=\"rod.length\", start=1.0, bounds=[0.5, 2.0], step=0.1, max_step=0.3}";
+    let args = |point: &str, curve_flag: bool, set: Option<&str>| {
+        let mut a = vec![
+            "continue".to_string(),
+            euler.clone(),
+            "-o".into(),
+            curve.to_str().unwrap().into(),
+            "--from".into(),
+            full.to_str().unwrap().into(),
+            "--point".into(),
+            point.into(),
+        ];
+        if curve_flag {
+            a.push("--curve".into());
+        }
+        if let Some(s) = set {
+            a.extend(["--set".to_string(), s.to_string()]);
+        }
+        a
+    };
+    let call = |a: Vec<String>| run(&a.iter().map(String::as_str).collect::<Vec<_>>());
+    let o = call(args("special/0", true, Some(set)));
+    assert!(o.status.success(), "{}", stderr(&o));
+    let file = hdf5::File::open(&curve).unwrap();
+    let p = file
+        .dataset("curve/parameters")
+        .unwrap()
+        .read_raw::<f64>()
+        .unwrap();
+    assert!(p.len() >= 20, "{} values", p.len());
+    for row in p.chunks(2) {
+        let exact = std::f64::consts::PI.powi(2) / (4.0 * row[1] * row[1]);
+        assert!(
+            (row[0] - exact).abs() <= 1e-10 * exact,
+            "L = {}: {} vs {exact}",
+            row[1],
+            row[0]
+        );
+    }
+    drop(file);
+    std::fs::remove_file(&curve).unwrap();
+    // Refused: no [continuation.curve]; a point that is not special.
+    let o = call(args("special/0", true, None));
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("[continuation.curve]"),
+        "{}",
+        stderr(&o)
+    );
+    let o = call(args("1/3", true, Some(set)));
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("special/K"), "{}", stderr(&o));
+    assert!(!curve.exists(), "nothing written by a refusal");
+}

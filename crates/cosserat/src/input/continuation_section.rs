@@ -68,6 +68,79 @@ pub struct ContinuationSection {
     /// ([`crate::continuation::Measure`]): `force[2]@0`, `turning`, …
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub measures: Vec<String>,
+    /// `[continuation.curve]`: a stored fold or branch point followed in
+    /// a second parameter (`cosserat continue --from … --point special/K
+    /// --curve`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub curve: Option<CurveSection>,
+}
+
+/// `[continuation.curve]`.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct CurveSection {
+    /// The second parameter's key (as `continuation.parameter`).
+    pub parameter: String,
+    /// Its value at the stored special point (the problem's own value).
+    pub start: f64,
+    /// [min, max] of the second parameter.
+    #[serde(deserialize_with = "super::strict::array")]
+    pub bounds: [f64; 2],
+    /// First arclength step.
+    #[serde(default = "default_step")]
+    pub step: f64,
+    /// Largest step.
+    #[serde(default = "default_max_step")]
+    pub max_step: f64,
+    /// Points per direction at most.
+    #[serde(default = "default_max_points")]
+    pub max_points: usize,
+}
+
+impl CurveSection {
+    /// The key and the curve options (the first parameter's bounds from
+    /// `[continuation]`), validated.
+    pub fn build(
+        &self,
+        first: &ContinuationOptions,
+    ) -> Result<(String, f64, crate::continuation::CurveOptions), ProblemError> {
+        let [lo, hi] = self.bounds;
+        if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+            return Err(invalid(
+                "continuation.curve.bounds",
+                format!("need finite lo < hi, got [{lo}, {hi}]"),
+            ));
+        }
+        if !(self.start.is_finite() && (lo..=hi).contains(&self.start)) {
+            return Err(invalid(
+                "continuation.curve.start",
+                format!("{} is not inside the bounds", self.start),
+            ));
+        }
+        let step = positive("continuation.curve.step", self.step)?;
+        let max_step = positive("continuation.curve.max_step", self.max_step)?;
+        if step > max_step {
+            return Err(invalid("continuation.curve.step", "need step ≤ max_step"));
+        }
+        if self.max_points < 1 {
+            return Err(invalid(
+                "continuation.curve.max_points",
+                "must be at least 1",
+            ));
+        }
+        Ok((
+            self.parameter.trim().to_string(),
+            self.start,
+            crate::continuation::CurveOptions {
+                bounds: [first.bounds, (lo, hi)],
+                step,
+                min_step: first.min_step,
+                max_step,
+                max_points: self.max_points,
+                tolerance: first.tolerance.max(1e-10),
+            },
+        ))
+    }
 }
 
 fn default_step() -> f64 {

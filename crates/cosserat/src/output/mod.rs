@@ -8,6 +8,8 @@
 #[cfg(feature = "hdf5")]
 mod arm_output;
 #[cfg(feature = "hdf5")]
+mod curve;
+#[cfg(feature = "hdf5")]
 mod diagram;
 #[cfg(feature = "hdf5")]
 mod hdf5_output;
@@ -18,6 +20,8 @@ pub mod target;
 
 #[cfg(feature = "hdf5")]
 pub use arm_output::{read_search, write_arm, write_arm_study, ArmStudy, SavedSearch};
+#[cfg(feature = "hdf5")]
+pub use curve::write_curve;
 #[cfg(feature = "hdf5")]
 pub use diagram::{read_saved, write_diagram};
 #[cfg(feature = "hdf5")]

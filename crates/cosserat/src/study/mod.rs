@@ -6,4 +6,4 @@ pub mod arm;
 mod problem;
 pub mod sweep;
 
-pub use problem::Problem;
+pub use problem::{Curve, Problem};

@@ -11,6 +11,18 @@ use crate::stability::{FixedShape, StabilityOptions};
 use crate::study::arm::{ArmProblem, ArmScene, SearchOptions};
 use crate::study::sweep::Sweep;
 
+/// A curve of singular points to follow: the two parameters, the second's
+/// value at the start, the options.
+#[derive(Debug, Clone)]
+pub struct Curve {
+    /// Both parameters (the first is the family's).
+    pub pair: std::sync::Arc<dyn crate::continuation::Lens2>,
+    /// The second parameter at the stored special point.
+    pub start: f64,
+    /// Bounds and steps.
+    pub options: crate::continuation::CurveOptions,
+}
+
 /// A problem ready to solve.
 #[derive(Debug, Clone)]
 pub struct Problem {
@@ -29,6 +41,9 @@ pub struct Problem {
     pub stability: StabilityOptions,
     /// The continued family and how to continue it.
     pub continuation: Option<(Family, ContinuationOptions)>,
+    /// `[continuation.curve]`: both parameters as one lens, the second's
+    /// start value, and how to follow a singular point in them.
+    pub curve: Option<Curve>,
     /// The arm optimization, its search, and whether to compute R̂0.
     pub arm: Option<(ArmProblem, SearchOptions, bool)>,
     /// The arm's loads and actuator limit, and the size of its reach map.

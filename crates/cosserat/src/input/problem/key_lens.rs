@@ -16,7 +16,7 @@ use std::sync::Mutex;
 use super::rod::build_rod;
 use super::sections::ProblemFile;
 use super::{invalid, overrides, ProblemError};
-use crate::continuation::{FamilyError, Lens};
+use crate::continuation::{FamilyError, Lens, Lens2};
 use crate::input::strict;
 use crate::model::{EnergyCatalog, Rod};
 
@@ -122,5 +122,57 @@ impl Lens for KeyLens {
         let rod = self.build(p).map_err(|e| refused(e.to_string()))?;
         *last = Some((p.to_bits(), rod.clone()));
         Ok(rod)
+    }
+}
+
+/// Two numeric keys of the rod's tables set together: the pair of a curve
+/// whose first parameter is itself a file key.
+#[derive(Debug)]
+pub(crate) struct KeyPair {
+    first: KeyLens,
+    second: String,
+}
+
+impl KeyPair {
+    pub(super) fn new(
+        first: &str,
+        second: &str,
+        text: &str,
+        catalog: &EnergyCatalog,
+    ) -> Result<KeyPair, ProblemError> {
+        // Both keys checked as a continued key would be.
+        KeyLens::new(second, text, catalog).map_err(|e| match e {
+            ProblemError::Invalid { message, .. } => {
+                invalid("continuation.curve.parameter", message)
+            }
+            other => other,
+        })?;
+        Ok(KeyPair {
+            first: KeyLens::new(first, text, catalog)?,
+            second: second.trim().to_string(),
+        })
+    }
+}
+
+impl Lens2 for KeyPair {
+    fn keys(&self) -> [String; 2] {
+        [self.first.key.clone(), self.second.clone()]
+    }
+
+    fn rod_at(&self, p: [f64; 2]) -> Result<Rod, FamilyError> {
+        let refused = |reason: String| FamilyError::Refused {
+            parameter: format!("{}, {}", self.first.key, self.second),
+            value: p[0],
+            reason,
+        };
+        if !(p[0].is_finite() && p[1].is_finite()) {
+            return Err(refused("not a finite number".into()));
+        }
+        let mut doc = self.first.doc.clone();
+        for (key, v) in [(&self.first.key, p[0]), (&self.second, p[1])] {
+            overrides::set_key(&mut doc, key, toml::Value::Float(v)).map_err(&refused)?;
+        }
+        let file: ProblemFile = strict::from_table(doc).map_err(|e| refused(e.to_string()))?;
+        build_rod(&file, &self.first.catalog).map_err(|e| refused(e.to_string()))
     }
 }

@@ -26,7 +26,9 @@ use crate::input::sweep_section::SweepSection;
 use crate::model::{EnergyCatalog, ModelLevel};
 pub use crate::study::Problem;
 pub(crate) use checks::{within, NEWTON_TOLERANCE};
-use options::{build_continuation, build_options, build_shape, build_stability, eigenvalue_count};
+use options::{
+    build_continuation, build_curve, build_options, build_shape, build_stability, eigenvalue_count,
+};
 use overrides::apply_overrides;
 use rod::{build_rod, choose_model};
 pub use sections::{ProblemFile, ProfileSpec};
@@ -131,6 +133,13 @@ impl Problem {
             &options,
             shape.as_ref(),
         )?;
+        let curve = build_curve(
+            &file,
+            &text,
+            catalog,
+            &rod,
+            continuation.as_ref().map(|(_, o)| o),
+        )?;
         if rod.clamp().hinge && model.level != ModelLevel::Planar {
             return Err(invalid(
                 "clamp.hinge",
@@ -155,6 +164,7 @@ impl Problem {
             shape,
             stability,
             continuation,
+            curve,
             arm,
             arm_scene,
             sweep,

@@ -13,8 +13,10 @@ use crate::bvp::newton::NewtonOptions;
 use crate::bvp::{Method, SolverOptions, Strategy};
 use std::sync::Arc;
 
-use super::key_lens::KeyLens;
-use crate::continuation::{ContinuationOptions, Family, Lens, Parameter, RodLens};
+use super::key_lens::{KeyLens, KeyPair};
+use crate::continuation::{
+    ContinuationOptions, Family, Lens, Lens2, Parameter, ParameterOn, RodLens,
+};
 use crate::input::mesh::MeshKeys;
 use crate::model::{EnergyCatalog, ModelChoice, ModelLevel, Profile, Rod};
 use crate::numerics::integrator::Tolerances;
@@ -82,6 +84,71 @@ pub(super) fn build_continuation(
         .rod_at(opts.start)
         .map_err(|e| invalid("continuation.parameter", e.to_string()))?;
     Ok(Some((family, opts)))
+}
+
+/// The `[continuation.curve]` of a continued problem: the family's
+/// parameter and the curve's as one [`Lens2`], the second's start value
+/// and the options.
+pub(super) fn build_curve(
+    file: &ProblemFile,
+    text: &str,
+    catalog: &EnergyCatalog,
+    rod: &Rod,
+    opts: Option<&ContinuationOptions>,
+) -> Result<Option<crate::study::Curve>, ProblemError> {
+    let (Some(section), Some(opts)) = (&file.continuation, opts) else {
+        return Ok(None);
+    };
+    let Some(curve) = &section.curve else {
+        return Ok(None);
+    };
+    let first = section.parameter.trim();
+    let (second, start, options) = curve.build(opts)?;
+    if second == first {
+        return Err(invalid(
+            "continuation.curve.parameter",
+            "must differ from continuation.parameter",
+        ));
+    }
+    let pair: Arc<dyn Lens2> = match Parameter::from_key(first) {
+        Some(Parameter::ClampAngle) => {
+            return Err(invalid(
+                "continuation.curve",
+                "clamp.angle as the first parameter of a curve is not supported (its base \
+                 frame is the unturned one); continue clamp.turn.angle instead",
+            ))
+        }
+        Some(p) => {
+            let lens: Arc<dyn Lens> = match Parameter::from_key(&second) {
+                Some(Parameter::ClampAngle) => Arc::new(RodLens::new(
+                    native_base(file, rod, Parameter::ClampAngle)?,
+                    Parameter::ClampAngle,
+                )),
+                Some(q) => Arc::new(RodLens::new(rod.clone(), q)),
+                None => Arc::new(
+                    KeyLens::new(&second, text, catalog)
+                        .map_err(|e| rename(e, "continuation.curve.parameter"))?,
+                ),
+            };
+            Arc::new(ParameterOn::new(p, lens))
+        }
+        None => Arc::new(KeyPair::new(first, &second, text, catalog)?),
+    };
+    pair.rod_at([opts.start, start])
+        .map_err(|e| invalid("continuation.curve.parameter", e.to_string()))?;
+    Ok(Some(crate::study::Curve {
+        pair,
+        start,
+        options,
+    }))
+}
+
+/// A key's error named for the curve's key.
+fn rename(e: ProblemError, field: &str) -> ProblemError {
+    match e {
+        ProblemError::Invalid { message, .. } => invalid(field, message),
+        other => other,
+    }
 }
 
 /// The base rod of a library parameter: the problem's rod, but for

@@ -1,0 +1,59 @@
+//! Curves of singular points (two-parameter continuation) as HDF5 files.
+//!
+//! Layout: `/curve/parameters` (m×2: p₁, p₂), `unknowns` (m×n), `tangent`
+//! (m×(n+2) or m×(n+3) with the branch point's ψ), `null_vector` (m×n),
+//! `singularity` (m: |g|), `cusps` (the index of the point before each
+//! cusp); root attributes `problem` (the problem text), `parameter_names`
+//! (the two keys, comma separated), `kind` (`fold` or `branch_point`),
+//! `ends` (why each end stopped, `;` separated).
+
+use std::path::Path;
+
+use super::hdf5_output::{array, string_attr, write_atomically, OutputError};
+use crate::continuation::{SingularCurve, SpecialKind};
+
+fn rows(
+    curve: &SingularCurve,
+    f: impl Fn(&crate::continuation::CurvePoint) -> Vec<f64>,
+) -> (usize, Vec<f64>) {
+    let width = curve.points.first().map_or(0, |p| f(p).len());
+    (width, curve.points.iter().flat_map(f).collect())
+}
+
+/// Writes the curve atomically (a temporary file renamed into place).
+pub fn write_curve(
+    path: &Path,
+    problem: &str,
+    kind: SpecialKind,
+    curve: &SingularCurve,
+    force: bool,
+) -> Result<(), OutputError> {
+    write_atomically(path, force, |file| {
+        string_attr(file, "problem", problem)?;
+        string_attr(file, "parameter_names", &curve.keys.join(","))?;
+        string_attr(file, "kind", kind.name())?;
+        string_attr(file, "ends", &curve.ends.join(";"))?;
+        string_attr(
+            file,
+            "generator",
+            concat!("cosserat ", env!("CARGO_PKG_VERSION")),
+        )?;
+        let g = file.create_group("curve")?;
+        let m = curve.points.len();
+        let (_, p) = rows(curve, |c| c.parameters.to_vec());
+        array(&g, "parameters", &[m, 2], &p)?;
+        let (n, x) = rows(curve, |c| c.unknowns.clone());
+        array(&g, "unknowns", &[m, n], &x)?;
+        let (k, t) = rows(curve, |c| c.tangent.clone());
+        array(&g, "tangent", &[m, k], &t)?;
+        let (nv, v) = rows(curve, |c| c.null_vector.clone());
+        array(&g, "null_vector", &[m, nv], &v)?;
+        let s: Vec<f64> = curve.points.iter().map(|c| c.singularity).collect();
+        array(&g, "singularity", &[m], &s)?;
+        let cusps: Vec<u64> = curve.cusps.iter().map(|&i| i as u64).collect();
+        g.new_dataset::<u64>()
+            .shape([cusps.len()])
+            .create("cusps")?
+            .write_raw(&cusps)
+    })
+}
