@@ -436,6 +436,23 @@ impl Run<'_> {
         let mut z = from.unknowns.clone();
         z.push(from.parameter);
         let pred: Vec<f64> = z.iter().zip(&t).map(|(a, b)| a + ds * b).collect();
+        // A branch of symmetric copies keeps a null vector of F_x: step in
+        // the slice through the last point (`slice.rs`).
+        let kernel = if self.sliced {
+            self.symmetric_kernel(&from.unknowns, from.parameter)
+        } else {
+            None
+        };
+        if let Some(kernel) = kernel {
+            let Some((z, iterations)) = self.correct_sliced(&from.unknowns, &pred, &t, &kernel)?
+            else {
+                return Ok(None);
+            };
+            let n = z.len() - 1;
+            let tangent = self.sliced_tangent(&z[..n], z[n], &kernel, &t)?;
+            let stored: Vec<f64> = tangent.iter().map(|v| v * sign).collect();
+            return Ok(Some((z[..n].to_vec(), z[n], stored, iterations)));
+        }
         let Some((z, iterations, fx)) = self.correct(&pred, &t)? else {
             return Ok(None);
         };

@@ -149,6 +149,10 @@ pub(super) struct Run<'a> {
     /// Branch points whose switch started fewer branches than asked, and
     /// why (moved to the diagram's warnings).
     pub(super) unswitched: Vec<String>,
+    /// The branch being walked is a continuum of symmetric copies: its
+    /// steps use the slice corrector (decided once, at its last point when
+    /// the walk begins; `slice.rs`).
+    pub(super) sliced: bool,
 }
 
 impl<'a> Run<'a> {
@@ -163,6 +167,7 @@ impl<'a> Run<'a> {
             tracker: Tracker::new(family, blocks, opts.stability),
             total_points: 0,
             unswitched: vec![],
+            sliced: false,
         }
     }
 
@@ -307,6 +312,11 @@ impl<'a> Run<'a> {
             .zip(&x)
             .map(|(a, b)| a + t * (b - a))
             .collect();
+        if self.sliced {
+            return self
+                .land_sliced(last, guess, bound, &tangent)
+                .unwrap_or((x, p, tangent));
+        }
         match self.newton_at_fixed_p(guess, bound) {
             Ok(xb) => match self.tangent(&xb, bound, &tangent) {
                 Ok(tb) => (xb, bound, tb),
@@ -362,6 +372,11 @@ impl<'a> Run<'a> {
             stop_reason: reason,
             interrupted,
         };
+        if let Some(last) = diagram.branches[branch].points.last() {
+            self.sliced = self
+                .symmetric_kernel(&last.unknowns, last.parameter)
+                .is_some();
+        }
         let mut ds = diagram.branches[branch].next_step;
         loop {
             let points = &diagram.branches[branch].points;

@@ -470,10 +470,7 @@ impl Run<'_> {
             for dir in [1.0, -1.0] {
                 let t: Vec<f64> = phi.iter().map(|v| v * dir).collect();
                 let pred: Vec<f64> = z.iter().zip(&t).map(|(a, b)| a + eps * b).collect();
-                let Ok(Some((zn, _, _))) = self.correct(&pred, &t) else {
-                    continue;
-                };
-                let Ok(tangent) = self.tangent(&zn[..n], zn[n], &t) else {
+                let Some((zn, tangent)) = self.switch_step(&pred, &t, directions.len()) else {
                     continue;
                 };
                 self.tracker.reset();
@@ -492,6 +489,32 @@ impl Run<'_> {
             ));
         }
         starts
+    }
+
+    /// The first point off a branch point along `t` from the predictor: the
+    /// plain corrector, or — off a multiple point, whose branches are
+    /// continua of copies (an isotropic rod turned about its axis) — the
+    /// slice corrector through the predictor (`slice.rs`).
+    fn switch_step(
+        &self,
+        pred: &[f64],
+        t: &[f64],
+        multiplicity: usize,
+    ) -> Option<(Vec<f64>, Vec<f64>)> {
+        let n = pred.len() - 1;
+        if let Ok(Some((zn, _, _))) = self.correct(pred, t) {
+            if let Ok(tangent) = self.tangent(&zn[..n], zn[n], t) {
+                return Some((zn, tangent));
+            }
+        }
+        if multiplicity < 2 {
+            return None;
+        }
+        let kernel = self.nearest_kernel(&pred[..n], pred[n])?;
+        let (zn, _) = self.correct_sliced(&pred[..n], pred, t, &kernel).ok()??;
+        let kernel = self.symmetric_kernel(&zn[..n], zn[n]).unwrap_or(kernel);
+        let tangent = self.sliced_tangent(&zn[..n], zn[n], &kernel, t).ok()?;
+        Some((zn, tangent))
     }
 
     /// m orthonormal directions of the null space of E = [F_x F_p] at the

@@ -34,6 +34,7 @@ mod measure;
 mod options;
 mod restart;
 mod resume;
+mod slice;
 mod status;
 mod tracking;
 
