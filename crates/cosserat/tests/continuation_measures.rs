@@ -132,3 +132,26 @@ fn measures_outside_their_scene_are_refused() {
         assert!(err.contains(says), "{set}: {err}");
     }
 }
+
+/// Full-resolution shapes: `continuation.shape_points` positions per point,
+/// equally spaced, clamp and tip included — on the buckled elastica the
+/// last one is the tip, and neighbours are one chord apart (the rod is
+/// inextensible: |Δr| ≤ L/(S − 1), equal on straight stretches).
+#[test]
+fn shapes_have_the_asked_resolution() {
+    let set = ["continuation.shape_points=401".to_string()];
+    let problem = Problem::from_str_with(EULER, &set).unwrap();
+    let (family, opts) = problem.continuation.clone().unwrap();
+    let d = continuation(&family, &opts, &mut |_, _| true).unwrap();
+    let point = d.branches[1].points.last().unwrap();
+    assert_eq!(point.shape.len(), 401);
+    assert!((point.shape[400] - point.tip.position).norm() < 1e-12);
+    let h = 1.0 / 400.0;
+    for w in point.shape.windows(2) {
+        let chord = (w[1] - w[0]).norm();
+        assert!(chord <= h * (1.0 + 1e-9) && chord > 0.99 * h, "{chord}");
+    }
+    let bad = ["continuation.shape_points=1".to_string()];
+    let err = Problem::from_str_with(EULER, &bad).unwrap_err().to_string();
+    assert!(err.contains("continuation.shape_points"), "{err}");
+}

@@ -164,7 +164,8 @@ impl<'a> Run<'a> {
         Run {
             family,
             opts,
-            tracker: Tracker::new(family, blocks, opts.stability),
+            tracker: Tracker::new(family, blocks, opts.stability)
+                .with_shape_points(opts.shape_points),
             total_points: 0,
             unswitched: vec![],
             sliced: false,

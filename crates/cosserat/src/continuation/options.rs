@@ -43,6 +43,9 @@ pub struct ContinuationOptions {
     pub start_solver: Option<SolverOptions>,
     /// The measures computed at every point ([`super::Measure`]).
     pub measures: Vec<super::Measure>,
+    /// Equally spaced points of the shape stored with every point (the
+    /// clamp and the tip included).
+    pub shape_points: usize,
 }
 
 impl Default for ContinuationOptions {
@@ -62,6 +65,7 @@ impl Default for ContinuationOptions {
             event_tolerance: 1e-11,
             start_solver: None,
             measures: vec![],
+            shape_points: 21,
         }
     }
 }

@@ -47,7 +47,7 @@ pub struct Spectrum {
     pub morse_index: usize,
     /// √∫|κ|² ds.
     pub curvature_norm: f64,
-    /// Positions at 21 equally spaced points.
+    /// Positions at the tracker's equally spaced shape points.
     pub shape: Vec<Vector3<f64>>,
     /// The tip sample.
     pub tip: RodSample,
@@ -62,6 +62,8 @@ pub struct Tracker {
     blocks: Vec<Block>,
     opts: StabilityOptions,
     base_length: f64,
+    /// Equally spaced points of the stored shape (≥ 2; the last is the tip).
+    shape_points: usize,
     previous: Option<Modes>,
     previous_values: Option<Vec<Vec<f64>>>,
 }
@@ -76,8 +78,19 @@ impl Tracker {
             blocks,
             opts,
             base_length,
+            shape_points: 21,
             previous: None,
             previous_values: None,
+        }
+    }
+
+    /// The same tracker storing `points` shape points per point (at least
+    /// 2: the clamp and the tip).
+    #[must_use]
+    pub fn with_shape_points(self, points: usize) -> Self {
+        Tracker {
+            shape_points: points.max(2),
+            ..self
         }
     }
 
@@ -115,11 +128,12 @@ impl Tracker {
         let rod = family.rod_at(p)?;
         let fe = FiniteElements::new(rod.length(), self.opts.elements(), self.opts.order())
             .with_hinged_base(rod.clamp().hinge);
-        // One integration for the quadrature points and the 21 shape points
+        // One integration for the quadrature points and the shape points
         // (the last is the tip).
         let quadrature = fe.quadrature_points();
-        let grid: Vec<f64> = (0..21)
-            .map(|i| rod.length() * f64::from(i) / 20.0)
+        let last = (self.shape_points - 1) as f64;
+        let grid: Vec<f64> = (0..self.shape_points)
+            .map(|i| rod.length() * i as f64 / last)
             .collect();
         let mut all: Vec<(f64, bool)> = quadrature
             .iter()
@@ -155,7 +169,7 @@ impl Tracker {
             .sum::<f64>()
             .sqrt();
         let c = coefficients(&rod, &samples);
-        let tip = shape.last().expect("21 shape points");
+        let tip = shape.last().expect("at least two shape points");
         let mats = self
             .blocks
             .iter()
@@ -245,7 +259,10 @@ impl Tracker {
         }
         let shape = shape_samples.iter().map(|s| s.position).collect();
         Ok(Spectrum {
-            tip: shape_samples.last().expect("21 shape points").clone(),
+            tip: shape_samples
+                .last()
+                .expect("at least two shape points")
+                .clone(),
             values,
             vectors,
             morse_index: block_morse.iter().sum(),

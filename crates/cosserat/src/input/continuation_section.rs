@@ -73,7 +73,20 @@ pub struct ContinuationSection {
     /// --curve`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub curve: Option<CurveSection>,
+    /// Equally spaced shape points stored per point (the clamp and the
+    /// tip included).
+    #[serde(default = "default_shape_points")]
+    pub shape_points: usize,
 }
+
+fn default_shape_points() -> usize {
+    21
+}
+
+/// The most shape points per diagram point: a 400-point branch of 10 001
+/// positions is 96 MB, a full-resolution picture of any rod these meshes
+/// resolve.
+pub const MAX_SHAPE_POINTS: usize = 10_001;
 
 /// `[continuation.curve]`.
 #[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
@@ -183,6 +196,20 @@ fn positive(field: &str, v: f64) -> Result<f64, ProblemError> {
 }
 
 impl ContinuationSection {
+    fn checked_shape_points(&self) -> Result<usize, ProblemError> {
+        if (2..=MAX_SHAPE_POINTS).contains(&self.shape_points) {
+            Ok(self.shape_points)
+        } else {
+            Err(invalid(
+                "continuation.shape_points",
+                format!(
+                    "must be between 2 (the clamp and the tip) and {MAX_SHAPE_POINTS}, got {}",
+                    self.shape_points
+                ),
+            ))
+        }
+    }
+
     /// The parameter's key and the options, validated (the key itself is
     /// checked where the problem text is at hand: a library parameter, or
     /// any numeric key of the rod's tables).
@@ -276,6 +303,7 @@ impl ContinuationSection {
                 event_tolerance: 1e-11,
                 start_solver: None,
                 measures,
+                shape_points: self.checked_shape_points()?,
             },
         ))
     }

@@ -17,7 +17,7 @@
 //! | collocation | `solver.max_intervals` | 2 × 8 K (m²n² + 2mn² + 2mn + (m+1)n), K = max_intervals, m = stages (per interval: the condensed LU, its right-hand sides, the stage Jacobians; the old and the new mesh during adaptation) |
 //! | stability verdict | `stability.elements` | the finite elements below at 32 × elements (the verdict's finest mesh, [`crate::stability::REFINEMENTS`] doublings), eigenvalues + 1 |
 //! | continuation system | `continuation.intervals` (collocation) or `solver.segments` | 6 × 8 (N+1)², N the family's unknowns (dense F_x, the bordered matrix, its LU, the SVD at branch points) |
-//! | continuation points | `continuation.max_points` | points × branches × (8 (2N + 1 + 3k + 63) + S + 256), branches = (1 + both_directions)(1 + 6 k switch_depth) |
+//! | continuation points | `continuation.max_points` | points × branches × (8 (2N + 1 + 3k + 3 shape_points + measures) + S + 256), branches = (1 + both_directions)(1 + 6 k switch_depth) |
 //! | tracked spectrum | `continuation.elements` | the finite elements below at `continuation.elements`, plus the previous point's 3k eigenvectors |
 //! | arm's second variation | `arm.elements` | the finite elements below at 4 × arm.elements, 1 eigenvalue (a reported optimum is re-evaluated on finer meshes) |
 //! | reach map | `arm.map_samples` | samples × (16 M + 160), M = arm.coefficients |
@@ -170,7 +170,9 @@ fn add_continuation(e: &mut MemoryEstimate, problem: &Problem) {
         let k = opts.stability.eigenvalues() as f64;
         let branches = (1.0 + f64::from(u8::from(opts.both_directions)))
             * (1.0 + 6.0 * k * opts.switch_depth as f64);
-        let per_point = 8.0 * (2.0 * size + 1.0 + 3.0 * k + 63.0) + SAMPLE + 256.0;
+        // The shape (3 per shape point) and the named measures.
+        let stored = 3.0 * opts.shape_points as f64 + opts.measures.len() as f64;
+        let per_point = 8.0 * (2.0 * size + 1.0 + 3.0 * k + stored) + SAMPLE + 256.0;
         let max_points = opts.max_points as f64;
         e.add(
             "continuation.max_points",
