@@ -85,14 +85,9 @@ fn continue_diagram(path: &Path, set: &[String], repeat: usize) -> ExitCode {
         Ok(p) => p,
         Err(e) => return fail(BAD_INPUT, format!("{}: {e}", path.display())),
     };
-    let Some((family, opts)) = &problem.continuation else {
-        return fail(
-            BAD_INPUT,
-            format!(
-                "{}: continuation: the problem has no [continuation] table",
-                path.display()
-            ),
-        );
+    let (family, opts) = match crate::continue_command::continued(&problem, path) {
+        Ok(c) => c,
+        Err(code) => return code,
     };
     let mut times = Vec::with_capacity(repeat);
     let mut last = None;

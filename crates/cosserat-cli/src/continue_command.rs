@@ -30,6 +30,24 @@ fn section_key(text: &str, key: &str) -> Option<String> {
     Some(table.get("continuation")?.get(key)?.as_str()?.to_string())
 }
 
+/// The problem's continued family and options, or exit 2 naming the
+/// missing `[continuation]` table.
+pub fn continued<'p>(
+    problem: &'p Problem,
+    path: &Path,
+) -> Result<(&'p Family, &'p ContinuationOptions), ExitCode> {
+    match &problem.continuation {
+        Some((family, opts)) => Ok((family, opts)),
+        None => Err(fail(
+            BAD_INPUT,
+            format!(
+                "{}: continuation: the problem has no [continuation] table",
+                path.display()
+            ),
+        )),
+    }
+}
+
 /// What `cosserat continue` was asked.
 pub struct ContinueArgs<'a> {
     /// The problem file.
@@ -78,14 +96,9 @@ pub fn run_continue(args: &ContinueArgs) -> ExitCode {
         Ok(read) => read,
         Err(code) => return code,
     };
-    let Some((family, opts)) = &problem.continuation else {
-        return fail(
-            BAD_INPUT,
-            format!(
-                "{}: continuation: the problem has no [continuation] table",
-                path.display()
-            ),
-        );
+    let (family, opts) = match continued(&problem, path) {
+        Ok(c) => c,
+        Err(code) => return code,
     };
     let mut outputs: Vec<&Path> = vec![output];
     outputs.extend(plot);

@@ -9,6 +9,21 @@ fn shipped(name: &str) -> String {
     format!("{}/../../problems/{name}.toml", env!("CARGO_MANIFEST_DIR"))
 }
 
+/// `cosserat continue PROBLEM -o OUT --from FROM --point POINT EXTRA…`.
+fn continue_from(
+    problem: &str,
+    out: &str,
+    from: &str,
+    point: &str,
+    extra: &[&str],
+) -> std::process::Output {
+    let mut args = vec![
+        "continue", problem, "-o", out, "--from", from, "--point", point,
+    ];
+    args.extend_from_slice(extra);
+    run(&args)
+}
+
 /// A restart from a point of the buckled Euler branch ends where the
 /// uninterrupted branch ends (the 170° landing), and says where it started.
 #[test]
@@ -19,18 +34,13 @@ fn a_restart_goes_on_along_the_stored_branch() {
     let euler = shipped("euler_column");
     let o = run(&["continue", &euler, "-o", full.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let o = run(&[
-        "continue",
+    let o = continue_from(
         &euler,
-        "-o",
         again.to_str().unwrap(),
-        "--from",
         full.to_str().unwrap(),
-        "--point",
         "1/10",
-        "--set",
-        "continuation.switch_depth=0",
-    ]);
+        &["--set", "continuation.switch_depth=0"],
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(out.contains("branch 1 point 10: load_scale = "), "{out}");
@@ -55,24 +65,22 @@ fn a_chained_stage_holds_the_first_parameter() {
         "continuation.bounds=[0.0, 6.3]",
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let o = run(&[
-        "continue",
+    let o = continue_from(
         &twisted,
-        "-o",
         second.to_str().unwrap(),
-        "--from",
         first.to_str().unwrap(),
-        "--point",
         "0/last",
-        "--set",
-        "continuation.parameter=\"energy.stiffness[2]\"",
-        "--set",
-        "continuation.start=1.0",
-        "--set",
-        "continuation.bounds=[0.5, 1.5]",
-        "--set",
-        "continuation.switch_depth=0",
-    ]);
+        &[
+            "--set",
+            "continuation.parameter=\"energy.stiffness[2]\"",
+            "--set",
+            "continuation.start=1.0",
+            "--set",
+            "continuation.bounds=[0.5, 1.5]",
+            "--set",
+            "continuation.switch_depth=0",
+        ],
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(out.contains("support.turn.angle = 6.3"), "{out}");
@@ -102,30 +110,18 @@ fn bad_stored_points_are_refused_by_name() {
         ("x", "BRANCH/POINT"),
         ("1/y", "points"),
     ] {
-        let o = run(&[
-            "continue",
+        let o = continue_from(
             &euler,
-            "-o",
             out.to_str().unwrap(),
-            "--from",
             full.to_str().unwrap(),
-            "--point",
             point,
-        ]);
+            &[],
+        );
         assert_eq!(o.status.code(), Some(2), "{point}");
         assert!(stderr(&o).contains(says), "{point}: {}", stderr(&o));
         assert!(!out.exists(), "nothing written");
     }
-    let o = run(&[
-        "continue",
-        &euler,
-        "-o",
-        out.to_str().unwrap(),
-        "--from",
-        &euler,
-        "--point",
-        "0/0",
-    ]);
+    let o = continue_from(&euler, out.to_str().unwrap(), &euler, "0/0", &[]);
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("not a diagram file"), "{}", stderr(&o));
     let o = run(&[
@@ -151,16 +147,13 @@ fn a_stored_branch_point_is_switched_again() {
     let o = run(&["continue", &euler, "-o", full.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
     let first = String::from_utf8_lossy(&o.stdout).into_owned();
-    let o = run(&[
-        "continue",
+    let o = continue_from(
         &euler,
-        "-o",
         again.to_str().unwrap(),
-        "--from",
         full.to_str().unwrap(),
-        "--point",
         "special/0",
-    ]);
+        &[],
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     let out = String::from_utf8_lossy(&o.stdout);
     let buckled = |text: &str| {
@@ -180,16 +173,13 @@ fn a_stored_branch_point_is_switched_again() {
     assert_eq!(buckled(&out).len(), 2, "{out}");
     assert_eq!(buckled(&out), buckled(&first), "the same branches: {out}");
     for bad in ["special/9", "special/x"] {
-        let o = run(&[
-            "continue",
+        let o = continue_from(
             &euler,
-            "-o",
             dir.join("bad.h5").to_str().unwrap(),
-            "--from",
             full.to_str().unwrap(),
-            "--point",
             bad,
-        ]);
+            &[],
+        );
         assert_eq!(o.status.code(), Some(2), "{bad}");
         assert!(stderr(&o).contains("special points"), "{}", stderr(&o));
     }
@@ -212,16 +202,13 @@ fn hostile_stored_diagrams_are_refused() {
         garbage.as_path(),
         missing.as_path(),
     ] {
-        let o = run(&[
-            "continue",
+        let o = continue_from(
             &euler,
-            "-o",
             out.to_str().unwrap(),
-            "--from",
             from.to_str().unwrap(),
-            "--point",
             "0/0",
-        ]);
+            &[],
+        );
         assert_eq!(o.status.code(), Some(2), "{}", from.display());
         assert!(stderr(&o).contains("not a diagram file"), "{}", stderr(&o));
         assert!(!out.exists(), "nothing written");

@@ -110,6 +110,28 @@ pub struct CurveSection {
     pub max_points: usize,
 }
 
+/// `bounds` = [lo, hi] finite with lo < hi, and `start` inside them;
+/// `table` names the keys (`continuation`, `continuation.curve`).
+fn bounds_with_start(
+    table: &str,
+    [lo, hi]: [f64; 2],
+    start: f64,
+) -> Result<(f64, f64), ProblemError> {
+    if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+        return Err(invalid(
+            format!("{table}.bounds"),
+            format!("need finite lo < hi, got [{lo}, {hi}]"),
+        ));
+    }
+    if !(start.is_finite() && (lo..=hi).contains(&start)) {
+        return Err(invalid(
+            format!("{table}.start"),
+            format!("{start} is not inside the bounds"),
+        ));
+    }
+    Ok((lo, hi))
+}
+
 impl CurveSection {
     /// The key and the curve options (the first parameter's bounds from
     /// `[continuation]`), validated.
@@ -117,19 +139,7 @@ impl CurveSection {
         &self,
         first: &ContinuationOptions,
     ) -> Result<(String, f64, crate::continuation::CurveOptions), ProblemError> {
-        let [lo, hi] = self.bounds;
-        if !(lo.is_finite() && hi.is_finite() && lo < hi) {
-            return Err(invalid(
-                "continuation.curve.bounds",
-                format!("need finite lo < hi, got [{lo}, {hi}]"),
-            ));
-        }
-        if !(self.start.is_finite() && (lo..=hi).contains(&self.start)) {
-            return Err(invalid(
-                "continuation.curve.start",
-                format!("{} is not inside the bounds", self.start),
-            ));
-        }
+        let (lo, hi) = bounds_with_start("continuation.curve", self.bounds, self.start)?;
         let step = positive("continuation.curve.step", self.step)?;
         let max_step = positive("continuation.curve.max_step", self.max_step)?;
         if step > max_step {
@@ -215,19 +225,7 @@ impl ContinuationSection {
     /// any numeric key of the rod's tables).
     pub fn build(&self) -> Result<(String, ContinuationOptions), ProblemError> {
         let parameter = self.parameter.trim().to_string();
-        let [lo, hi] = self.bounds;
-        if !(lo.is_finite() && hi.is_finite() && lo < hi) {
-            return Err(invalid(
-                "continuation.bounds",
-                format!("need finite lo < hi, got [{lo}, {hi}]"),
-            ));
-        }
-        if !(self.start.is_finite() && (lo..=hi).contains(&self.start)) {
-            return Err(invalid(
-                "continuation.start",
-                format!("{} is not inside the bounds", self.start),
-            ));
-        }
+        let (lo, hi) = bounds_with_start("continuation", self.bounds, self.start)?;
         let step = positive("continuation.step", self.step)?;
         let min_step = positive("continuation.min_step", self.min_step)?;
         let max_step = positive("continuation.max_step", self.max_step)?;
