@@ -75,11 +75,11 @@ pub fn run_curve(
         last.map_or(f64::NAN, |p| p.parameters[1]),
         followed.ends.join("; ")
     );
-    for &i in &followed.cusps {
-        let (a, b) = (&followed.points[i], &followed.points[i + 1]);
+    for cusp in &followed.cusps {
+        let [p1, p2] = cusp.point.parameters;
         println!(
-            "cusp      between ({:.8}, {:.8}) and ({:.8}, {:.8})",
-            a.parameters[0], a.parameters[1], b.parameters[0], b.parameters[1]
+            "cusp      at ({p1:.12}, {p2:.12}), after point {}",
+            cusp.after
         );
     }
     println!("time      {:.1} ms", clock.elapsed().as_secs_f64() * 1e3);

@@ -63,3 +63,46 @@ fn euler_branch_point_curve_is_pi_squared_over_four_l_squared() {
     );
     assert!(curve.cusps.is_empty(), "a smooth curve has no cusp");
 }
+
+/// A fold curve with a cusp: the paper's Fig. 2 rod (its clamp turned,
+/// a tip weight) has a pair of folds in the clamp angle; followed in the
+/// rod length, the fold curve comes down to a cusp where the pair is born —
+/// at the clamp pointing straight up, 3π/2, and Euler's critical length of
+/// the upright column, L √(F/B) = π/2 (paper eq. (2)): below it the upright
+/// rod stands, above it buckles. Located to 1e-9 in both parameters.
+#[test]
+fn the_fold_pair_of_a_turned_clamp_is_born_at_eulers_upright_column() {
+    const FIG2: &str = include_str!("../../../problems/planar_clamp_angle.toml");
+    let problem = Problem::from_str_with(FIG2, &[]).unwrap();
+    let (family, opts) = problem.continuation.clone().unwrap();
+    let d = continuation(&family, &opts, &mut |_, _| true).unwrap();
+    let fold = d
+        .special_points
+        .iter()
+        .find(|s| s.kind == SpecialKind::Fold && s.point.parameter > 5.0)
+        .expect("the fold near 5.46");
+    let length = Arc::new(RodLens::new(problem.rod.clone(), Parameter::Length));
+    let pair: Arc<dyn Lens2> = Arc::new(ParameterOn::new(Parameter::ClampAngle, length));
+    let curve_opts = CurveOptions {
+        bounds: [(-6.3, 6.3), (1.0, 2.6)],
+        step: 0.05,
+        max_step: 0.1,
+        ..CurveOptions::default()
+    };
+    let curve = follow_singular(
+        &family,
+        &pair,
+        SpecialKind::Fold,
+        &fold.point.unknowns,
+        [fold.point.parameter, 2.4],
+        &curve_opts,
+    )
+    .unwrap();
+    assert_eq!(curve.cusps.len(), 1, "one cusp");
+    let [angle, l] = curve.cusps[0].point.parameters;
+    let (up, euler) = (1.5 * std::f64::consts::PI, std::f64::consts::FRAC_PI_2);
+    assert!((angle - up).abs() < 1e-9, "cusp angle {angle} vs 3π/2");
+    assert!((l - euler).abs() < 1e-9, "cusp length {l} vs π/2");
+    // Every point of the curve is a fold: |g| at the tolerance.
+    assert!(curve.points.iter().all(|p| p.singularity < 1e-8));
+}

@@ -98,6 +98,17 @@ pub struct CurvePoint {
     pub singularity: f64,
 }
 
+/// A cusp of the curve: where its projection on (p₁, p₂) turns back,
+/// located by bisection in the arclength between two points.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cusp {
+    /// The index of the curve point before it.
+    pub after: usize,
+    /// The located point, where the projected tangent vanishes (to the
+    /// bisection's 2⁻⁴⁰ of the step).
+    pub point: CurvePoint,
+}
+
 /// A followed curve of singular points.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SingularCurve {
@@ -105,8 +116,8 @@ pub struct SingularCurve {
     pub keys: [String; 2],
     /// The points, from one end to the other.
     pub points: Vec<CurvePoint>,
-    /// Cusps: each lies between point i and i + 1.
-    pub cusps: Vec<usize>,
+    /// Cusps, located.
+    pub cusps: Vec<Cusp>,
     /// Why each end stopped (the first end, then the second).
     pub ends: [String; 2],
 }
@@ -372,13 +383,76 @@ pub fn follow_singular(
     points.extend(halves[0].iter().cloned());
     let cusps = (0..points.len().saturating_sub(1))
         .filter(|&i| projected(&points[i], n).dot(&projected(&points[i + 1], n)) < 0.0)
-        .collect();
+        .map(|i| {
+            locate_cusp(&aug, &points[i], &points[i + 1], opts)
+                .map(|point| Cusp { after: i, point })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
     Ok(SingularCurve {
         keys: pair.keys(),
         points,
         cusps,
         ends: [ends[1].clone(), ends[0].clone()],
     })
+}
+
+/// The cusp between `a` and `b` (whose projected tangents point against
+/// each other): bisection in the arclength s from `a` along its tangent
+/// on the sign of proj τ_a · proj τ(s), each τ(s) at the point corrected
+/// from z_a + s τ_a with a's borders. Refused (an error, not a guess)
+/// when a corrector along the way does not converge.
+fn locate_cusp(
+    aug: &Augmented,
+    a: &CurvePoint,
+    b: &CurvePoint,
+    opts: &CurveOptions,
+) -> Result<CurvePoint, ContinuationError> {
+    let n = aug.n;
+    let m = aug.unknowns();
+    let za = |p: &CurvePoint| {
+        let mut z = p.unknowns.clone();
+        z.extend_from_slice(&p.parameters);
+        z.resize(m, 0.0);
+        z
+    };
+    let (z0, z1) = (za(a), za(b));
+    let mut tau = a.tangent.clone();
+    tau.resize(m, 0.0);
+    let span: f64 = z0
+        .iter()
+        .zip(&z1)
+        .zip(&tau)
+        .map(|((x, y), t)| (y - x) * t)
+        .sum();
+    let (_, fx) = aug.evaluate(&z0)?;
+    let (left, right) = Augmented::null_vectors(&fx);
+    let along = projected(a, n);
+    let at = |s: f64| -> Result<(Vec<f64>, Vec<f64>), ContinuationError> {
+        let pred: Vec<f64> = z0.iter().zip(&tau).map(|(z, t)| z + s * t).collect();
+        let (z, jac, _) = aug
+            .correct(&pred, &tau, (&left, &right), &a.unknowns, opts.tolerance)?
+            .ok_or_else(|| ContinuationError::Start {
+                p: a.parameters[0],
+                message: "the cusp could not be located: a corrector did not converge".into(),
+            })?;
+        let t = Augmented::tangent(&jac, &tau).ok_or(PointError::SingularTangent(z[n]))?;
+        Ok((z, t))
+    };
+    let (mut lo, mut hi) = (0.0, span);
+    let mut found = None;
+    for _ in 0..40 {
+        let mid = 0.5 * (lo + hi);
+        let (z, t) = at(mid)?;
+        let turned = along.dot(&nalgebra::Vector2::new(t[n], t[n + 1])) < 0.0;
+        if turned {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+        found = Some((z, t));
+    }
+    let (z, t) = found.expect("forty halvings");
+    Ok(curve_point(aug, &z, t, &left, &right)?)
 }
 
 /// The curve's tangent projected on (p₁, p₂), oriented along the stored

@@ -3,7 +3,7 @@
 //! Layout: `/curve/parameters` (m×2: p₁, p₂), `unknowns` (m×n), `tangent`
 //! (m×(n+2) or m×(n+3) with the branch point's ψ), `null_vector` (m×n),
 //! `singularity` (m: |g|), `cusps` (the index of the point before each
-//! cusp); root attributes `problem` (the problem text), `parameter_names`
+//! cusp), `cusp_parameters` (c×2: the located cusps); root attributes `problem` (the problem text), `parameter_names`
 //! (the two keys, comma separated), `kind` (`fold` or `branch_point`),
 //! `ends` (why each end stopped, `;` separated).
 
@@ -50,10 +50,16 @@ pub fn write_curve(
         array(&g, "null_vector", &[m, nv], &v)?;
         let s: Vec<f64> = curve.points.iter().map(|c| c.singularity).collect();
         array(&g, "singularity", &[m], &s)?;
-        let cusps: Vec<u64> = curve.cusps.iter().map(|&i| i as u64).collect();
+        let after: Vec<u64> = curve.cusps.iter().map(|c| c.after as u64).collect();
         g.new_dataset::<u64>()
-            .shape([cusps.len()])
+            .shape([after.len()])
             .create("cusps")?
-            .write_raw(&cusps)
+            .write_raw(&after)?;
+        let at: Vec<f64> = curve
+            .cusps
+            .iter()
+            .flat_map(|c| c.point.parameters)
+            .collect();
+        array(&g, "cusp_parameters", &[curve.cusps.len(), 2], &at)
     })
 }

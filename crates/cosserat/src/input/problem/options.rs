@@ -111,11 +111,12 @@ pub(super) fn build_curve(
         ));
     }
     let pair: Arc<dyn Lens2> = match Parameter::from_key(first) {
-        Some(Parameter::ClampAngle) => {
+        Some(Parameter::ClampAngle) if file.clamp.angle != 0.0 => {
             return Err(invalid(
                 "continuation.curve",
-                "clamp.angle as the first parameter of a curve is not supported (its base \
-                 frame is the unturned one); continue clamp.turn.angle instead",
+                "clamp.angle as the first parameter of a curve turns the rods of the second \
+                 parameter, which carry the file's clamp.angle: write clamp.angle = 0 (the \
+                 continued angle is then absolute)",
             ))
         }
         Some(p) => {
