@@ -26,14 +26,23 @@ pub fn continuation(
     opts: &ContinuationOptions,
     monitor: &mut dyn FnMut(Progress, &Diagram) -> bool,
 ) -> Result<Diagram, ContinuationError> {
+    check_start(family, opts)?;
+    let mut run = Run::new(family, opts);
+    let first = run.start_point()?;
+    Ok(follow_from(&mut run, first, monitor))
+}
+
+/// The rod at the start value exists and its loads have a potential
+/// (stability decides nothing otherwise).
+pub(super) fn check_start(
+    family: &Family,
+    opts: &ContinuationOptions,
+) -> Result<(), ContinuationError> {
     let start = family.rod_at(opts.start).map_err(PointError::from)?;
     crate::stability::check_conservative(&start).map_err(|e| ContinuationError::Start {
         p: opts.start,
         message: e.to_string(),
-    })?;
-    let mut run = Run::new(family, opts);
-    let first = run.start_point()?;
-    Ok(follow_from(&mut run, first, monitor))
+    })
 }
 
 /// The diagram of a run from its first point: the first branch (both ways

@@ -178,10 +178,7 @@ impl Run<'_> {
     }
 
     fn jacobian(&self, x: &[f64], p: f64) -> Option<DMatrix<f64>> {
-        let n = x.len();
-        let (mut r, mut j) = (DVector::zeros(n), DMatrix::zeros(n, n));
-        self.family.residual(x, p, &mut r, &mut j).ok()?;
-        Some(j)
+        self.dense_jacobian(x, p).ok().map(|(_, j)| j)
     }
 
     /// det F_x, dense up to [`super::corrector::DENSE_UP_TO`] unknowns;

@@ -8,7 +8,7 @@
 //! uninterrupted run did. A stored branch point restarts the switch onto
 //! the branches that leave it ([`switch_from`]).
 
-use super::driver::follow_from;
+use super::driver::{check_start, follow_from};
 use super::resume::rebuild_special;
 use super::{
     drain, Branch, ContinuationError, ContinuationOptions, Diagram, Family, Point, Progress, Run,
@@ -51,11 +51,7 @@ pub fn continuation_from(
     start: &StartPoint,
     monitor: &mut dyn FnMut(Progress, &Diagram) -> bool,
 ) -> Result<Diagram, ContinuationError> {
-    let rod = family.rod_at(opts.start).map_err(super::PointError::from)?;
-    crate::stability::check_conservative(&rod).map_err(|e| ContinuationError::Start {
-        p: opts.start,
-        message: e.to_string(),
-    })?;
+    check_start(family, opts)?;
     let mut run = Run::new(family, opts);
     let first = run.start_point_from(start)?;
     Ok(follow_from(&mut run, first, monitor))

@@ -48,7 +48,8 @@ fn smallest_pair(fx: &DMatrix<f64>) -> Option<(DVector<f64>, DVector<f64>, f64)>
 }
 
 impl Run<'_> {
-    fn dense_jacobian(
+    /// F and the dense F_x at (x, p).
+    pub(super) fn dense_jacobian(
         &self,
         x: &[f64],
         p: f64,
