@@ -20,6 +20,7 @@ use std::time::Instant;
 use nalgebra::DMatrix;
 
 use crate::equations::{KirchhoffEquations, PlanarEquations, RodEquations, RodSample};
+use crate::model::energy_check;
 use crate::model::{ModelChoice, ModelLevel, Rod};
 use crate::numerics::integrator::{IntegrationStats, Tolerances};
 pub use collocation::{
@@ -363,10 +364,76 @@ pub fn solve(
             }
         }
     };
+    check_derivatives_along(rod, &equilibrium.samples)?;
     Ok(Equilibrium {
         wall_time: start.elapsed().as_secs_f64(),
         ..equilibrium
     })
+}
+
+/// Whether the energy's derivatives are checked before and after a solve:
+/// a program's own energy always (its hand-written derivatives are what a
+/// wrong answer would come from), every energy in debug builds.
+fn derivatives_checked(rod: &Rod) -> bool {
+    cfg!(debug_assertions) || !rod.energy().derivatives_trusted()
+}
+
+/// The energy's derivatives at the strains of the solution (at most 17
+/// samples along it), before the solution is reported.
+fn check_derivatives_along(rod: &Rod, samples: &[RodSample]) -> Result<(), SolveError> {
+    if !derivatives_checked(rod) || samples.is_empty() {
+        return Ok(());
+    }
+    let every = samples.len().div_ceil(17);
+    let at: Vec<_> = samples
+        .iter()
+        .step_by(every)
+        .map(|x| (x.s, x.curvature))
+        .collect();
+    let report = energy_check::check_at(
+        rod.energy().as_ref(),
+        rod.length(),
+        curvature_scale(rod),
+        &at,
+    );
+    derivative_verdict(rod, "along the solution", &report)
+}
+
+/// A typical curvature of the problem (1/m): 1/L, or the curvature the
+/// loads' moment scale gives the softest section.
+fn curvature_scale(rod: &Rod) -> f64 {
+    let zero = nalgebra::Vector3::zeros();
+    let softest = (0..=8)
+        .map(|i| {
+            let s = rod.length() * f64::from(i) / 8.0;
+            rod.energy()
+                .stiffness(s, &zero)
+                .symmetric_eigenvalues()
+                .min()
+        })
+        .fold(f64::INFINITY, f64::min);
+    let loaded = rod.loads().moment_scale(rod.length()) / softest;
+    (1.0 / rod.length()).max(if loaded.is_finite() { loaded } else { 0.0 })
+}
+
+fn derivative_verdict(
+    rod: &Rod,
+    place: &str,
+    report: &energy_check::EnergyCheck,
+) -> Result<(), SolveError> {
+    match report.failures().next() {
+        None => Ok(()),
+        Some(f) => Err(SolveError::Model(format!(
+            "the {} energy's {} disagrees with a difference of the quantity it derives              (by {:.2e} relative at s = {}, κ = ({:e}, {:e}, {:e}), {place}): a wrong              hand-written derivative gives a wrong equilibrium; `cosserat check-energy`              lists every sample",
+            rod.energy().name(),
+            f.property.name(),
+            f.error,
+            f.s,
+            f.kappa[0],
+            f.kappa[1],
+            f.kappa[2]
+        ))),
+    }
 }
 
 impl SolveError {
@@ -411,8 +478,14 @@ impl Solved {
 /// κ' = H⁻¹(M' − ∂s∇W) to exist (see [`crate::model::StoredEnergy`]);
 /// checked on the undeformed rod at 65
 /// points, and along the solution by the integrator (a singular H there
-/// makes the state non-finite, reported as a blow-up).
+/// makes the state non-finite, reported as a blow-up). An energy whose
+/// derivatives are not trusted has them checked first
+/// ([`energy_check::check`]).
 fn check_energy(rod: &Rod) -> Result<(), SolveError> {
+    if derivatives_checked(rod) {
+        let report = energy_check::check(rod.energy().as_ref(), rod.length(), curvature_scale(rod));
+        derivative_verdict(rod, "before the solve", &report)?;
+    }
     let kappa = nalgebra::Vector3::zeros();
     for i in 0..=64 {
         let s = rod.length() * f64::from(i) / 64.0;

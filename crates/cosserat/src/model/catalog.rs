@@ -10,6 +10,7 @@
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
+use super::formula::{Formula, FormulaEnergy, Variable as FormulaVariable};
 use super::{LinearElastic, ModelError, Profile, QuarticStiffening, StoredEnergy};
 
 /// The `[energy]` table of a problem file, validated.
@@ -21,6 +22,8 @@ pub struct EnergySpec {
     pub intrinsic_curvature: [Profile; 3],
     /// `[energy.parameters]`: further numbers an energy needs, finite.
     pub parameters: BTreeMap<String, f64>,
+    /// `energy.density`: the formula of a `kind = "formula"` energy.
+    pub density: Option<String>,
 }
 
 /// A problem in an energy specification: the parameter (the key under
@@ -72,8 +75,15 @@ impl EnergySpec {
     }
 
     /// Rejects parameters the energy does not know (typos would otherwise
-    /// pass silently).
+    /// pass silently), and a `density` formula (only `kind = "formula"`
+    /// reads one).
     pub fn only(&self, known: &[&str]) -> Result<(), EnergySpecError> {
+        if self.density.is_some() {
+            return Err(EnergySpecError {
+                field: "energy.density".into(),
+                message: "only an energy of kind \"formula\" reads a density formula".into(),
+            });
+        }
         match self
             .parameters
             .keys()
@@ -138,6 +148,7 @@ impl EnergyCatalog {
             }
             Ok(Arc::new(QuarticStiffening::new(spec.linear()?, quartic)?))
         });
+        c.register("formula", formula_energy);
         c
     }
 
@@ -169,6 +180,49 @@ impl EnergyCatalog {
     }
 }
 
+/// The `formula` energy: `energy.density` parsed with the parameters
+/// bound; every parameter must be read by the formula (a typo in a name
+/// would otherwise pass silently).
+fn formula_energy(spec: &EnergySpec) -> Result<Arc<dyn StoredEnergy>, EnergySpecError> {
+    let text = spec.density.as_deref().ok_or_else(|| EnergySpecError {
+        field: "energy.density".into(),
+        message: "required by kind = \"formula\": W as an expression in k1, k2, k3, s, B1, B2, B3 \
+                  and energy.parameters"
+            .into(),
+    })?;
+    if let Some(name) = spec
+        .parameters
+        .keys()
+        .find(|n| FormulaVariable::NAMES.contains(&n.as_str()) || n.as_str() == "pi")
+    {
+        return Err(EnergySpecError {
+            field: format!("energy.parameters.{name}"),
+            message: "is a name the formula language reserves; rename it".into(),
+        });
+    }
+    let bound = |name: &str| spec.parameters.get(name).copied();
+    let formula = Formula::new(text, &bound).map_err(|e| EnergySpecError {
+        field: "energy.density".into(),
+        message: e.to_string(),
+    })?;
+    if let Some(name) = spec.parameters.keys().find(|n| !formula.binds(n)) {
+        return Err(EnergySpecError {
+            field: format!("energy.parameters.{name}"),
+            message: "not read by energy.density".into(),
+        });
+    }
+    let energy = FormulaEnergy::new(
+        formula,
+        spec.stiffness.clone(),
+        spec.intrinsic_curvature.clone(),
+    )
+    .map_err(|e| EnergySpecError {
+        field: "energy.density".into(),
+        message: e.0,
+    })?;
+    Ok(Arc::new(energy))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -181,6 +235,7 @@ mod tests {
             stiffness: [1.0, -2.0, 1.0].map(Profile::Constant),
             intrinsic_curvature: Default::default(),
             parameters: BTreeMap::new(),
+            density: None,
         };
         let catalog = EnergyCatalog::standard();
         let err = catalog.build("linear", &spec).unwrap().unwrap_err();
@@ -190,6 +245,7 @@ mod tests {
             stiffness: [1.0; 3].map(Profile::Constant),
             intrinsic_curvature: [0.0, 0.0, f64::NAN].map(Profile::Constant),
             parameters: BTreeMap::from([("quartic".to_owned(), 0.5)]),
+            density: None,
         };
         let err = catalog.build("quartic", &spec).unwrap().unwrap_err();
         assert_eq!(err.field, "energy.intrinsic_curvature[2]");

@@ -45,6 +45,15 @@ pub trait StoredEnergy: std::fmt::Debug + Send + Sync {
     fn is_quadratic(&self) -> bool {
         false
     }
+    /// Whether the derivatives are exact by construction or verified in
+    /// this crate's tests (the built-in energies against automatic
+    /// differentiation, crates/cosserat/tests/formula_energy.rs; formulas,
+    /// differentiated automatically). Otherwise — a program's own energy —
+    /// the solver checks them with [`super::energy_check`] before and
+    /// after every solve, and refuses an energy that fails.
+    fn derivatives_trusted(&self) -> bool {
+        false
+    }
     /// The stiffnesses S = (S1, S2, S3) of a quadratic shear and extension
     /// energy ½ (ν − e3)ᵀ diag(S) (ν − e3) at s (see [`super::Shearable`]);
     /// None for an unshearable, inextensible (Kirchhoff) rod.
@@ -235,6 +244,10 @@ impl StoredEnergy for LinearElastic {
         true
     }
 
+    fn derivatives_trusted(&self) -> bool {
+        true
+    }
+
     fn intrinsic_profiles(&self) -> Option<&[Profile; 3]> {
         Some(&self.intrinsic_curvature)
     }
@@ -376,6 +389,10 @@ impl StoredEnergy for QuarticStiffening {
 
     fn name(&self) -> &'static str {
         "quartic"
+    }
+
+    fn derivatives_trusted(&self) -> bool {
+        true
     }
 }
 

@@ -5,7 +5,9 @@
 
 mod catalog;
 mod energy;
+pub mod energy_check;
 mod error;
+mod formula;
 mod frame;
 mod level;
 mod loads;
@@ -17,6 +19,10 @@ mod support;
 pub use catalog::{EnergyBuilder, EnergyCatalog, EnergySpec, EnergySpecError};
 pub use energy::{LinearElastic, ProfileKind, QuarticStiffening, StoredEnergy};
 pub use error::ModelError;
+pub use formula::{
+    Formula, FormulaEnergy, FormulaError, Variable as FormulaVariable,
+    FUNCTIONS as FORMULA_FUNCTIONS,
+};
 pub use frame::Frame;
 pub use level::{ModelChoice, ModelLevel};
 pub use loads::DeadLoads;

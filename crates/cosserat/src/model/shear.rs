@@ -90,6 +90,10 @@ impl StoredEnergy for Shearable {
         self.bending.is_quadratic()
     }
 
+    fn derivatives_trusted(&self) -> bool {
+        self.bending.derivatives_trusted()
+    }
+
     fn shear_stiffness(&self, _s: f64) -> Option<Vector3<f64>> {
         Some(self.shear)
     }

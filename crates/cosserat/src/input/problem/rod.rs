@@ -165,6 +165,7 @@ pub(super) fn build_energy(
         stiffness: Default::default(),
         intrinsic_curvature: Default::default(),
         parameters: BTreeMap::default(),
+        density: e.density.clone(),
     };
     let mut softest: Option<(f64, String)> = None;
     let mut stiffest: Option<(f64, String)> = None;

@@ -112,6 +112,9 @@ pub struct EnergySection {
     /// Further numbers of a registered energy (`[energy.parameters]`).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub parameters: BTreeMap<String, f64>,
+    /// W as a formula (`kind = "formula"`, `model::Formula`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density: Option<String>,
     /// Shear and extension stiffnesses (k G A, k G A, E A) in N: a
     /// shearable, extensible Cosserat rod. Absent: unshearable and
     /// inextensible (Kirchhoff).

@@ -1,0 +1,316 @@
+//! Checks of a stored energy's derivatives: what catches a wrong
+//! hand-written moment, stiffness, s-rate or third derivative before it
+//! can give an answer (a Hessian 2 % off still converges — to a wrong
+//! tip).
+//!
+//! At sampled arc lengths and strains each derivative is compared with a
+//! central difference of the quantity below it (M with W, H with M, the
+//! s-rates with M and H in s, ∂(Hv)/∂κ with H v), of fourth order and
+//! Richardson-checked: D(h) and D(h/2) differ by about the truncation
+//! error of D(h) (15/16 of it), which bounds the reference's own error. A
+//! derivative passes when it is within 100 such bounds plus 1e-9 of the
+//! quantity's scale; where the two differences disagree by more than 1e-4
+//! of the scale the energy is not smooth there (a kink of `abs`, `min`,
+//! `max` or a table's knot) and the sample is *undecided*, not passed.
+//! Also checked: H symmetric, H positive definite (where it is not, the
+//! material itself is unstable there — a material instability, not a
+//! structural one), and the planar claim (M1 = M3 = 0 on κ1 = κ3 = 0).
+
+use nalgebra::{Matrix3, Vector3};
+
+use super::StoredEnergy;
+
+/// Which property a finding is about.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Property {
+    /// M = ∂W/∂κ.
+    Moment,
+    /// H = ∂M/∂κ.
+    Stiffness,
+    /// ∂sM at fixed κ.
+    MomentRate,
+    /// ∂sH at fixed κ.
+    StiffnessRate,
+    /// ∂(H v)/∂κ.
+    StiffnessDerivative,
+    /// H = Hᵀ.
+    Symmetry,
+    /// H positive definite (material stability).
+    Convexity,
+    /// M1 = M3 = 0 on κ1 = κ3 = 0, claimed by `admits_planar_bending`.
+    PlanarBending,
+}
+
+impl Property {
+    /// A name for reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Property::Moment => "moment M = ∂W/∂κ",
+            Property::Stiffness => "stiffness H = ∂M/∂κ",
+            Property::MomentRate => "moment rate ∂sM",
+            Property::StiffnessRate => "stiffness rate ∂sH",
+            Property::StiffnessDerivative => "third derivative ∂(Hv)/∂κ",
+            Property::Symmetry => "symmetry of H",
+            Property::Convexity => "positive definite H",
+            Property::PlanarBending => "planar bending (M1 = M3 = 0 on κ1 = κ3 = 0)",
+        }
+    }
+}
+
+/// One failed or undecided sample.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Finding {
+    /// What was checked.
+    pub property: Property,
+    /// Where: arc length.
+    pub s: f64,
+    /// Where: strains κ.
+    pub kappa: Vector3<f64>,
+    /// The largest difference from the reference, relative to the scale.
+    pub error: f64,
+    /// Whether the sample could not be decided (a non-smooth energy).
+    pub undecided: bool,
+}
+
+/// The result of [`check`]: every sample that failed or could not be
+/// decided; passed when there is no failure.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EnergyCheck {
+    /// The number of (s, κ) samples.
+    pub samples: usize,
+    /// Failures and undecided samples.
+    pub findings: Vec<Finding>,
+    /// The largest relative difference of a passed derivative.
+    pub worst_passed: f64,
+}
+
+impl EnergyCheck {
+    /// No failure (undecided samples allowed, and reported).
+    pub fn passed(&self) -> bool {
+        self.findings.iter().all(|f| f.undecided)
+    }
+
+    /// The failures.
+    pub fn failures(&self) -> impl Iterator<Item = &Finding> {
+        self.findings.iter().filter(|f| !f.undecided)
+    }
+}
+
+impl std::fmt::Display for EnergyCheck {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let failed = self.failures().count();
+        let undecided = self.findings.len() - failed;
+        writeln!(
+            f,
+            "{} samples: {failed} failed, {undecided} undecided; worst passed derivative {:.1e} \
+             (relative)",
+            self.samples, self.worst_passed
+        )?;
+        for x in &self.findings {
+            writeln!(
+                f,
+                "  {} {} at s = {:.6}, κ = ({:.4e}, {:.4e}, {:.4e}): off by {:.2e} relative",
+                if x.undecided { "undecided" } else { "FAILED" },
+                x.property.name(),
+                x.s,
+                x.kappa[0],
+                x.kappa[1],
+                x.kappa[2],
+                x.error
+            )?;
+        }
+        Ok(())
+    }
+}
+
+/// The strain directions sampled around κ⁰(s), scaled by `scale`.
+const DIRECTIONS: [[f64; 3]; 5] = [
+    [0.0, 0.0, 0.0],
+    [0.3, -0.7, 0.2],
+    [-0.9, 0.4, 0.6],
+    [0.05, 1.1, -0.35],
+    [0.0, -0.8, 0.0],
+];
+
+/// Checks `energy` on [0, `length`] at 9 arc lengths (off the ends and
+/// the midpoint, where tables put knots) × 5 strains κ⁰(s) + `scale` d,
+/// `scale` a typical curvature (1/m) of the problem.
+pub fn check(energy: &dyn StoredEnergy, length: f64, scale: f64) -> EnergyCheck {
+    let mut samples = Vec::new();
+    for j in 0..9 {
+        let s = length * (f64::from(j) + 0.37) / 9.0;
+        let kappa0 = intrinsic(energy, s);
+        for d in DIRECTIONS {
+            samples.push((s, kappa0 + scale * Vector3::from(d)));
+        }
+    }
+    check_at(energy, length, scale, &samples)
+}
+
+/// Checks `energy` at given (s, κ) samples, e.g. along a solution.
+pub fn check_at(
+    energy: &dyn StoredEnergy,
+    length: f64,
+    scale: f64,
+    samples: &[(f64, Vector3<f64>)],
+) -> EnergyCheck {
+    let mut report = EnergyCheck {
+        samples: samples.len(),
+        findings: Vec::new(),
+        worst_passed: 0.0,
+    };
+    for &(s, kappa) in samples {
+        Sample {
+            energy,
+            s,
+            kappa,
+            hk: 1e-3 * scale.max(kappa.amax()).max(1e-300),
+            hs: 1e-3 * length,
+        }
+        .check(&mut report);
+    }
+    report
+}
+
+fn intrinsic(energy: &dyn StoredEnergy, s: f64) -> Vector3<f64> {
+    energy
+        .intrinsic_profiles()
+        .map_or_else(Vector3::zeros, |p| Vector3::from_fn(|i, _| p[i].value(s)))
+}
+
+/// One (s, κ) and its difference steps in κ and in s.
+struct Sample<'e> {
+    energy: &'e dyn StoredEnergy,
+    s: f64,
+    kappa: Vector3<f64>,
+    hk: f64,
+    hs: f64,
+}
+
+/// The fourth-order central difference of f at 0 with step h, and the
+/// Richardson bound of its error: |D(h) − D(h/2)|.
+fn derivative<const N: usize>(f: impl Fn(f64) -> [f64; N], h: f64) -> ([f64; N], [f64; N]) {
+    let d = |h: f64| {
+        let (a, b, c, e) = (f(-2.0 * h), f(-h), f(h), f(2.0 * h));
+        std::array::from_fn(|i| (a[i] - 8.0 * b[i] + 8.0 * c[i] - e[i]) / (12.0 * h))
+    };
+    let (coarse, fine): ([f64; N], [f64; N]) = (d(h), d(0.5 * h));
+    (fine, std::array::from_fn(|i| (coarse[i] - fine[i]).abs()))
+}
+
+fn max_abs(x: &[f64]) -> f64 {
+    x.iter().fold(0.0, |m, v| m.max(v.abs()))
+}
+
+fn flat(m: &Matrix3<f64>) -> [f64; 9] {
+    std::array::from_fn(|i| m[(i % 3, i / 3)])
+}
+
+impl Sample<'_> {
+    fn check(&self, report: &mut EnergyCheck) {
+        let (e, s, k) = (self.energy, self.s, self.kappa);
+        let m = e.moment(s, &k);
+        let h = e.stiffness(s, &k);
+        let m_scale = m.amax() + h.amax() * self.hk * 1e3;
+        let h_scale = h.amax();
+        for i in 0..3 {
+            let (fd, bound) = derivative(|t| [e.density(s, &self.shifted(i, t))], self.hk);
+            self.compare(report, Property::Moment, &[m[i]], &fd, &bound, m_scale);
+            let (fd, bound) = derivative(|t| e.moment(s, &self.shifted(i, t)).into(), self.hk);
+            let column: [f64; 3] = h.column(i).into();
+            self.compare(report, Property::Stiffness, &column, &fd, &bound, h_scale);
+            let v = Vector3::from(DIRECTIONS[(i + 1) % 5]);
+            let (fd, bound) = derivative(
+                |t| (e.stiffness(s, &self.shifted(i, t)) * v).into(),
+                self.hk,
+            );
+            let third: [f64; 3] = e.stiffness_derivative(s, &k, &v).column(i).into();
+            let third_scale = max_abs(&third) + h_scale / (1e3 * self.hk);
+            self.compare(
+                report,
+                Property::StiffnessDerivative,
+                &third,
+                &fd,
+                &bound,
+                third_scale,
+            );
+        }
+        // Rates are compared on the scale of the quantity over the length.
+        let per_length = 1.0 / (1e3 * self.hs);
+        let (fd, bound) = derivative(|t| e.moment(s + t, &k).into(), self.hs);
+        let rate: [f64; 3] = e.moment_rate(s, &k).into();
+        let scale = max_abs(&rate) + m_scale * per_length;
+        self.compare(report, Property::MomentRate, &rate, &fd, &bound, scale);
+        let (fd, bound) = derivative(|t| flat(&e.stiffness(s + t, &k)), self.hs);
+        let rate = flat(&e.stiffness_rate(s, &k));
+        let scale = max_abs(&rate) + h_scale * per_length;
+        self.compare(report, Property::StiffnessRate, &rate, &fd, &bound, scale);
+        self.structure(report, &h);
+    }
+
+    fn shifted(&self, i: usize, t: f64) -> Vector3<f64> {
+        let mut k = self.kappa;
+        k[i] += t;
+        k
+    }
+
+    fn compare(
+        &self,
+        report: &mut EnergyCheck,
+        property: Property,
+        exact: &[f64],
+        reference: &[f64],
+        bound: &[f64],
+        scale: f64,
+    ) {
+        let scale = scale.max(f64::MIN_POSITIVE);
+        let mut error: f64 = 0.0;
+        let mut undecided = false;
+        for ((a, b), e) in exact.iter().zip(reference).zip(bound) {
+            let off = (a - b).abs();
+            if *e > 1e-4 * scale {
+                undecided = true;
+            } else if off > 100.0 * e + 1e-9 * scale {
+                error = error.max(off / scale);
+            } else {
+                report.worst_passed = report.worst_passed.max(off / scale);
+            }
+        }
+        if undecided || error > 0.0 {
+            report.findings.push(Finding {
+                property,
+                s: self.s,
+                kappa: self.kappa,
+                error,
+                undecided: undecided && error == 0.0,
+            });
+        }
+    }
+
+    fn structure(&self, report: &mut EnergyCheck, h: &Matrix3<f64>) {
+        let mut finding = |property, error| {
+            report.findings.push(Finding {
+                property,
+                s: self.s,
+                kappa: self.kappa,
+                error,
+                undecided: false,
+            });
+        };
+        let asymmetry = (h - h.transpose()).amax() / h.amax().max(f64::MIN_POSITIVE);
+        if asymmetry > 1e-12 {
+            finding(Property::Symmetry, asymmetry);
+        }
+        if h.cholesky().is_none() {
+            finding(Property::Convexity, h.symmetric_eigenvalues().min());
+        }
+        if self.energy.admits_planar_bending() {
+            let k = Vector3::new(0.0, self.kappa[1], 0.0);
+            let m = self.energy.moment(self.s, &k);
+            let off = m[0].abs().max(m[2].abs()) / m.amax().max(h.amax() * self.hk);
+            if off > 1e-12 {
+                finding(Property::PlanarBending, off);
+            }
+        }
+    }
+}
