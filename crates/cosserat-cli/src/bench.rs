@@ -81,7 +81,7 @@ pub fn run(command: BenchCommand) -> ExitCode {
 fn continue_diagram(path: &Path, set: &[String], repeat: usize) -> ExitCode {
     use crate::exit::{fail, BAD_INPUT, NO_RESULT};
     use cosserat::continuation::continuation;
-    let problem = match cosserat::input::Problem::from_path(path, set) {
+    let problem = match crate::energies::read_problem(path, set) {
         Ok(p) => p,
         Err(e) => return fail(BAD_INPUT, format!("{}: {e}", path.display())),
     };

@@ -187,6 +187,16 @@ pub enum Command {
         #[arg(long)]
         force: bool,
     },
+    /// Check the stored energy of a problem: each derivative against a
+    /// difference of the quantity below it, symmetry, convexity and the
+    /// planar claim, at sampled strains and along the solution.
+    CheckEnergy {
+        /// The problem file (TOML).
+        problem: PathBuf,
+        /// Override any key of the problem file.
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        set: Vec<String>,
+    },
     /// Benchmarks: `cosserat bench work-precision [-o DIR]`,
     /// `cosserat bench continue PROBLEM [--set KEY=VALUE ...] [--repeat N]`.
     Bench {

@@ -72,7 +72,7 @@ pub struct ContinueArgs<'a> {
 /// parameter value set before the user's `--set`).
 fn read_problem(args: &ContinueArgs) -> Result<(Problem, Option<StoredStart>), ExitCode> {
     let read = |set: &[String]| {
-        Problem::from_path(args.path, set)
+        crate::energies::read_problem(args.path, set)
             .map_err(|e| fail(BAD_INPUT, format!("{}: {e}", args.path.display())))
     };
     let problem = read(args.set)?;

@@ -35,6 +35,7 @@ pub mod bench;
 pub mod cli;
 pub mod continue_command;
 pub mod curve_command;
+pub mod energies;
 pub mod exit;
 pub mod optimize_command;
 pub mod plot;
@@ -49,6 +50,28 @@ pub mod validate;
 use std::process::ExitCode;
 
 use cli::{Cli, Command};
+
+/// The `cosserat` command with a program's own energies: every command
+/// reads problem files with `catalog` (the standard energies plus the
+/// program's, [`cosserat::model::EnergyCatalog::register`]), so a binary
+/// with one extra energy is `fn main() -> ExitCode {
+/// cosserat_cli::main_with_energies(catalog) }` (examples/own_energy.rs).
+pub fn main_with_energies(catalog: cosserat::model::EnergyCatalog) -> ExitCode {
+    use clap::Parser;
+    run_with_energies(Cli::parse(), catalog)
+}
+
+/// [`run`] with the energies of `catalog`; refused (exit 2) if this
+/// process already read a problem with another catalog.
+pub fn run_with_energies(cli: Cli, catalog: cosserat::model::EnergyCatalog) -> ExitCode {
+    if !energies::install(catalog) {
+        return exit::fail(
+            exit::BAD_INPUT,
+            "the energy catalog was already set in this process",
+        );
+    }
+    run(cli)
+}
 
 /// Runs a parsed command line; the exit code of the table in [`exit`].
 pub fn run(cli: Cli) -> ExitCode {
@@ -145,6 +168,7 @@ pub fn run(cli: Cli) -> ExitCode {
             force,
         } => continue_command::run_plot(&diagram, &measure, &output, force),
         Command::Bench { which } => bench::run(which),
+        Command::CheckEnergy { problem, set } => energies::run_check(&problem, &set),
         Command::Validate(args) => validate::run_cli(&args),
     }
 }

@@ -61,7 +61,7 @@ pub struct OptimizeRun {
 /// Optimizes the arm and writes the results.
 pub fn run_optimize(run: &OptimizeRun) -> ExitCode {
     let path = &run.path;
-    let problem = match Problem::from_path(path, &run.set) {
+    let problem = match crate::energies::read_problem(path, &run.set) {
         Ok(p) => p,
         Err(e) => return fail(BAD_INPUT, format!("{}: {e}", path.display())),
     };

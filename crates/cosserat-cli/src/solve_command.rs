@@ -20,7 +20,7 @@ fn prepare(
     set: &[String],
     force: bool,
 ) -> Result<(Problem, Option<Claim>), ExitCode> {
-    let problem = Problem::from_path(path, set)
+    let problem = crate::energies::read_problem(path, set)
         .map_err(|e| fail(BAD_INPUT, format!("{}: {e}", path.display())))?;
     let claimed = output
         .map(|out| claim(out, &[path], force).map(hold))

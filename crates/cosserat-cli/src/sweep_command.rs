@@ -69,7 +69,7 @@ pub fn run_sweep(args: &SweepArgs) -> ExitCode {
 fn prepare(args: &SweepArgs) -> Result<Option<Setup>, ExitCode> {
     let at = |e: &dyn std::fmt::Display| fail(BAD_INPUT, format!("{}: {e}", args.path.display()));
     let threads = threads(args.threads)?;
-    let problem = Problem::from_path(&args.path, &args.set).map_err(|e| at(&e))?;
+    let problem = crate::energies::read_problem(&args.path, &args.set).map_err(|e| at(&e))?;
     let mut sweep = problem
         .sweep
         .clone()
@@ -155,7 +155,9 @@ fn point_problems<'a>(
     text: &'a str,
     sweep: &'a Sweep,
 ) -> impl Fn(usize) -> Result<Problem, String> + Sync + 'a {
-    move |i| Problem::from_str_with(text, &sweep.overrides(i)).map_err(|e| e.to_string())
+    move |i| {
+        crate::energies::read_problem_text(text, &sweep.overrides(i)).map_err(|e| e.to_string())
+    }
 }
 
 fn header(

@@ -304,3 +304,41 @@ fn formula_refusals_name_their_key() {
     let e = build(Some("B1*k1^2 + v3^2"), &[], "formula");
     assert!(e.message.contains("energy.shear"), "{}", e.message);
 }
+
+/// A program's energy with a Hessian 2 % off is refused by the solver,
+/// naming the derivative, instead of converging to a wrong tip; the same
+/// energy with the right Hessian solves.
+#[test]
+fn the_solver_refuses_a_wrong_hand_written_derivative() {
+    use cosserat::bvp::{solve, SolveError};
+    let text = r#"
+[rod]
+length = 1.0
+[energy]
+kind = "wrong"
+stiffness = [10.0, 1.0, 10.0]
+[clamp]
+d1 = [1.0, 0.0, 0.0]
+d3 = [0.0, 0.0, 1.0]
+[loads]
+tip_force = [3.0, 0.0, 0.0]
+"#;
+    for (factor, refused) in [(1.02, true), (1.0, false)] {
+        let mut catalog = EnergyCatalog::standard();
+        catalog.register("wrong", move |spec| {
+            Ok(Arc::new(Wrong {
+                right: spec.linear()?,
+                broken: Property::Stiffness,
+                factor,
+            }))
+        });
+        let p = cosserat::input::Problem::from_str_in(text, &[], &catalog).unwrap();
+        match solve(&p.rod, &p.model, &p.options) {
+            Err(SolveError::Model(m)) if refused => {
+                assert!(m.contains("stiffness H"), "{m}");
+            }
+            Ok(_) if !refused => {}
+            other => panic!("factor {factor}: {:?}", other.map(|e| e.unknowns)),
+        }
+    }
+}

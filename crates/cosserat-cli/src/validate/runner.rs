@@ -141,7 +141,7 @@ fn run_analysis(
             )));
         }
         set.extend(method_overrides(method));
-        Problem::from_path(&path, &set)
+        crate::energies::read_problem(&path, &set)
             .map_err(|e| InputError(format!("{}: {}: {e}", case.name, path.display())))
     };
     let params =

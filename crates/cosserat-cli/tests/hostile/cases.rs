@@ -15,10 +15,11 @@ pub(crate) enum Verb {
     Sweep,
     Plot,
     Merge,
+    CheckEnergy,
 }
 
 impl Verb {
-    pub(crate) const ALL: [Verb; 7] = [
+    pub(crate) const ALL: [Verb; 8] = [
         Verb::Solve,
         Verb::Stability,
         Verb::Continue,
@@ -26,6 +27,7 @@ impl Verb {
         Verb::Sweep,
         Verb::Plot,
         Verb::Merge,
+        Verb::CheckEnergy,
     ];
     pub(crate) fn name(self) -> &'static str {
         match self {
@@ -36,6 +38,7 @@ impl Verb {
             Verb::Sweep => "sweep",
             Verb::Plot => "plot",
             Verb::Merge => "merge",
+            Verb::CheckEnergy => "check-energy",
         }
     }
     /// The table a problem needs for this command.
@@ -343,7 +346,8 @@ pub(crate) fn problem_case(
         }
     }
     let mut outputs = vec![];
-    let wants_output = matches!(verb, Verb::Continue | Verb::Sweep) || rng.chance(0.7);
+    let wants_output = verb != Verb::CheckEnergy
+        && (matches!(verb, Verb::Continue | Verb::Sweep) || rng.chance(0.7));
     if wants_output {
         let (out, more, writable) = output(rng, 0.3, "h5", "out.h5");
         if rng.chance(0.1) {
@@ -368,7 +372,7 @@ pub(crate) fn problem_case(
         write!(what, " {}", args[args.len().saturating_sub(2)..].join(" "))
             .expect("writing to a String cannot fail");
     }
-    if rng.chance(0.3) {
+    if verb != Verb::CheckEnergy && rng.chance(0.3) {
         args.push("--force".into());
     }
     if matches!(verb, Verb::Continue | Verb::Optimize | Verb::Sweep) && rng.chance(0.15) {

@@ -378,9 +378,26 @@ fn derivatives_checked(rod: &Rod) -> bool {
     cfg!(debug_assertions) || !rod.energy().derivatives_trusted()
 }
 
-/// The energy's derivatives at the strains of the solution (at most 17
-/// samples along it), before the solution is reported.
+/// The material along the solution, before it is reported: H positive
+/// definite at every sample (where it is not, the material itself is
+/// unstable — a material instability, not a structural one — and the
+/// equations κ' = H⁻¹(…) do not hold), and, for an energy whose derivatives
+/// are not trusted, the derivatives at (at most 17 of) the samples' strains.
 fn check_derivatives_along(rod: &Rod, samples: &[RodSample]) -> Result<(), SolveError> {
+    let energy = rod.energy();
+    if let Some(x) = samples
+        .iter()
+        .find(|x| energy.stiffness(x.s, &x.curvature).cholesky().is_none())
+    {
+        return Err(SolveError::Model(format!(
+            "the {} energy's Hessian is not positive definite at s = {}, κ = ({:e}, {:e}, {:e})              of the solution: the material is unstable there (a material instability, not a              structural one), and no equilibrium of this model is reported",
+            energy.name(),
+            x.s,
+            x.curvature[0],
+            x.curvature[1],
+            x.curvature[2]
+        )));
+    }
     if !derivatives_checked(rod) || samples.is_empty() {
         return Ok(());
     }
@@ -390,30 +407,9 @@ fn check_derivatives_along(rod: &Rod, samples: &[RodSample]) -> Result<(), Solve
         .step_by(every)
         .map(|x| (x.s, x.curvature))
         .collect();
-    let report = energy_check::check_at(
-        rod.energy().as_ref(),
-        rod.length(),
-        curvature_scale(rod),
-        &at,
-    );
+    let scale = energy_check::typical_curvature(rod);
+    let report = energy_check::check_at(energy.as_ref(), rod.length(), scale, &at);
     derivative_verdict(rod, "along the solution", &report)
-}
-
-/// A typical curvature of the problem (1/m): 1/L, or the curvature the
-/// loads' moment scale gives the softest section.
-fn curvature_scale(rod: &Rod) -> f64 {
-    let zero = nalgebra::Vector3::zeros();
-    let softest = (0..=8)
-        .map(|i| {
-            let s = rod.length() * f64::from(i) / 8.0;
-            rod.energy()
-                .stiffness(s, &zero)
-                .symmetric_eigenvalues()
-                .min()
-        })
-        .fold(f64::INFINITY, f64::min);
-    let loaded = rod.loads().moment_scale(rod.length()) / softest;
-    (1.0 / rod.length()).max(if loaded.is_finite() { loaded } else { 0.0 })
 }
 
 fn derivative_verdict(
@@ -483,7 +479,11 @@ impl Solved {
 /// ([`energy_check::check`]).
 fn check_energy(rod: &Rod) -> Result<(), SolveError> {
     if derivatives_checked(rod) {
-        let report = energy_check::check(rod.energy().as_ref(), rod.length(), curvature_scale(rod));
+        let report = energy_check::check(
+            rod.energy().as_ref(),
+            rod.length(),
+            energy_check::typical_curvature(rod),
+        );
         derivative_verdict(rod, "before the solve", &report)?;
     }
     let kappa = nalgebra::Vector3::zeros();

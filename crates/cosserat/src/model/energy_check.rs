@@ -18,7 +18,25 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::StoredEnergy;
+use super::{Rod, StoredEnergy};
+
+/// A typical curvature of a problem (1/m), the scale of the strains the
+/// checks sample: 1/L, or the curvature the loads' moment scale gives the
+/// softest section if larger.
+pub fn typical_curvature(rod: &Rod) -> f64 {
+    let zero = Vector3::zeros();
+    let softest = (0..=8)
+        .map(|i| {
+            let s = rod.length() * f64::from(i) / 8.0;
+            rod.energy()
+                .stiffness(s, &zero)
+                .symmetric_eigenvalues()
+                .min()
+        })
+        .fold(f64::INFINITY, f64::min);
+    let loaded = rod.loads().moment_scale(rod.length()) / softest;
+    (1.0 / rod.length()).max(if loaded.is_finite() { loaded } else { 0.0 })
+}
 
 /// Which property a finding is about.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

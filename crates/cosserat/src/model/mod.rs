@@ -3,6 +3,7 @@
 //!
 //! This stage knows nothing of how equilibria are computed.
 
+mod autodiff;
 mod catalog;
 mod energy;
 pub mod energy_check;
@@ -16,6 +17,7 @@ mod rod;
 mod shear;
 mod support;
 
+pub use autodiff::{lift, AutoDiff, Density};
 pub use catalog::{EnergyBuilder, EnergyCatalog, EnergySpec, EnergySpecError};
 pub use energy::{LinearElastic, ProfileKind, QuarticStiffening, StoredEnergy};
 pub use error::ModelError;

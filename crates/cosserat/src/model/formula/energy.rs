@@ -1,21 +1,17 @@
 //! [`FormulaEnergy`]: a [`StoredEnergy`] given by a [`Formula`], its
-//! derivatives by forward-mode automatic differentiation.
-//!
-//! With u = κ − κ⁰(s) the formula's `k`, one evaluation over a
-//! second-order vector dual number (value, gradient, Hessian in the three
-//! strains; num-dual's `Dual2SVec64<3>`) gives W, M = ∇W and H = ∇²W. The
-//! s-rates ∂s∇W, ∂sH (at fixed κ, so u moves by −κ⁰′(s) and B_i by
-//! B_i′(s)) and the contraction ∂(H v)/∂κ = Σ_k W_ijk v_k come from the
-//! same evaluation with a first-order dual (`Dual64`) inside each entry,
-//! seeded with the s-direction or with v: exact to rounding, no step size.
+//! derivatives by forward-mode automatic differentiation
+//! ([`crate::model::autodiff`]): the formula is a [`Density`] whose
+//! profiles B_i(s), κ⁰_i(s) are lifted to the number type of s.
 
 use std::sync::Arc;
 
 use nalgebra::{Matrix3, Vector3};
-use num_dual::{Derivative, Dual2SVec, Dual64, DualNum};
+use num_dual::DualNum;
 
-use super::expr::Inputs;
 use super::{Formula, Variable};
+use crate::model::autodiff::{
+    along, differentiated, jet, lift, new_identity, second_order, Density,
+};
 use crate::model::{Profile, ProfileKind, StoredEnergy};
 
 /// W(s, κ) = formula(s, κ − κ⁰(s), B(s)), with the file's stiffness and
@@ -25,6 +21,8 @@ pub struct FormulaEnergy {
     formula: Arc<Formula>,
     stiffness: [Profile; 3],
     kappa0: [Profile; 3],
+    /// Renewed whenever a profile changes (the jet cache's key).
+    id: u64,
 }
 
 /// Why a formula cannot be a bending-twisting energy.
@@ -51,6 +49,7 @@ impl FormulaEnergy {
             formula: Arc::new(formula),
             stiffness,
             kappa0,
+            id: new_identity(),
         })
     }
 
@@ -59,109 +58,37 @@ impl FormulaEnergy {
         &self.formula
     }
 
-    /// The inputs at s, κ for a number type whose value parts are set by
-    /// `lift` from (value, s-rate) of each input.
-    fn inputs<D: DualNum<Primitive = f64> + Copy>(
-        &self,
-        s: f64,
-        kappa: &Vector3<f64>,
-        lift: impl Fn(usize, f64, f64) -> D,
-    ) -> Inputs<D> {
-        let mut x = [D::from(0.0); 10];
-        x[Variable::ArcLength.slot()] = lift(usize::MAX, s, 1.0);
-        for i in 0..3 {
-            let u = kappa[i] - self.kappa0[i].value(s);
-            x[Variable::Curvature(i).slot()] = lift(i, u, -self.kappa0[i].derivative(s));
-            x[Variable::ShearExtension(i).slot()] = D::from(if i == 2 { 1.0 } else { 0.0 });
-            x[Variable::Stiffness(i).slot()] = lift(
-                usize::MAX,
-                self.stiffness[i].value(s),
-                self.stiffness[i].derivative(s),
-            );
+    fn density_ref(&self) -> &Self {
+        self
+    }
+
+    /// A copy with its profiles about to change: a new identity.
+    fn modified(&self) -> Self {
+        FormulaEnergy {
+            id: new_identity(),
+            ..self.clone()
         }
-        x
-    }
-
-    /// W, ∇W, ∇²W in the strains, with an inner dual part seeded by
-    /// `inner(i, value, s-rate)` (i = usize::MAX for s and B).
-    fn second_order(
-        &self,
-        s: f64,
-        kappa: &Vector3<f64>,
-        inner: impl Fn(usize, f64, f64) -> Dual64,
-    ) -> (Vector3<Dual64>, Matrix3<Dual64>) {
-        let x = self.inputs::<Dual2SVec<Dual64, 3>>(s, kappa, |i, v, rate| {
-            let d = Dual2SVec::from_re(inner(i, v, rate));
-            if i < 3 {
-                d.derivative(i)
-            } else {
-                d
-            }
-        });
-        let w = self.formula.value(&x);
-        (gradient(&w.v1), hessian(&w.v2))
     }
 }
 
-fn gradient<T: DualNum<Primitive = f64> + Copy>(
-    d: &Derivative<T, nalgebra::U1, nalgebra::Const<3>>,
-) -> Vector3<T> {
-    match &d.0 {
-        Some(m) => Vector3::new(m[0], m[1], m[2]),
-        // No entry: the formula does not depend on the strains.
-        None => Vector3::from_element(T::from(0.0)),
-    }
-}
-
-fn hessian<T: DualNum<Primitive = f64> + Copy>(
-    d: &Derivative<T, nalgebra::Const<3>, nalgebra::Const<3>>,
-) -> Matrix3<T> {
-    match &d.0 {
-        Some(m) => Matrix3::from_fn(|i, j| m[(i, j)]),
-        None => Matrix3::from_element(T::from(0.0)),
-    }
-}
-
-/// The inner dual of a plain evaluation (no inner direction).
-fn plain(_: usize, v: f64, _: f64) -> Dual64 {
-    Dual64::from(v)
-}
-
-/// The inner dual seeded with the s-direction.
-fn along_s(_: usize, v: f64, rate: f64) -> Dual64 {
-    Dual64::new(v, rate)
-}
-
-impl StoredEnergy for FormulaEnergy {
-    fn density(&self, s: f64, kappa: &Vector3<f64>) -> f64 {
-        self.formula.value(&self.inputs(s, kappa, |_, v, _| v))
+impl Density for FormulaEnergy {
+    /// The formula at s, with k = κ − κ⁰(s), v = e3 and B(s).
+    fn density<D: DualNum<Primitive = f64> + Copy>(&self, s: D, kappa: [D; 3]) -> D {
+        let at = s.re();
+        let mut x = [D::from(0.0); 10];
+        x[Variable::ArcLength.slot()] = s;
+        x[Variable::ShearExtension(2).slot()] = D::from(1.0);
+        for i in 0..3 {
+            let k0 = &self.kappa0[i];
+            x[Variable::Curvature(i).slot()] = kappa[i] - lift(s, k0.value(at), k0.derivative(at));
+            let b = &self.stiffness[i];
+            x[Variable::Stiffness(i).slot()] = lift(s, b.value(at), b.derivative(at));
+        }
+        self.formula.value(&x)
     }
 
-    fn moment(&self, s: f64, kappa: &Vector3<f64>) -> Vector3<f64> {
-        self.second_order(s, kappa, plain).0.map(|d| d.re)
-    }
-
-    fn stiffness(&self, s: f64, kappa: &Vector3<f64>) -> Matrix3<f64> {
-        self.second_order(s, kappa, plain).1.map(|d| d.re)
-    }
-
-    fn moment_rate(&self, s: f64, kappa: &Vector3<f64>) -> Vector3<f64> {
-        self.second_order(s, kappa, along_s).0.map(|d| d.eps)
-    }
-
-    fn stiffness_rate(&self, s: f64, kappa: &Vector3<f64>) -> Matrix3<f64> {
-        self.second_order(s, kappa, along_s).1.map(|d| d.eps)
-    }
-
-    fn stiffness_derivative(&self, s: f64, kappa: &Vector3<f64>, v: &Vector3<f64>) -> Matrix3<f64> {
-        let seeded = |i: usize, value: f64, _: f64| {
-            if i < 3 {
-                Dual64::new(value, v[i])
-            } else {
-                Dual64::from(value)
-            }
-        };
-        self.second_order(s, kappa, seeded).1.map(|d| d.eps)
+    fn name(&self) -> &'static str {
+        "formula"
     }
 
     /// Proved from the formula's structure: W even under (k1, k3) →
@@ -175,14 +102,21 @@ impl StoredEnergy for FormulaEnergy {
                 .formula
                 .is_even_in(&[Variable::Curvature(0), Variable::Curvature(2)])
     }
+}
+
+impl StoredEnergy for FormulaEnergy {
+    fn density(&self, s: f64, kappa: &Vector3<f64>) -> f64 {
+        Density::density(self, s, [kappa[0], kappa[1], kappa[2]])
+    }
+
+    differentiated!();
+
+    fn admits_planar_bending(&self) -> bool {
+        Density::admits_planar_bending(self)
+    }
 
     fn name(&self) -> &'static str {
         "formula"
-    }
-
-    /// Exact by automatic differentiation.
-    fn derivatives_trusted(&self) -> bool {
-        true
     }
 
     fn intrinsic_profiles(&self) -> Option<&[Profile; 3]> {
@@ -190,7 +124,7 @@ impl StoredEnergy for FormulaEnergy {
     }
 
     fn with_intrinsic_scaled(&self, factor: f64) -> Option<Arc<dyn StoredEnergy>> {
-        let mut e = self.clone();
+        let mut e = self.modified();
         e.kappa0 = self.kappa0.clone().map(|p| p.scaled(factor));
         Some(Arc::new(e))
     }
@@ -201,7 +135,7 @@ impl StoredEnergy for FormulaEnergy {
         i: usize,
         value: f64,
     ) -> Option<Arc<dyn StoredEnergy>> {
-        let mut e = self.clone();
+        let mut e = self.modified();
         let slot = match profile {
             ProfileKind::Stiffness if value > 0.0 => &mut e.stiffness[i],
             ProfileKind::IntrinsicCurvature => &mut e.kappa0[i],
@@ -220,7 +154,7 @@ impl StoredEnergy for FormulaEnergy {
         p: f64,
     ) -> Option<Arc<dyn StoredEnergy>> {
         let other = target.intrinsic_profiles()?;
-        let mut e = self.clone();
+        let mut e = self.modified();
         for (slot, (mine, theirs)) in e.kappa0.iter_mut().zip(self.kappa0.iter().zip(other)) {
             *slot = mine.blend(theirs, p)?;
         }

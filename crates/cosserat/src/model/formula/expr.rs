@@ -29,7 +29,7 @@ impl Variable {
     pub const NAMES: [&'static str; 10] =
         ["s", "k1", "k2", "k3", "v1", "v2", "v3", "B1", "B2", "B3"];
 
-    /// The slot in [`Inputs`].
+    /// The slot of the variable in the array a formula is evaluated at.
     pub fn slot(self) -> usize {
         match self {
             Variable::ArcLength => 0,
