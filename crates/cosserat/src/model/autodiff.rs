@@ -208,7 +208,6 @@ macro_rules! differentiated {
         }
     };
 }
-pub(super) use differentiated;
 
 impl<E: Density> AutoDiff<E> {
     fn density_ref(&self) -> &E {

@@ -1,17 +1,20 @@
-//! [`FormulaEnergy`]: a [`StoredEnergy`] given by a [`Formula`], its
-//! derivatives by forward-mode automatic differentiation
-//! ([`crate::model::autodiff`]): the formula is a [`Density`] whose
-//! profiles B_i(s), κ⁰_i(s) are lifted to the number type of s.
+//! [`FormulaEnergy`]: a [`StoredEnergy`] given by a [`Formula`]. Its
+//! derivatives are the formula's symbolic derivative trees (differentiated
+//! once when read, evaluated in `f64`); a formula whose trees would be too
+//! large uses forward-mode automatic differentiation instead
+//! ([`crate::model::autodiff`]: the formula is a [`Density`] whose profiles
+//! B_i(s), κ⁰_i(s) are lifted to the number type of s). The tests check
+//! each against the other.
 
 use std::sync::Arc;
 
 use nalgebra::{Matrix3, Vector3};
 use num_dual::DualNum;
 
+use super::derivative::{CURVATURE_RATE, DIRECTION, PAIRS, SLOTS, STIFFNESS_RATE};
+use super::expr::Expr;
 use super::{Formula, Variable};
-use crate::model::autodiff::{
-    along, differentiated, jet, lift, new_identity, second_order, Density,
-};
+use crate::model::autodiff::{along, jet, lift, new_identity, second_order, Density};
 use crate::model::{Profile, ProfileKind, StoredEnergy};
 
 /// W(s, κ) = formula(s, κ − κ⁰(s), B(s)), with the file's stiffness and
@@ -58,8 +61,35 @@ impl FormulaEnergy {
         &self.formula
     }
 
-    fn density_ref(&self) -> &Self {
-        self
+    /// The inputs of the symbolic derivatives at (s, κ), with direction v.
+    fn slots(&self, s: f64, kappa: &Vector3<f64>, v: &Vector3<f64>) -> [f64; SLOTS] {
+        let mut x = [0.0; SLOTS];
+        x[Variable::ArcLength.slot()] = s;
+        x[Variable::ShearExtension(2).slot()] = 1.0;
+        for i in 0..3 {
+            let (k0, b) = (&self.kappa0[i], &self.stiffness[i]);
+            x[Variable::Curvature(i).slot()] = kappa[i] - k0.value(s);
+            x[Variable::Stiffness(i).slot()] = b.value(s);
+            x[STIFFNESS_RATE + i] = b.derivative(s);
+            x[CURVATURE_RATE + i] = k0.derivative(s);
+            x[DIRECTION + i] = v[i];
+        }
+        x
+    }
+
+    /// The vector of three trees at x.
+    fn vector(trees: &[Expr; 3], x: &[f64]) -> Vector3<f64> {
+        Vector3::from_fn(|i, _| trees[i].eval(x))
+    }
+
+    /// The symmetric matrix of six trees (upper triangle) at x.
+    fn symmetric(trees: &[Expr; 6], x: &[f64]) -> Matrix3<f64> {
+        let mut m = Matrix3::zeros();
+        for (t, &(i, j)) in trees.iter().zip(&PAIRS) {
+            m[(i, j)] = t.eval(x);
+            m[(j, i)] = m[(i, j)];
+        }
+        m
     }
 
     /// A copy with its profiles about to change: a new identity.
@@ -109,7 +139,45 @@ impl StoredEnergy for FormulaEnergy {
         Density::density(self, s, [kappa[0], kappa[1], kappa[2]])
     }
 
-    differentiated!();
+    fn moment(&self, s: f64, kappa: &Vector3<f64>) -> Vector3<f64> {
+        match self.formula.derivatives() {
+            Some(d) => Self::vector(&d.moment, &self.slots(s, kappa, &Vector3::zeros())),
+            None => jet(self, self.id, s, kappa).m,
+        }
+    }
+
+    fn stiffness(&self, s: f64, kappa: &Vector3<f64>) -> Matrix3<f64> {
+        match self.formula.derivatives() {
+            Some(d) => Self::symmetric(&d.stiffness, &self.slots(s, kappa, &Vector3::zeros())),
+            None => jet(self, self.id, s, kappa).h,
+        }
+    }
+
+    fn moment_rate(&self, s: f64, kappa: &Vector3<f64>) -> Vector3<f64> {
+        match self.formula.derivatives() {
+            Some(d) => Self::vector(&d.moment_rate, &self.slots(s, kappa, &Vector3::zeros())),
+            None => jet(self, self.id, s, kappa).m_s,
+        }
+    }
+
+    fn stiffness_rate(&self, s: f64, kappa: &Vector3<f64>) -> Matrix3<f64> {
+        match self.formula.derivatives() {
+            Some(d) => Self::symmetric(&d.stiffness_rate, &self.slots(s, kappa, &Vector3::zeros())),
+            None => jet(self, self.id, s, kappa).h_s,
+        }
+    }
+
+    fn stiffness_derivative(&self, s: f64, kappa: &Vector3<f64>, v: &Vector3<f64>) -> Matrix3<f64> {
+        match self.formula.derivatives() {
+            Some(d) => Self::symmetric(&d.contracted, &self.slots(s, kappa, v)),
+            None => second_order(self, s, kappa, along(v)).1.map(|d| d.eps),
+        }
+    }
+
+    /// Exact: symbolic derivatives, or automatic differentiation.
+    fn derivatives_trusted(&self) -> bool {
+        true
+    }
 
     fn admits_planar_bending(&self) -> bool {
         Density::admits_planar_bending(self)

@@ -67,6 +67,8 @@ pub(super) enum Function {
     Tanh,
     Atan,
     Abs,
+    /// sign(x) ∈ {−1, 1} (the derivative of |x|; not in the language).
+    Sign,
 }
 
 /// The functions of the language, by name: one argument, or two for
@@ -111,6 +113,8 @@ pub(super) enum Expr {
     Apply(Function, Box<Expr>),
     Min(Box<Expr>, Box<Expr>),
     Max(Box<Expr>, Box<Expr>),
+    /// if a < b { then } else { otherwise } (derivatives of min, max).
+    Less(Box<[Expr; 4]>),
 }
 
 /// Resolves names against the variables, `pi` and `parameter`.
@@ -220,9 +224,10 @@ fn fold(expr: Expr) -> Expr {
         | Expr::Power(a, b)
         | Expr::Min(a, b)
         | Expr::Max(a, b) => constant(a) && constant(b),
+        Expr::Less(parts) => parts.iter().all(constant),
     };
     if foldable {
-        Expr::Constant(expr.eval::<f64>(&[0.0; 10]))
+        Expr::Constant(expr.eval::<f64>(&[]))
     } else {
         expr
     }
@@ -232,7 +237,7 @@ impl Expr {
     /// The value at `x`, in the arithmetic of `D` (derivatives carried
     /// exactly by dual numbers). `min`/`max` take the derivative of the
     /// argument chosen (one-sided at a tie), `abs` that of ±x (none at 0).
-    pub(super) fn eval<D: DualNum<Primitive = f64> + Copy>(&self, x: &Inputs<D>) -> D {
+    pub(super) fn eval<D: DualNum<Primitive = f64> + Copy>(&self, x: &[D]) -> D {
         match self {
             Expr::Constant(c) => D::from(*c),
             Expr::Variable(i) => x[*i],
@@ -261,6 +266,14 @@ impl Expr {
                     u
                 }
             }
+            Expr::Less(parts) => {
+                let [a, b, then, otherwise] = parts.as_ref();
+                if a.eval(x).re() < b.eval(x).re() {
+                    then.eval(x)
+                } else {
+                    otherwise.eval(x)
+                }
+            }
         }
     }
 
@@ -279,6 +292,7 @@ impl Expr {
             | Expr::Power(a, b)
             | Expr::Min(a, b)
             | Expr::Max(a, b) => a.reads(i) || b.reads(i),
+            Expr::Less(parts) => parts.iter().any(|p| p.reads(i)),
         }
     }
 
@@ -330,6 +344,13 @@ impl Expr {
                     Neither
                 }
             }
+            Expr::Less(parts) => {
+                if parts.iter().all(|p| p.parity(flipped) == Even) {
+                    Even
+                } else {
+                    Neither
+                }
+            }
         }
     }
 }
@@ -355,7 +376,12 @@ fn function_parity(f: Function, p: Parity) -> Parity {
     use Parity::{Even, Neither, Odd};
     let odd_in_odd_out = matches!(
         f,
-        Function::Sin | Function::Tan | Function::Sinh | Function::Tanh | Function::Atan
+        Function::Sin
+            | Function::Tan
+            | Function::Sinh
+            | Function::Tanh
+            | Function::Atan
+            | Function::Sign
     );
     let even_of_odd = matches!(f, Function::Abs | Function::Cos | Function::Cosh);
     match p {
@@ -385,5 +411,6 @@ fn apply<D: DualNum<Primitive = f64> + Copy>(f: Function, x: D) -> D {
                 x
             }
         }
+        Function::Sign => D::from(if x.re() < 0.0 { -1.0 } else { 1.0 }),
     }
 }

@@ -10,6 +10,7 @@
 //! with `+ - * / ^`, parentheses and the functions `sqrt exp log sin cos
 //! tan sinh cosh tanh atan abs min max` (see docs/problem-files.md).
 
+mod derivative;
 mod energy;
 mod expr;
 mod parse;
@@ -70,6 +71,9 @@ pub struct Formula {
     tree: Expr,
     /// The parameter names the text reads.
     bound: Vec<String>,
+    /// The derivatives the equations need, symbolically (None: too large,
+    /// automatic differentiation instead).
+    derivatives: Option<Box<derivative::Derivatives>>,
 }
 
 impl Formula {
@@ -86,11 +90,18 @@ impl Formula {
             Some(v)
         };
         let tree = expr::compile(&node, &recording)?;
+        let derivatives = derivative::Derivatives::of(&tree).map(Box::new);
         Ok(Formula {
             text: text.to_owned(),
             tree,
             bound: bound.into_inner(),
+            derivatives,
         })
+    }
+
+    /// The symbolic derivatives, when their trees are small enough.
+    fn derivatives(&self) -> Option<&derivative::Derivatives> {
+        self.derivatives.as_deref()
     }
 
     /// Whether the text reads the parameter `name`.
