@@ -1,12 +1,12 @@
 //! `cosserat continue` and `cosserat plot`: bifurcation diagrams from a
 //! problem file's `[continuation]` table, saved as they grow.
 
-use std::io::IsTerminal;
 use std::path::Path;
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
 use crate::plot::{draw, read_diagram};
+use crate::progress::Meter;
 use crate::stored_start::{stored_start, Start, StoredStart};
 use cosserat::continuation::{
     continuation, continuation_from, switch_from, ContinuationError, ContinuationOptions, Diagram,
@@ -15,7 +15,6 @@ use cosserat::continuation::{
 use cosserat::input::{Problem, MEASURES};
 use cosserat::output::target::replace_atomically;
 use cosserat::output::{read_saved, write_diagram};
-use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::exit::{fail, BAD_INPUT, INTERRUPTED, NO_RESULT, OUTPUT};
 use crate::signals;
@@ -129,7 +128,7 @@ pub fn run_continue(args: &ContinueArgs) -> ExitCode {
     if let Some(stored) = &stored {
         println!("from      {}", stored.summary);
     }
-    let bar = spinner();
+    let bar = Meter::spinner();
     let start = Instant::now();
     let run = Run {
         family,
@@ -202,7 +201,7 @@ impl Run<'_> {
     /// on `bar` and writing a checkpoint every [`CHECKPOINT`].
     fn follow(
         &self,
-        bar: &ProgressBar,
+        bar: &Meter,
         saved: Option<&SavedDiagram>,
         start: Option<&Start>,
     ) -> Result<Diagram, ContinuationError> {
@@ -277,19 +276,6 @@ impl Run<'_> {
         }
         ExitCode::SUCCESS
     }
-}
-
-/// A spinner on a terminal; plain lines every few seconds elsewhere are
-/// left to the checkpoints.
-fn spinner() -> ProgressBar {
-    if !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let b = ProgressBar::new_spinner();
-    b.set_style(
-        ProgressStyle::with_template("{spinner} {msg} [{elapsed}]").expect("a valid template"),
-    );
-    b
 }
 
 /// `cosserat plot`: the chart of a diagram file, claimed like every output

@@ -39,6 +39,7 @@ pub mod energies;
 pub mod exit;
 pub mod optimize_command;
 pub mod plot;
+pub mod progress;
 pub mod signals;
 pub mod solve_command;
 pub mod stored_start;

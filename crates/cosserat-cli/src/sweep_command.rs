@@ -2,7 +2,6 @@
 //! of its `[sweep]` table, checkpointed as it goes, and the join of shard
 //! files.
 
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Mutex;
@@ -15,7 +14,6 @@ use cosserat::output::target::{replace_atomically, Claim};
 use cosserat::output::{read_sweep, write_sweep, SweepHeader};
 use cosserat::study::sweep::Sweep;
 use cosserat::study::sweep::{run, ArmJob, Job, Record, Shard, SolveJob, SweepPlan};
-use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::exit::{fail, BAD_INPUT, INTERRUPTED, OUTPUT};
 use crate::signals;
@@ -216,19 +214,6 @@ fn resumable(path: &Path, expected: &SweepHeader) -> Result<Option<Vec<Record>>,
     Ok(Some(records))
 }
 
-fn progress_bar(total: usize, done: usize) -> ProgressBar {
-    if !std::io::stderr().is_terminal() {
-        return ProgressBar::hidden();
-    }
-    let bar = ProgressBar::new(total as u64);
-    bar.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} points [{elapsed} < {eta}]")
-            .expect("a valid template"),
-    );
-    bar.set_position(done as u64);
-    bar
-}
-
 /// Prints what is about to run.
 fn announce(args: &SweepArgs, setup: &Setup, members: usize) {
     println!("problem   {}", args.path.display());
@@ -259,7 +244,7 @@ fn execute(args: &SweepArgs, setup: &Setup) -> ExitCode {
     let members = plan.members().len();
     announce(args, setup, members);
     let before = setup.done.len();
-    let bar = progress_bar(members, before);
+    let bar = crate::progress::Meter::counted(members, before);
     let kind = setup.job.kind();
     let running = header(
         &setup.problem,
