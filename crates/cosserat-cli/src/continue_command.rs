@@ -14,7 +14,7 @@ use cosserat::continuation::{
 };
 use cosserat::input::{Problem, MEASURES};
 use cosserat::output::target::replace_atomically;
-use cosserat::output::{read_saved, write_diagram};
+use cosserat::output::{read_saved, write_diagram, OutputError};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use crate::exit::{fail, BAD_INPUT, INTERRUPTED, NO_RESULT, OUTPUT};
@@ -25,7 +25,7 @@ const CHECKPOINT: Duration = Duration::from_secs(2);
 
 /// A string key of the `[continuation]` table of the effective problem
 /// text (the parsed value, never a scan of the raw text).
-fn section_key(text: &str, key: &str) -> Option<String> {
+pub(crate) fn section_key(text: &str, key: &str) -> Option<String> {
     let table: toml::Table = toml::from_str(text).ok()?;
     Some(table.get("continuation")?.get(key)?.as_str()?.to_string())
 }
@@ -76,6 +76,9 @@ fn read_problem(args: &ContinueArgs) -> Result<(Problem, Option<StoredStart>), E
             .map_err(|e| fail(BAD_INPUT, format!("{}: {e}", args.path.display())))
     };
     let problem = read(args.set)?;
+    if !problem.stage_keys.is_empty() {
+        chain_alone(args)?;
+    }
     let Some((file, spec)) = args.from else {
         return Ok((problem, None));
     };
@@ -108,6 +111,9 @@ pub fn run_continue(args: &ContinueArgs) -> ExitCode {
         Ok(c) => c,
         Err(code) => return code,
     };
+    if !problem.stage_keys.is_empty() {
+        return crate::chain::run_chain(&problem, path, output, plot);
+    }
     if args.curve {
         return crate::curve_command::run_curve(&problem, stored.as_ref(), output);
     }
@@ -147,6 +153,33 @@ pub fn run_continue(args: &ContinueArgs) -> ExitCode {
     report(&diagram);
     println!("time      {:.1} ms", elapsed.as_secs_f64() * 1e3);
     run.finish(&diagram, plot)
+}
+
+/// A chained run (`[[continuation.stage]]`) starts from the problem's own
+/// solve and is not resumed: `--from`, `--curve` and `--resume` are
+/// refused (exit 2) rather than applied to one stage of it.
+fn chain_alone(args: &ContinueArgs) -> Result<(), ExitCode> {
+    let refused = if args.from.is_some() {
+        Some("--from")
+    } else if args.resume {
+        Some("--resume")
+    } else if args.curve {
+        Some("--curve")
+    } else {
+        None
+    };
+    match refused {
+        Some(flag) => Err(fail(
+            BAD_INPUT,
+            format!(
+                "{flag}: {} chains stages ([[continuation.stage]]), which run from the \
+                 problem's own solve to the end; run the stages one by one (continue, then \
+                 continue --from DIAGRAM --point 0/last) to restart or resume one",
+                args.path.display()
+            ),
+        )),
+        None => Ok(()),
+    }
 }
 
 /// The diagram to resume from: none without `--resume` or when `output`
@@ -189,12 +222,12 @@ fn saved_diagram(
 }
 
 /// One continuation run: what it follows and where its diagram goes.
-struct Run<'a> {
-    family: &'a Family,
-    opts: &'a ContinuationOptions,
-    output: &'a Path,
-    text: &'a str,
-    parameter_name: &'a str,
+pub(crate) struct Run<'a> {
+    pub(crate) family: &'a Family,
+    pub(crate) opts: &'a ContinuationOptions,
+    pub(crate) output: &'a Path,
+    pub(crate) text: &'a str,
+    pub(crate) parameter_name: &'a str,
 }
 
 impl Run<'_> {
@@ -205,6 +238,20 @@ impl Run<'_> {
         bar: &ProgressBar,
         saved: Option<&SavedDiagram>,
         start: Option<&Start>,
+    ) -> Result<Diagram, ContinuationError> {
+        let save = |diagram: &Diagram| {
+            write_diagram(self.output, self.text, self.parameter_name, diagram, true)
+        };
+        self.follow_saving(bar, saved, start, &save)
+    }
+
+    /// [`Run::follow`] with the checkpoints written by `save`.
+    pub(crate) fn follow_saving(
+        &self,
+        bar: &ProgressBar,
+        saved: Option<&SavedDiagram>,
+        start: Option<&Start>,
+        save: &dyn Fn(&Diagram) -> Result<(), OutputError>,
     ) -> Result<Diagram, ContinuationError> {
         let mut last_save = Instant::now();
         let mut checkpoint_error = None;
@@ -219,9 +266,7 @@ impl Run<'_> {
             ));
             bar.tick();
             if last_save.elapsed() >= CHECKPOINT {
-                if let Err(e) =
-                    write_diagram(self.output, self.text, self.parameter_name, diagram, true)
-                {
+                if let Err(e) = save(diagram) {
                     checkpoint_error.get_or_insert_with(|| e.to_string());
                 }
                 last_save = Instant::now();
@@ -281,7 +326,7 @@ impl Run<'_> {
 
 /// A spinner on a terminal; plain lines every few seconds elsewhere are
 /// left to the checkpoints.
-fn spinner() -> ProgressBar {
+pub(crate) fn spinner() -> ProgressBar {
     if !std::io::stderr().is_terminal() {
         return ProgressBar::hidden();
     }
@@ -320,7 +365,7 @@ pub fn run_plot(diagram: &Path, measure: &str, output: &Path, force: bool) -> Ex
     }
 }
 
-fn report(d: &Diagram) {
+pub(crate) fn report(d: &Diagram) {
     for w in &d.warnings {
         eprintln!("warning: {w}");
     }

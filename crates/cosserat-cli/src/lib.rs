@@ -32,6 +32,7 @@
 
 pub mod arm_chart;
 pub mod bench;
+pub mod chain;
 pub mod cli;
 pub mod continue_command;
 pub mod curve_command;

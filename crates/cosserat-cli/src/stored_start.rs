@@ -8,7 +8,9 @@
 //! stored direction of travel — so a branch restarted from one of its own
 //! points goes on as the uninterrupted run did. A stage continued in
 //! another parameter (bend a rod shut, then twist it) starts from the
-//! stored shape with the stored value of the first parameter held.
+//! stored shape with the stored value of the first parameter held; a
+//! point of a later stage of a chained run holds that stage's held keys
+//! too.
 
 use std::path::Path;
 
@@ -85,7 +87,14 @@ pub fn stored_start(file: &Path, spec: &str, new_key: &str) -> Result<StoredStar
     let (b, i) = parse_point(spec, &saved)?;
     let branch = &saved.branches[b];
     let value = branch.parameter[i];
-    let mut sets = vec![];
+    // A branch of a later stage of a chained run continues its own key,
+    // the earlier stages' keys held.
+    let old_key = branch.parameter_name.clone().unwrap_or(old_key);
+    let mut sets: Vec<String> = branch
+        .held
+        .iter()
+        .map(|(k, v)| format!("{k}={v}"))
+        .collect();
     // A number of the problem file is set to the stored value; the
     // library's scalings (load_scale, control_scale) are not file keys.
     if Parameter::from_key(&old_key).is_none_or(Parameter::is_file_key) {
@@ -138,6 +147,13 @@ fn switch_start(
                 saved.specials.len()
             )
         })?;
+    // The branch point of a later stage of a chained run is one of that
+    // stage's key, the earlier keys held.
+    let branch = saved.branches.get(saved.specials[special].branch);
+    let old_key = branch
+        .and_then(|b| b.parameter_name.as_deref())
+        .unwrap_or(old_key)
+        .to_string();
     if old_key != new_key {
         return Err(format!(
             "--point special/{special}: the branch point is one of {old_key}; switch at it in \
@@ -145,8 +161,12 @@ fn switch_start(
         ));
     }
     let value = saved.specials[special].parameter;
+    let mut sets: Vec<String> = branch
+        .map(|b| b.held.iter().map(|(k, v)| format!("{k}={v}")).collect())
+        .unwrap_or_default();
+    sets.push(format!("continuation.start={value}"));
     Ok(StoredStart {
-        sets: vec![format!("continuation.start={value}")],
+        sets,
         summary: format!(
             "{} special point {special}: {} at {old_key} = {value}",
             file.display(),
