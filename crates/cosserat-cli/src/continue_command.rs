@@ -7,7 +7,7 @@ use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
 use crate::plot::{draw, read_diagram};
-use crate::stored_start::{stored_start, Start, StoredStart};
+use crate::stored_start::{solved_start, stored_start, Start, StoredStart};
 use cosserat::continuation::{
     continuation, continuation_from, switch_from, ContinuationError, ContinuationOptions, Diagram,
     Family, Progress, RunState, SavedDiagram,
@@ -62,8 +62,9 @@ pub struct ContinueArgs<'a> {
     pub force: bool,
     /// Go on with the output's interrupted run.
     pub resume: bool,
-    /// Start from a stored point: the diagram file and `B/I`.
-    pub from: Option<(&'a Path, &'a str)>,
+    /// Start from a stored point: the diagram file and `B/I`, or a solve
+    /// file (no point).
+    pub from: Option<(&'a Path, Option<&'a str>)>,
     /// Follow the stored special point in two parameters.
     pub curve: bool,
 }
@@ -82,10 +83,14 @@ fn read_problem(args: &ContinueArgs) -> Result<(Problem, Option<StoredStart>), E
     let Some((file, spec)) = args.from else {
         return Ok((problem, None));
     };
-    let Some((family, _)) = &problem.continuation else {
+    let Some((family, opts)) = &problem.continuation else {
         return Ok((problem, None));
     };
-    let stored = stored_start(file, spec, &family.key()).map_err(|e| fail(BAD_INPUT, e))?;
+    let stored = match spec {
+        Some(spec) => stored_start(file, spec, &family.key()),
+        None => solved_start(file, &problem.text, family, opts.start),
+    }
+    .map_err(|e| fail(BAD_INPUT, e))?;
     let mut set = stored.sets.clone();
     set.extend_from_slice(args.set);
     Ok((read(&set)?, Some(stored)))

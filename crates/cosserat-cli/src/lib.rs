@@ -90,7 +90,7 @@ pub fn run(cli: Cli) -> ExitCode {
             set: &set,
             force,
             resume,
-            from: from.as_deref().zip(point.as_deref()),
+            from: from.as_deref().map(|f| (f, point.as_deref())),
             curve,
         }),
         Command::Optimize {

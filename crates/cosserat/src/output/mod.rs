@@ -26,7 +26,8 @@ pub use curve::write_curve;
 pub use diagram::{read_saved, write_diagram, write_stages};
 #[cfg(feature = "hdf5")]
 pub use hdf5_output::{
-    check_target, write_equilibrium, write_stability, OutputError, StabilityResult,
+    check_target, read_solved, write_equilibrium, write_stability, OutputError, SolvedUnknowns,
+    StabilityResult,
 };
 #[cfg(feature = "hdf5")]
 pub use sweep_output::{read_sweep, write_sweep, SweepHeader};
