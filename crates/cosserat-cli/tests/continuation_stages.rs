@@ -279,3 +279,64 @@ fn what_cannot_be_chained_is_refused_by_stage() {
     let f = hdf5::File::open(&out).unwrap();
     assert!(f.group("branches/0").is_ok() && f.group("branches/1").is_err());
 }
+
+/// `--from` a point of stage 2 holds stage 2's held key: restarted in
+/// its own key from its tenth point, the branch goes on to the end stage
+/// 2 reached (the same last point to the corrector's tolerance).
+#[test]
+fn a_later_stage_restarts_with_its_held_keys() {
+    let dir = scratch("stages", "restart");
+    let (chained, again) = (dir.join("chain.h5"), dir.join("again.h5"));
+    let problem = shipped(CHAINED);
+    let o = run(&["continue", &problem, "-o", chained.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // The file's own start (stage 1's, −0.95) is outside stage 2's bounds:
+    // the point's value, which --from would set, is given for the check.
+    let c = hdf5::File::open(&chained).unwrap();
+    let start = format!(
+        "continuation.start={}",
+        read_f64(&branch(&c, 1), "parameter")[10]
+    );
+    let o = run(&[
+        "continue",
+        &problem,
+        "-o",
+        again.to_str().unwrap(),
+        "--set",
+        &start,
+        "--from",
+        chained.to_str().unwrap(),
+        "--point",
+        "1/10",
+        "--set",
+        "continuation.stage=[]",
+        "--set",
+        "continuation.parameter=\"support.turn.angle\"",
+        "--set",
+        "continuation.bounds=[0.0, 1.2]",
+        "--set",
+        "continuation.step=0.05",
+        "--set",
+        "continuation.max_step=0.1",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let a = hdf5::File::open(&again).unwrap();
+    let ends = |f: &hdf5::File, b: usize| {
+        let g = branch(f, b);
+        (
+            *read_f64(&g, "parameter").last().unwrap(),
+            rows(f, b, "unknowns").pop().unwrap(),
+        )
+    };
+    let ((p, x), (q, y)) = (ends(&c, 1), ends(&a, 0));
+    assert_eq!((p, q), (1.2, 1.2));
+    let worst = x
+        .iter()
+        .zip(&y)
+        .fold(0f64, |w, (u, v)| w.max((u - v).abs()));
+    assert!(worst < 1e-9, "the ends differ by {worst}");
+    // The restart held the end distance stage 2 held.
+    for tip in rows(&a, 0, "tip_position") {
+        assert!((tip[2] + 0.7).abs() < 1e-9, "{tip:?}");
+    }
+}
