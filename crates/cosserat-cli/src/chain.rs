@@ -55,7 +55,9 @@ pub fn run_chain(problem: &Problem, path: &Path, output: &Path, plot: Option<&Pa
     let mut stage_problems = vec![];
     for number in 2..=stages {
         let Some((last, previous_key)) = before.take() else {
-            break;
+            let key = &problem.stage_keys[number - 2];
+            let none = "the stage before ended without a point to start from";
+            return chain.failed(number, key, &none);
         };
         held.push((previous_key, last.parameter));
         let stage = match problem.stage(number, &held) {
