@@ -71,14 +71,10 @@ pub enum Command {
         /// Go on with an interrupted run saved in the output file.
         #[arg(long)]
         resume: bool,
-        /// Start from a point of this stored diagram (with --point) instead
-        /// of the problem's own solve.
-        #[arg(
-            long,
-            value_name = "DIAGRAM",
-            requires = "point",
-            conflicts_with = "resume"
-        )]
+        /// Start from a point of this stored diagram (with --point), or
+        /// from the equilibrium of this solve file (without --point),
+        /// instead of the problem's own solve.
+        #[arg(long, value_name = "DIAGRAM|SOLVE", conflicts_with = "resume")]
         from: Option<PathBuf>,
         /// The stored point: BRANCH/POINT, e.g. 1/10 or 1/last; or
         /// special/K to switch at the stored branch point K.

@@ -7,14 +7,14 @@ use std::time::{Duration, Instant};
 
 use crate::plot::{draw, read_diagram};
 use crate::progress::Meter;
-use crate::stored_start::{stored_start, Start, StoredStart};
+use crate::stored_start::{solved_start, stored_start, Start, StoredStart};
 use cosserat::continuation::{
     continuation, continuation_from, switch_from, ContinuationError, ContinuationOptions, Diagram,
     Family, Progress, RunState, SavedDiagram,
 };
 use cosserat::input::{Problem, MEASURES};
 use cosserat::output::target::replace_atomically;
-use cosserat::output::{read_saved, write_diagram};
+use cosserat::output::{read_saved, write_diagram, OutputError};
 
 use crate::exit::{fail, BAD_INPUT, INTERRUPTED, NO_RESULT, OUTPUT};
 use crate::signals;
@@ -24,7 +24,7 @@ const CHECKPOINT: Duration = Duration::from_secs(2);
 
 /// A string key of the `[continuation]` table of the effective problem
 /// text (the parsed value, never a scan of the raw text).
-fn section_key(text: &str, key: &str) -> Option<String> {
+pub(crate) fn section_key(text: &str, key: &str) -> Option<String> {
     let table: toml::Table = toml::from_str(text).ok()?;
     Some(table.get("continuation")?.get(key)?.as_str()?.to_string())
 }
@@ -61,8 +61,9 @@ pub struct ContinueArgs<'a> {
     pub force: bool,
     /// Go on with the output's interrupted run.
     pub resume: bool,
-    /// Start from a stored point: the diagram file and `B/I`.
-    pub from: Option<(&'a Path, &'a str)>,
+    /// Start from a stored point: the diagram file and `B/I`, or a solve
+    /// file (no point).
+    pub from: Option<(&'a Path, Option<&'a str>)>,
     /// Follow the stored special point in two parameters.
     pub curve: bool,
 }
@@ -75,13 +76,20 @@ fn read_problem(args: &ContinueArgs) -> Result<(Problem, Option<StoredStart>), E
             .map_err(|e| fail(BAD_INPUT, format!("{}: {e}", args.path.display())))
     };
     let problem = read(args.set)?;
+    if !problem.stage_keys.is_empty() {
+        chain_alone(args)?;
+    }
     let Some((file, spec)) = args.from else {
         return Ok((problem, None));
     };
-    let Some((family, _)) = &problem.continuation else {
+    let Some((family, opts)) = &problem.continuation else {
         return Ok((problem, None));
     };
-    let stored = stored_start(file, spec, &family.key()).map_err(|e| fail(BAD_INPUT, e))?;
+    let stored = match spec {
+        Some(spec) => stored_start(file, spec, &family.key()),
+        None => solved_start(file, &problem.text, family, opts.start),
+    }
+    .map_err(|e| fail(BAD_INPUT, e))?;
     let mut set = stored.sets.clone();
     set.extend_from_slice(args.set);
     Ok((read(&set)?, Some(stored)))
@@ -107,6 +115,9 @@ pub fn run_continue(args: &ContinueArgs) -> ExitCode {
         Ok(c) => c,
         Err(code) => return code,
     };
+    if !problem.stage_keys.is_empty() {
+        return crate::chain::run_chain(&problem, path, output, plot);
+    }
     if args.curve {
         return crate::curve_command::run_curve(&problem, stored.as_ref(), output);
     }
@@ -146,6 +157,33 @@ pub fn run_continue(args: &ContinueArgs) -> ExitCode {
     report(&diagram);
     println!("time      {:.1} ms", elapsed.as_secs_f64() * 1e3);
     run.finish(&diagram, plot)
+}
+
+/// A chained run (`[[continuation.stage]]`) starts from the problem's own
+/// solve and is not resumed: `--from`, `--curve` and `--resume` are
+/// refused (exit 2) rather than applied to one stage of it.
+fn chain_alone(args: &ContinueArgs) -> Result<(), ExitCode> {
+    let refused = if args.from.is_some() {
+        Some("--from")
+    } else if args.resume {
+        Some("--resume")
+    } else if args.curve {
+        Some("--curve")
+    } else {
+        None
+    };
+    match refused {
+        Some(flag) => Err(fail(
+            BAD_INPUT,
+            format!(
+                "{flag}: {} chains stages ([[continuation.stage]]), which run from the \
+                 problem's own solve to the end; run the stages one by one (continue, then \
+                 continue --from DIAGRAM --point 0/last) to restart or resume one",
+                args.path.display()
+            ),
+        )),
+        None => Ok(()),
+    }
 }
 
 /// The diagram to resume from: none without `--resume` or when `output`
@@ -188,12 +226,12 @@ fn saved_diagram(
 }
 
 /// One continuation run: what it follows and where its diagram goes.
-struct Run<'a> {
-    family: &'a Family,
-    opts: &'a ContinuationOptions,
-    output: &'a Path,
-    text: &'a str,
-    parameter_name: &'a str,
+pub(crate) struct Run<'a> {
+    pub(crate) family: &'a Family,
+    pub(crate) opts: &'a ContinuationOptions,
+    pub(crate) output: &'a Path,
+    pub(crate) text: &'a str,
+    pub(crate) parameter_name: &'a str,
 }
 
 impl Run<'_> {
@@ -204,6 +242,20 @@ impl Run<'_> {
         bar: &Meter,
         saved: Option<&SavedDiagram>,
         start: Option<&Start>,
+    ) -> Result<Diagram, ContinuationError> {
+        let save = |diagram: &Diagram| {
+            write_diagram(self.output, self.text, self.parameter_name, diagram, true)
+        };
+        self.follow_saving(bar, saved, start, &save)
+    }
+
+    /// [`Run::follow`] with the checkpoints written by `save`.
+    pub(crate) fn follow_saving(
+        &self,
+        bar: &Meter,
+        saved: Option<&SavedDiagram>,
+        start: Option<&Start>,
+        save: &dyn Fn(&Diagram) -> Result<(), OutputError>,
     ) -> Result<Diagram, ContinuationError> {
         let mut last_save = Instant::now();
         let mut checkpoint_error = None;
@@ -218,9 +270,7 @@ impl Run<'_> {
             ));
             bar.tick();
             if last_save.elapsed() >= CHECKPOINT {
-                if let Err(e) =
-                    write_diagram(self.output, self.text, self.parameter_name, diagram, true)
-                {
+                if let Err(e) = save(diagram) {
                     checkpoint_error.get_or_insert_with(|| e.to_string());
                 }
                 last_save = Instant::now();
@@ -306,7 +356,7 @@ pub fn run_plot(diagram: &Path, measure: &str, output: &Path, force: bool) -> Ex
     }
 }
 
-fn report(d: &Diagram) {
+pub(crate) fn report(d: &Diagram) {
     for w in &d.warnings {
         eprintln!("warning: {w}");
     }

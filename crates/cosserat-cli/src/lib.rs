@@ -32,6 +32,7 @@
 
 pub mod arm_chart;
 pub mod bench;
+pub mod chain;
 pub mod cli;
 pub mod continue_command;
 pub mod curve_command;
@@ -113,7 +114,7 @@ pub fn run(cli: Cli) -> ExitCode {
             set: &set,
             force,
             resume,
-            from: from.as_deref().zip(point.as_deref()),
+            from: from.as_deref().map(|f| (f, point.as_deref())),
             curve,
         }),
         Command::Optimize {

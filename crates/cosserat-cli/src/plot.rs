@@ -49,7 +49,8 @@ pub struct SpecialData {
 /// A diagram file's contents needed for charts.
 #[derive(Debug, Clone, Default)]
 pub struct DiagramData {
-    /// The continued parameter's name.
+    /// The continued parameter's name (the stages' keys, in order, for a
+    /// chained run: its stages share the horizontal axis).
     pub parameter_name: String,
     /// Branches.
     pub branches: Vec<BranchData>,
@@ -103,10 +104,21 @@ pub fn read_diagram(path: &Path) -> hdf5::Result<DiagramData> {
     };
     let k = measure_names.len();
     let mut branches = vec![];
+    let mut keys: Vec<String> = vec![];
     for i in 0.. {
         let Ok(g) = root.group(&i.to_string()) else {
             break;
         };
+        // A chained run's stages continue different keys on one axis.
+        if let Ok(a) = g.attr("parameter_name") {
+            let key = a
+                .read_scalar::<hdf5::types::VarLenUnicode>()?
+                .as_str()
+                .to_string();
+            if !keys.contains(&key) {
+                keys.push(key);
+            }
+        }
         let read = |name: &str| g.dataset(name).and_then(|d| d.read_raw::<f64>());
         let shapes_ds = g.dataset("shapes")?;
         let per = shapes_ds.shape().get(1).copied().unwrap_or(0);
@@ -138,6 +150,15 @@ pub fn read_diagram(path: &Path) -> hdf5::Result<DiagramData> {
     let branch = sp.dataset("branch")?.read_raw::<u64>()?;
     let index = sp.dataset("index")?.read_raw::<u64>()?;
     let parameter = sp.dataset("parameter")?.read_raw::<f64>()?;
+    let parameter_name = if keys.len() > 1 {
+        keys.iter()
+            .enumerate()
+            .map(|(i, k)| format!("stage {}: {k}", i + 1))
+            .collect::<Vec<_>>()
+            .join(" | ")
+    } else {
+        parameter_name
+    };
     let tip = rows3(&sp.dataset("tip_position")?.read_raw::<f64>()?)?;
     let n = kinds.len();
     let special_measures = measure_rows(&sp, k, n)?;

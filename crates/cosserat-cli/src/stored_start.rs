@@ -1,5 +1,7 @@
 //! `cosserat continue PROBLEM --from DIAGRAM.h5 --point B/I`: a
-//! continuation started from a point of a stored diagram.
+//! continuation started from a point of a stored diagram; and
+//! `--from SOLVE.h5` (no point): started from the equilibrium a
+//! `cosserat solve` stored, of the same rod.
 //!
 //! The point's unknowns start Newton at the new run's start value. The
 //! stored parameter carries over: the number it names is set to the
@@ -8,12 +10,14 @@
 //! stored direction of travel — so a branch restarted from one of its own
 //! points goes on as the uninterrupted run did. A stage continued in
 //! another parameter (bend a rod shut, then twist it) starts from the
-//! stored shape with the stored value of the first parameter held.
+//! stored shape with the stored value of the first parameter held; a
+//! point of a later stage of a chained run holds that stage's held keys
+//! too.
 
 use std::path::Path;
 
-use cosserat::continuation::{Parameter, SavedDiagram, StartPoint};
-use cosserat::output::read_saved;
+use cosserat::continuation::{Family, Parameter, SavedDiagram, StartPoint};
+use cosserat::output::{read_saved, read_solved};
 
 /// Where the new run begins.
 pub enum Start {
@@ -85,7 +89,14 @@ pub fn stored_start(file: &Path, spec: &str, new_key: &str) -> Result<StoredStar
     let (b, i) = parse_point(spec, &saved)?;
     let branch = &saved.branches[b];
     let value = branch.parameter[i];
-    let mut sets = vec![];
+    // A branch of a later stage of a chained run continues its own key,
+    // the earlier stages' keys held.
+    let old_key = branch.parameter_name.clone().unwrap_or(old_key);
+    let mut sets: Vec<String> = branch
+        .held
+        .iter()
+        .map(|(k, v)| format!("{k}={v}"))
+        .collect();
     // A number of the problem file is set to the stored value; the
     // library's scalings (load_scale, control_scale) are not file keys.
     if Parameter::from_key(&old_key).is_none_or(Parameter::is_file_key) {
@@ -138,6 +149,13 @@ fn switch_start(
                 saved.specials.len()
             )
         })?;
+    // The branch point of a later stage of a chained run is one of that
+    // stage's key, the earlier keys held.
+    let branch = saved.branches.get(saved.specials[special].branch);
+    let old_key = branch
+        .and_then(|b| b.parameter_name.as_deref())
+        .unwrap_or(old_key)
+        .to_string();
     if old_key != new_key {
         return Err(format!(
             "--point special/{special}: the branch point is one of {old_key}; switch at it in \
@@ -145,8 +163,12 @@ fn switch_start(
         ));
     }
     let value = saved.specials[special].parameter;
+    let mut sets: Vec<String> = branch
+        .map(|b| b.held.iter().map(|(k, v)| format!("{k}={v}")).collect())
+        .unwrap_or_default();
+    sets.push(format!("continuation.start={value}"));
     Ok(StoredStart {
-        sets: vec![format!("continuation.start={value}")],
+        sets,
         summary: format!(
             "{} special point {special}: {} at {old_key} = {value}",
             file.display(),
@@ -170,4 +192,68 @@ fn stored_key(text: &str) -> Option<String> {
             .trim()
             .to_string(),
     )
+}
+
+/// The tables whose numbers make the rod: a solve of the same problem has
+/// the same ones.
+const ROD_TABLES: [&str; 5] = ["rod", "energy", "clamp", "support", "loads"];
+
+/// The start from the equilibrium of the solve file `file` for a run of
+/// the problem `text` continuing `family` from `start`: Newton at the
+/// start value from the stored unknowns. Refused when the file is not a
+/// solve file, was solved for another rod (a table of the rod differs),
+/// at another model level, or with another discretization.
+pub fn solved_start(
+    file: &Path,
+    text: &str,
+    family: &Family,
+    start: f64,
+) -> Result<StoredStart, String> {
+    let solved = read_solved(file).map_err(|e| {
+        format!(
+            "{}: not a solve file ({e}); a diagram needs --point B/I",
+            file.display()
+        )
+    })?;
+    let (stored, own): (toml::Table, toml::Table) = (
+        toml::from_str(&solved.problem)
+            .map_err(|e| format!("{}: its problem text does not read: {e}", file.display()))?,
+        toml::from_str(text).map_err(|e| e.to_string())?,
+    );
+    if let Some(table) = ROD_TABLES.iter().find(|t| stored.get(**t) != own.get(**t)) {
+        return Err(format!(
+            "--from {}: solved for another problem: its [{table}] differs from this problem's",
+            file.display()
+        ));
+    }
+    if solved.model != family.level().name() {
+        return Err(format!(
+            "--from {}: solved at the {} model; this continuation runs the {} model",
+            file.display(),
+            solved.model,
+            family.level().name()
+        ));
+    }
+    if solved.unknowns.is_empty() {
+        return Err(format!(
+            "--from {}: solved by {}, which keeps no shooting unknowns; solve with \
+             solver.method = \"shooting\" or \"multiple-shooting\"",
+            file.display(),
+            solved.method
+        ));
+    }
+    let x = family
+        .solved_unknowns(&solved.unknowns, start)
+        .map_err(|e| format!("--from {}: {e}", file.display()))?;
+    Ok(StoredStart {
+        sets: vec![],
+        start: Start::Point(StartPoint::new(x, None)),
+        summary: format!(
+            "{}: the equilibrium solved by {} ({} unknowns), Newton at {} = {start}",
+            file.display(),
+            solved.method,
+            solved.unknowns.len(),
+            family.key()
+        ),
+    })
 }

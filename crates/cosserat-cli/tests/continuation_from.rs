@@ -3,6 +3,7 @@
 
 mod common;
 
+use common::h5::read_f64;
 use common::run::{run, scratch, stderr};
 
 fn shipped(name: &str) -> String {
@@ -278,4 +279,136 @@ fn a_stored_branch_point_is_followed_in_a_second_parameter() {
     assert_eq!(o.status.code(), Some(2));
     assert!(stderr(&o).contains("special/K"), "{}", stderr(&o));
     assert!(!curve.exists(), "nothing written by a refusal");
+}
+
+/// `--from SOLVE.h5`: the displacement-controlled elastica started from
+/// the equilibrium `cosserat solve` stored follows the same branches as
+/// the run that solves its own start (Newton at the start value from the
+/// same unknowns), to the corrector's tolerance.
+#[test]
+fn a_solve_file_starts_the_continuation() {
+    let dir = scratch("from", "solve");
+    let (solved, own, from) = (
+        dir.join("solve.h5"),
+        dir.join("own.h5"),
+        dir.join("from.h5"),
+    );
+    let problem = shipped("clamped_elastica_displacement");
+    let o = run(&["solve", &problem, "-o", solved.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = run(&["continue", &problem, "-o", own.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = run(&[
+        "continue",
+        &problem,
+        "-o",
+        from.to_str().unwrap(),
+        "--from",
+        solved.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("the equilibrium solved by shooting"), "{out}");
+    let (a, b) = (
+        hdf5::File::open(&own).unwrap(),
+        hdf5::File::open(&from).unwrap(),
+    );
+    let mut worst: f64 = 0.0;
+    for i in 0..2 {
+        let path = format!("branches/{i}");
+        let (ga, gb) = (a.group(&path).unwrap(), b.group(&path).unwrap());
+        for name in ["parameter", "unknowns"] {
+            let (u, v) = (read_f64(&ga, name), read_f64(&gb, name));
+            assert_eq!(u.len(), v.len(), "branch {i} {name}");
+            worst = u
+                .iter()
+                .zip(&v)
+                .fold(worst, |w, (x, y)| w.max((x - y).abs()));
+        }
+    }
+    assert!(worst < 1e-9, "the branches differ by {worst}");
+}
+
+/// Hostile and wrong `--from` files without `--point` are refused by name
+/// with exit code 2 and nothing written: a device, a directory, a file
+/// that is not HDF5, a missing file, a damaged solve file, a diagram, a
+/// solve of another problem, at another model level, or with another
+/// discretization.
+#[test]
+fn wrong_solve_files_are_refused() {
+    let dir = scratch("from", "solve-hostile");
+    let out = dir.join("out.h5");
+    let problem = shipped("clamped_elastica_displacement");
+    let solve = |name: &str, extra: &[&str]| {
+        let path = dir.join(name);
+        let mut args = vec!["solve", &problem, "-o", path.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        let o = run(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        path
+    };
+    let good = solve("good.h5", &[]);
+    let damaged = dir.join("damaged.h5");
+    let mut bytes = std::fs::read(&good).unwrap();
+    let middle = bytes.len() / 2;
+    bytes[middle] ^= 0xff;
+    std::fs::write(&damaged, bytes).unwrap();
+    let garbage = dir.join("garbage.h5");
+    std::fs::write(&garbage, b"not an hdf5 file").unwrap();
+    let diagram = dir.join("diagram.h5");
+    let o = run(&["continue", &problem, "-o", diagram.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let other = dir.join("other.h5");
+    let o = run(&[
+        "solve",
+        &shipped("cantilever_tip_load"),
+        "-o",
+        other.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let spatial = solve("spatial.h5", &["--set", "solver.model=\"kirchhoff\""]);
+    let segments = solve(
+        "segments.h5",
+        &[
+            "--set",
+            "solver.method=\"multiple-shooting\"",
+            "--set",
+            "solver.segments=4",
+        ],
+    );
+    let cases: [(&std::path::Path, &str); 9] = [
+        (std::path::Path::new("/dev/zero"), "not a solve file"),
+        (dir.as_path(), "not a solve file"),
+        (&garbage, "not a solve file"),
+        (&dir.join("missing.h5"), "not a solve file"),
+        (&damaged, "is damaged"),
+        (&diagram, "not a solve file (it has no /solution group)"),
+        (&other, "solved for another problem: its ["),
+        (&spatial, "solved at the kirchhoff model"),
+        (&segments, "the solve has 21 unknowns"),
+    ];
+    for (from, says) in cases {
+        let o = run(&[
+            "continue",
+            &problem,
+            "-o",
+            out.to_str().unwrap(),
+            "--from",
+            from.to_str().unwrap(),
+        ]);
+        assert_eq!(
+            o.status.code(),
+            Some(2),
+            "{}: {}",
+            from.display(),
+            stderr(&o)
+        );
+        assert!(
+            stderr(&o).contains(says),
+            "{}: {}",
+            from.display(),
+            stderr(&o)
+        );
+        assert!(!out.exists(), "nothing written");
+    }
 }

@@ -64,6 +64,67 @@ fn turning_and_energy_follow_the_elastica() {
     assert!((last.abs() - 170f64.to_radians()).abs() < 1e-8, "{last}");
 }
 
+/// The total potential energy Π = ∫W ds − P·r(L) along the buckled
+/// column (load P = λP₀, P₀ = −e3, B = L = 1). The elastica gives it in
+/// closed form, Π = 2K(E − k'²K) + λ z(L) with λ = K² and the tip height
+/// z(L) = 2E/K − 1 (Timoshenko & Gere, Sec. 2.7); and by the envelope
+/// theorem its slope along the branch is dΠ/dλ = −P₀·r(L) = z(L), which
+/// the central difference between neighbouring points meets to its
+/// O(Δλ²) truncation error.
+#[test]
+fn the_total_potential_energy_has_the_envelope_slope() {
+    let set = [
+        "continuation.measures=[\"total_potential_energy\", \"position[2]@1\"]".to_string(),
+        "continuation.step=0.05".to_string(),
+        "continuation.max_step=0.05".to_string(),
+    ];
+    let problem = Problem::from_str_with(EULER, &set).unwrap();
+    let (family, opts) = problem.continuation.clone().unwrap();
+    let d = continuation(&family, &opts, &mut |_, _| true).unwrap();
+    assert_eq!(d.measure_names, ["total_potential_energy", "position[2]@1"]);
+    let tip_height = |lambda: f64| {
+        let k = modulus(lambda);
+        2.0 * ellip_e(FRAC_PI_2, k) / ellip_f(FRAC_PI_2, k) - 1.0
+    };
+    let buckled = &d.branches[1];
+    for point in &buckled.points[1..] {
+        let lambda = point.parameter;
+        let k = modulus(lambda);
+        let (kk, ee) = (ellip_f(FRAC_PI_2, k), ellip_e(FRAC_PI_2, k));
+        let exact = 2.0 * kk * (ee - (1.0 - k * k) * kk) + lambda * tip_height(lambda);
+        assert!(
+            (point.measures[0] - exact).abs() < 1e-8 * exact.abs().max(1.0),
+            "λ = {lambda}: Π {} vs {exact}",
+            point.measures[0]
+        );
+    }
+    let mut worst: f64 = 0.0;
+    let mut checked = 0;
+    for pair in buckled.points[1..].windows(2) {
+        let (a, b) = (&pair[0], &pair[1]);
+        let h = b.parameter - a.parameter;
+        if h.abs() < 1e-6 {
+            continue;
+        }
+        let slope = (b.measures[0] - a.measures[0]) / h;
+        let exact = tip_height(0.5 * (a.parameter + b.parameter));
+        // The central difference's truncation error is h²/24 · z''(λ), and
+        // |z''| < 0.74 on the buckled branch (the closed form's second
+        // difference, largest next to λ = π²/4); 1e-7 for the points'
+        // own Π, accurate to the corrector's tolerance.
+        let error = (slope - exact).abs();
+        assert!(
+            error < h * h / 24.0 + 1e-7,
+            "λ = {}: {slope} vs {exact}",
+            a.parameter
+        );
+        worst = worst.max(error);
+        checked += 1;
+    }
+    assert!(checked > 20, "{checked} slopes checked");
+    eprintln!("dΠ/dλ against z(L): {checked} slopes, worst error {worst:.2e}");
+}
+
 /// The stored measure is the force the support exerts (−P along the axis).
 #[test]
 fn the_support_force_is_measured_along_the_displacement_branch() {

@@ -62,7 +62,8 @@ impl Method {
         }
     }
 
-    fn segments(&self) -> usize {
+    /// The shooting segments (1 for shooting and collocation).
+    pub fn segments(&self) -> usize {
         match *self {
             Method::Shooting | Method::Collocation { .. } => 1,
             Method::MultipleShooting { segments } => segments.max(1),

@@ -205,6 +205,31 @@ impl Family {
         Ok(self.scaled(&sys.refined_unknowns(raw, self.segments)?))
     }
 
+    /// The family's unknowns at p from the raw shooting unknowns of a
+    /// stored solve: those of [`Family::method`] (carried onto the
+    /// family's nodes by [`Family::start_unknowns`]) or of the family's own
+    /// segments; another count (another level, method or mesh) is refused
+    /// naming both.
+    pub fn solved_unknowns(&self, raw: &[f64], p: f64) -> Result<Vec<f64>, String> {
+        let eq = equations(&self.base, self.level);
+        let coarse = eq.unknowns() + eq.dim() * (self.segments.min(START_SEGMENTS) - 1);
+        if raw.len() == self.size() {
+            Ok(self.scaled(raw))
+        } else if raw.len() == coarse {
+            self.start_unknowns(raw, p).map_err(|e| e.to_string())
+        } else {
+            Err(format!(
+                "the solve has {} unknowns; this continuation starts from {coarse} ({} model, {} \
+                 segments) or {} (its own discretization): solve with the same model and \
+                 solver.method",
+                raw.len(),
+                self.level.name(),
+                self.segments.min(START_SEGMENTS),
+                self.size()
+            ))
+        }
+    }
+
     /// The length of the base rod (the problem's `rod.length`).
     pub fn base_length(&self) -> f64 {
         self.base.length()

@@ -2,19 +2,28 @@
 //! the position, tangent, internal force, internal moment or curvature at
 //! any point s = σL of the rod (σ ∈ [0, 1]; the force and moment at σ = 0
 //! are the clamp's reaction, at σ = 1 a support's), the planar turning
-//! angle φ(L) − φ(0) unfolded through any number of turns, and the stored
-//! energy. Each is computed from the point's own equilibrium (one
+//! angle φ(L) − φ(0) unfolded through any number of turns, the stored
+//! energy and the total potential energy. Each is computed from the point's own equilibrium (one
 //! integration for all the measures of a point), stored with the point and
 //! written to the diagram, so that `cosserat plot --measure NAME` draws it.
 //!
 //! Grammar: `position[i]@σ`, `tangent[i]@σ`, `force[i]@σ`, `moment[i]@σ`
 //! (global components, i = 0, 1, 2), `curvature[i]@σ` (body components),
 //! `turning` (∫₀ᴸ κ2 ds, planar scenes), `stored_energy` (∫₀ᴸ W(s, κ) ds,
-//! unshearable rods). The integrals use 3-point Gauss–Legendre on 64 equal
+//! unshearable rods), `total_potential_energy` (the stored energy minus
+//! the work of the dead loads,
+//! Π = ∫₀ᴸ W(s, κ) ds − P·r(L) − ∫₀ᴸ f·r(s) ds, unshearable rods; the
+//! potential of the dead loads as [`crate::stability`] defines it,
+//! −∫ n·r' ds with n = P + ∫ₛᴸ f, integrated by parts with r measured from
+//! the global origin; a dead tip couple is only accepted where the tip's
+//! rotation is held, where it does no work and is left out). Along a
+//! branch in a load factor λ (P = λP₀, f = λf₀) the envelope theorem gives
+//! dΠ/dλ = −P₀·r(L) − ∫ f₀·r ds. The integrals use 3-point Gauss–Legendre on 64 equal
 //! intervals (exact for the polynomial part, sixth order on a smooth
 //! integrand).
 
 use crate::equations::RodSample;
+use crate::model::DeadLoads;
 use crate::numerics::quadrature::gauss_legendre;
 
 /// A quantity sampled at one point of the rod.
@@ -70,6 +79,9 @@ pub enum Measure {
     Turning,
     /// ∫₀ᴸ W(s, κ) ds.
     StoredEnergy,
+    /// ∫₀ᴸ W(s, κ) ds − P·r(L) − ∫₀ᴸ f·r ds: the stored energy minus the
+    /// work of the dead loads (module doc).
+    TotalPotentialEnergy,
 }
 
 /// Intervals of the quadrature of the integral measures.
@@ -82,13 +94,14 @@ impl Measure {
         match name {
             "turning" => return Ok(Measure::Turning),
             "stored_energy" => return Ok(Measure::StoredEnergy),
+            "total_potential_energy" => return Ok(Measure::TotalPotentialEnergy),
             _ => {}
         }
         let bad = || {
             format!(
                 "`{name}` is not a measure: expected QUANTITY[i]@σ (QUANTITY one of position, \
-                 tangent, force, moment, curvature; i = 0, 1, 2; σ = s/L in [0, 1]), turning \
-                 or stored_energy"
+                 tangent, force, moment, curvature; i = 0, 1, 2; σ = s/L in [0, 1]), turning, \
+                 stored_energy or total_potential_energy"
             )
         };
         let (head, at) = name.split_once('@').ok_or_else(bad)?;
@@ -131,11 +144,15 @@ impl Measure {
             } => format!("{}[{component}]@{fraction}", quantity.name()),
             Measure::Turning => "turning".into(),
             Measure::StoredEnergy => "stored_energy".into(),
+            Measure::TotalPotentialEnergy => "total_potential_energy".into(),
         }
     }
 
     fn integral(&self) -> bool {
-        matches!(self, Measure::Turning | Measure::StoredEnergy)
+        matches!(
+            self,
+            Measure::Turning | Measure::StoredEnergy | Measure::TotalPotentialEnergy
+        )
     }
 }
 
@@ -148,6 +165,8 @@ pub(super) struct Plan {
     at: Vec<Option<usize>>,
     /// Quadrature nodes' indices in `points` and weights.
     quadrature: Vec<(usize, f64)>,
+    /// The tip's index in `points` when a measure needs r(L).
+    tip: Option<usize>,
 }
 
 impl Plan {
@@ -169,6 +188,10 @@ impl Plan {
             }
             points.extend(nodes.iter().map(|(x, _)| *x));
         }
+        let needs_tip = measures.contains(&Measure::TotalPotentialEnergy);
+        if needs_tip {
+            points.push(length);
+        }
         points.sort_by(f64::total_cmp);
         points.dedup();
         let index = |s: f64| points.partition_point(|p| *p < s);
@@ -180,20 +203,23 @@ impl Plan {
             })
             .collect();
         let quadrature = nodes.iter().map(|(x, w)| (index(*x), *w)).collect();
+        let tip = needs_tip.then(|| index(length));
         Plan {
             points,
             at,
             quadrature,
+            tip,
         }
     }
 
     /// The measures' values from the samples at `self.points`; `density`
-    /// is W(s, κ).
+    /// is W(s, κ), `loads` the rod's dead loads.
     pub(super) fn values(
         &self,
         measures: &[Measure],
         samples: &[RodSample],
         density: &dyn Fn(f64, &nalgebra::Vector3<f64>) -> f64,
+        loads: &DeadLoads,
     ) -> Vec<f64> {
         let integral = |f: &dyn Fn(&RodSample) -> f64| -> f64 {
             self.quadrature
@@ -215,6 +241,12 @@ impl Plan {
                 ) => quantity.value(&samples[*i], *component),
                 (Measure::Turning, _) => integral(&|r| r.curvature[1]),
                 (Measure::StoredEnergy, _) => integral(&|r| density(r.s, &r.curvature)),
+                (Measure::TotalPotentialEnergy, _) => {
+                    let tip = &samples[self.tip.expect("the plan samples the tip")];
+                    integral(&|r| {
+                        density(r.s, &r.curvature) - loads.distributed_force.dot(&r.position)
+                    }) - loads.tip_force.dot(&tip.position)
+                }
                 (Measure::At { .. }, None) => unreachable!("point measures have a sample"),
             })
             .collect()
@@ -233,7 +265,12 @@ impl super::Run<'_> {
         let plan = Plan::new(measures, rod.length());
         let samples = self.family.samples(x, p, &plan.points)?;
         let energy = rod.energy();
-        Ok(plan.values(measures, &samples, &|s, k| energy.density(s, k)))
+        Ok(plan.values(
+            measures,
+            &samples,
+            &|s, k| energy.density(s, k),
+            rod.loads(),
+        ))
     }
 }
 
@@ -243,7 +280,14 @@ mod tests {
 
     #[test]
     fn names_read_back() {
-        for name in ["force[2]@0", "position[0]@0.5", "curvature[1]@1", "turning"] {
+        for name in [
+            "force[2]@0",
+            "position[0]@0.5",
+            "curvature[1]@1",
+            "turning",
+            "stored_energy",
+            "total_potential_energy",
+        ] {
             assert_eq!(Measure::parse(name).unwrap().name(), name);
         }
         for bad in [

@@ -20,7 +20,8 @@
 //! the bordered pseudo-arclength system, the tangent), `driver` the loop
 //! that follows branches and switches at branch points, `events` the
 //! location of folds and branch points, `resume` a run continued from a
-//! saved diagram.
+//! saved diagram, `restart` a run started from given unknowns, `stage` the
+//! chained stages of one run joined into one diagram.
 
 mod codim2;
 mod corrector;
@@ -35,6 +36,7 @@ mod options;
 mod restart;
 mod resume;
 mod slice;
+mod stage;
 mod status;
 mod tracking;
 
@@ -47,6 +49,7 @@ pub use measure::{Measure, Quantity};
 pub use options::ContinuationOptions;
 pub use restart::{continuation_from, switch_from, StartPoint};
 pub use resume::{resume, SavedBranch, SavedDiagram, SavedSpecial};
+pub use stage::{stage_of, Stage};
 pub use status::{BranchEnd, RunState};
 pub use tracking::{Modes, Spectrum, Tracker};
 

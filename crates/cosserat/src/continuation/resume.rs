@@ -29,6 +29,12 @@ pub struct SavedBranch {
     pub direction: f64,
     /// The arclength step the next point would be tried with.
     pub next_step: f64,
+    /// The key the branch continues (absent in files written before
+    /// branches recorded it: the problem's `continuation.parameter`).
+    pub parameter_name: Option<String>,
+    /// The keys of earlier stages held on the branch, and their values
+    /// (none on a first stage).
+    pub held: Vec<(String, f64)>,
 }
 
 /// One saved special point.

@@ -77,6 +77,52 @@ pub struct ContinuationSection {
     /// tip included).
     #[serde(default = "default_shape_points")]
     pub shape_points: usize,
+    /// `[[continuation.stage]]`: later stages of the run, each continuing
+    /// its own key from the last point of the stage before's first branch
+    /// with that stage's key held (this table is stage 1).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub stage: Vec<StageSection>,
+}
+
+/// `[[continuation.stage]]`: a later stage of a chained run. It names its
+/// key, start and bounds; the step settings it leaves out are those of
+/// `[continuation]`, and what one diagram must share (measures, the
+/// tracked eigenvalues, shapes, the collocation mesh) is not a stage's to
+/// change.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct StageSection {
+    /// The continued key (as `continuation.parameter`).
+    pub parameter: String,
+    /// Its value at the stage's first point.
+    pub start: f64,
+    /// [min, max] of the key.
+    #[serde(deserialize_with = "super::strict::array")]
+    pub bounds: [f64; 2],
+    /// Initial arclength step.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub step: Option<f64>,
+    /// Smallest step.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_step: Option<f64>,
+    /// Largest step.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_step: Option<f64>,
+    /// Points per branch at most.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_points: Option<usize>,
+    /// Follow the stage's first branch both ways.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub both_directions: Option<bool>,
+    /// Depth of recursive branch switching.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub switch_depth: Option<usize>,
+    /// Stop a branch when the tip tangent has turned this far (degrees).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tip_angle_limit: Option<f64>,
+    /// Corrector tolerance.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tolerance: Option<f64>,
 }
 
 fn default_shape_points() -> usize {

@@ -5,14 +5,20 @@
 //! (m), `norm` (m), `measures` (m×k, named by `/branches/measure_names`),
 //! `shapes` (m×21×3), `unknowns` (m×n) and `tangent`
 //! (m×(n+1)) of the discretization, attributes `parent`, `stop_reason`,
-//! `direction` (±1: travel along or against the stored tangents) and
-//! `next_step` (the arclength step a resumed run goes on with); `/special_points/kind` (strings), `branch`, `index`,
+//! `direction` (±1: travel along or against the stored tangents),
+//! `next_step` (the arclength step a resumed run goes on with), `stage`
+//! (1 for a single run; the stage of a chained run, `[[continuation.stage]]`)
+//! and `parameter_name` (the key the branch continues), datasets
+//! `held_keys` (strings) and `held_values` (the earlier stages' keys held
+//! on the branch and their values; empty on a first stage);
+//! `/special_points/kind` (strings), `branch`, `index`,
 //! `parameter`, `tip_position` (s×3), `measures` (s×k), `block`, `symmetry_breaking`,
 //! `null_vectors` (s×nodes×3), `singularity` (s×2), `multiplicity` (s:
 //! eigenvalues crossing zero; absent in older files, read as 1); `/warnings` (events
 //! detected but not located, as text); the problem text as the
 //! root attribute `problem`, the run's `stop_reason` and the parameter name
-//! as root attributes.
+//! as root attributes (the first stage's parameter for a chained run, whose
+//! root attribute `stages` counts its stages).
 
 use std::path::Path;
 
@@ -20,7 +26,8 @@ use hdf5::types::VarLenUnicode;
 
 use super::hdf5_output::{array, string_attr, text, write_atomically, OutputError};
 use crate::continuation::{
-    BranchEnd, Diagram, RunState, SavedBranch, SavedDiagram, SavedSpecial, SpecialKind,
+    stage_of, BranchEnd, Diagram, RunState, SavedBranch, SavedDiagram, SavedSpecial, SpecialKind,
+    Stage,
 };
 use crate::stability::Block;
 
@@ -41,7 +48,8 @@ fn strings(group: &hdf5::Group, name: &str, data: &[&str]) -> hdf5::Result<()> {
         .write_raw(&values)
 }
 
-/// Writes the diagram atomically (a temporary file renamed into place).
+/// Writes the diagram of a single run in `parameter` atomically (a
+/// temporary file renamed into place).
 pub fn write_diagram(
     path: &Path,
     problem: &str,
@@ -49,23 +57,41 @@ pub fn write_diagram(
     diagram: &Diagram,
     force: bool,
 ) -> Result<(), OutputError> {
+    write_stages(path, problem, &[Stage::first(parameter)], diagram, force)
+}
+
+/// Writes the diagram of a chained run atomically, each branch tagged with
+/// its stage (`stages` in order, the first starting at branch 0).
+pub fn write_stages(
+    path: &Path,
+    problem: &str,
+    stages: &[Stage],
+    diagram: &Diagram,
+    force: bool,
+) -> Result<(), OutputError> {
+    let parameter = stages.first().map_or("", Stage::key);
     write_atomically(path, force, |file| {
         string_attr(file, "problem", problem)?;
         string_attr(file, "parameter_name", parameter)?;
+        if stages.len() > 1 {
+            file.new_attr::<u64>()
+                .create("stages")?
+                .write_scalar(&(stages.len() as u64))?;
+        }
         string_attr(file, "stop_reason", diagram.stop_reason.name())?;
         string_attr(
             file,
             "generator",
             concat!("cosserat ", env!("CARGO_PKG_VERSION")),
         )?;
-        write_branches(file, diagram)?;
+        write_branches(file, diagram, stages)?;
         write_special_points(file, diagram)?;
         let warnings: Vec<&str> = diagram.warnings.iter().map(String::as_str).collect();
         strings(file, "warnings", &warnings)
     })
 }
 
-fn write_branches(file: &hdf5::File, d: &Diagram) -> hdf5::Result<()> {
+fn write_branches(file: &hdf5::File, d: &Diagram, stages: &[Stage]) -> hdf5::Result<()> {
     let root = file.create_group("branches")?;
     let names: Vec<&str> = d.eigenvalue_names.iter().map(String::as_str).collect();
     strings(&root, "eigenvalue_names", &names)?;
@@ -122,8 +148,46 @@ fn write_branches(file: &hdf5::File, d: &Diagram) -> hdf5::Result<()> {
         g.new_attr::<f64>()
             .create("next_step")?
             .write_scalar(&b.next_step)?;
+        write_stage(&g, stages, i)?;
     }
     Ok(())
+}
+
+/// The stage of branch `i`: its number, key and held keys.
+fn write_stage(g: &hdf5::Group, stages: &[Stage], i: usize) -> hdf5::Result<()> {
+    let k = stage_of(stages, i);
+    g.new_attr::<u64>()
+        .create("stage")?
+        .write_scalar(&(k as u64 + 1))?;
+    let Some(stage) = stages.get(k) else {
+        return Ok(());
+    };
+    string_attr(g, "parameter_name", stage.key())?;
+    let keys: Vec<&str> = stage.held().iter().map(|(k, _)| k.as_str()).collect();
+    strings(g, "held_keys", &keys)?;
+    let values: Vec<f64> = stage.held().iter().map(|(_, v)| *v).collect();
+    array(g, "held_values", &[values.len()], &values)
+}
+
+/// The keys held on a branch and their values.
+type Held = Vec<(String, f64)>;
+
+/// The key and held keys of a stored branch (absent in older files).
+fn read_stage(g: &hdf5::Group) -> hdf5::Result<(Option<String>, Held)> {
+    let Ok(name) = read_string(g, "parameter_name") else {
+        return Ok((None, vec![]));
+    };
+    let keys = g.dataset("held_keys")?.read_raw::<VarLenUnicode>()?;
+    let values = g.dataset("held_values")?.read_raw::<f64>()?;
+    if keys.len() != values.len() {
+        return Err("held_keys and held_values have different lengths".into());
+    }
+    let held = keys
+        .iter()
+        .map(|k| k.as_str().to_string())
+        .zip(values)
+        .collect();
+    Ok((Some(name), held))
 }
 
 fn write_special_points(file: &hdf5::File, d: &Diagram) -> hdf5::Result<()> {
@@ -230,6 +294,7 @@ pub fn read_saved(path: &Path) -> hdf5::Result<(String, SavedDiagram)> {
             break;
         };
         let parent = g.attr("parent")?.read_scalar::<i64>()?;
+        let (parameter_name, held) = read_stage(&g)?;
         branches.push(SavedBranch {
             parameter: g.dataset("parameter")?.read_raw::<f64>()?,
             unknowns: rows(&g, "unknowns")?,
@@ -238,6 +303,8 @@ pub fn read_saved(path: &Path) -> hdf5::Result<(String, SavedDiagram)> {
             stop_reason: BranchEnd::from_text(&read_string(&g, "stop_reason")?),
             direction: g.attr("direction")?.read_scalar::<f64>()?,
             next_step: g.attr("next_step")?.read_scalar::<f64>()?,
+            parameter_name,
+            held,
         });
     }
     let g = f.group("special_points")?;

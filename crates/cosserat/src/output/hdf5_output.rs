@@ -2,9 +2,12 @@
 //!
 //! Layout (a contract, see README.md): group `/solution` with datasets `s`
 //! (n), `position`, `d1`, `d2`, `d3`, `curvature`, `moment` (body), `force`
-//! (global), each n×3; attributes `model`, `model_reason`, `method`,
-//! `iterations`, `residual`, and more; the problem text as the root
-//! attribute `problem`.
+//! (global), each n×3, `unknowns` (the solve's shooting unknowns: κ(0)
+//! and the interior node states of multiple shooting, what
+//! `cosserat continue --from SOLVE.h5` starts Newton from; empty for
+//! collocation); attributes `model`, `model_reason`, `method`, `segments`
+//! (the shooting segments), `iterations`, `residual`, and more; the
+//! problem text as the root attribute `problem`.
 //!
 //! The file is written under a temporary name in the target directory and
 //! renamed at the end, so a failure never leaves half a file behind.
@@ -211,6 +214,8 @@ fn write_solution(file: &hdf5::File, eq: &Equilibrium) -> hdf5::Result<()> {
     vectors(&g, "force", &eq.samples, |p| p.force)?;
     let h = &eq.residual_history;
     array(&g, "residual_history", &[h.len()], h)?;
+    array(&g, "unknowns", &[eq.unknowns.len()], &eq.unknowns)?;
+    usize_attr(&g, "segments", eq.method.segments())?;
     string_attr(&g, "model", eq.model.level.name())?;
     string_attr(&g, "model_reason", &eq.model.reason)?;
     string_attr(&g, "method", eq.method.name())?;
@@ -294,4 +299,49 @@ fn write_critical_load(file: &hdf5::File, c: &CriticalLoad) -> hdf5::Result<()> 
         }
     }
     Ok(())
+}
+
+/// What a solve file keeps to start a continuation from its equilibrium.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SolvedUnknowns {
+    /// The problem text it was solved from.
+    pub problem: String,
+    /// The model level's name (`planar`, `kirchhoff`, `cosserat`).
+    pub model: String,
+    /// The method's name (`shooting`, `multiple-shooting`, `collocation`).
+    pub method: String,
+    /// The shooting unknowns (empty for collocation).
+    pub unknowns: Vec<f64>,
+}
+
+/// The equilibrium's unknowns of a file `cosserat solve` (or
+/// `cosserat stability` on an equilibrium) wrote, its seal checked; an
+/// error names what is missing (a file of another kind, or one written
+/// before solve files kept their unknowns).
+pub fn read_solved(path: &Path) -> hdf5::Result<SolvedUnknowns> {
+    let f = super::seal::open(path)?;
+    let g = f
+        .group("solution")
+        .map_err(|_| hdf5::Error::from("it has no /solution group"))?;
+    let unknowns = g
+        .dataset("unknowns")
+        .map_err(|_| {
+            hdf5::Error::from(
+                "its /solution has no unknowns (written before solve files kept them): solve again",
+            )
+        })?
+        .read_raw::<f64>()?;
+    let read = |loc: &hdf5::Location, name: &str| -> hdf5::Result<String> {
+        Ok(loc
+            .attr(name)?
+            .read_scalar::<VarLenUnicode>()?
+            .as_str()
+            .to_string())
+    };
+    Ok(SolvedUnknowns {
+        problem: read(&f, "problem")?,
+        model: read(&g, "model")?,
+        method: read(&g, "method")?,
+        unknowns,
+    })
 }

@@ -23,10 +23,11 @@ pub use arm_output::{read_search, write_arm, write_arm_study, ArmStudy, SavedSea
 #[cfg(feature = "hdf5")]
 pub use curve::write_curve;
 #[cfg(feature = "hdf5")]
-pub use diagram::{read_saved, write_diagram};
+pub use diagram::{read_saved, write_diagram, write_stages};
 #[cfg(feature = "hdf5")]
 pub use hdf5_output::{
-    check_target, write_equilibrium, write_stability, OutputError, StabilityResult,
+    check_target, read_solved, write_equilibrium, write_stability, OutputError, SolvedUnknowns,
+    StabilityResult,
 };
 #[cfg(feature = "hdf5")]
 pub use sweep_output::{read_sweep, write_sweep, SweepHeader};

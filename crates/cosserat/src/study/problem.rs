@@ -50,4 +50,8 @@ pub struct Problem {
     pub arm_scene: Option<(ArmScene, usize)>,
     /// The grid of a `[sweep]` table.
     pub sweep: Option<Sweep>,
+    /// The keys of the later stages of a chained continuation
+    /// (`[[continuation.stage]]`, stage 2 on; empty for a single run);
+    /// `Problem::stage` reads each stage's problem.
+    pub stage_keys: Vec<String>,
 }

@@ -18,6 +18,7 @@ mod options;
 mod overrides;
 mod rod;
 mod sections;
+mod stages;
 
 use std::path::Path;
 
@@ -168,10 +169,20 @@ impl Problem {
             arm,
             arm_scene,
             sweep,
+            stage_keys: vec![],
         };
         // Before any command allocates: what the sizes ask for must fit.
         super::memory::check(&problem)?;
-        Ok(problem)
+        let count = file.continuation.as_ref().map_or(0, |c| c.stage.len());
+        if count == 0 {
+            return Ok(problem);
+        }
+        let first_key = problem.continuation.as_ref().map(|(f, _)| f.key());
+        let stage_keys = stages::check_stages(&problem, first_key.as_deref(), count, catalog)?;
+        Ok(Problem {
+            stage_keys,
+            ..problem
+        })
     }
 }
 

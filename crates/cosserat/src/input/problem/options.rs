@@ -168,7 +168,10 @@ fn native_base(file: &ProblemFile, rod: &Rod, parameter: Parameter) -> Result<Ro
 }
 
 /// The integral measures need what they integrate: `turning` the planar
-/// angle, `stored_energy` an energy that is all of W (no shear part).
+/// angle, `stored_energy` and `total_potential_energy` an energy that is
+/// all of W (no shear part), the latter a tip whose rotation is either
+/// free (no dead couple then: [`crate::stability::check_conservative`]) or
+/// held (the couple does no work).
 fn check_measures(
     opts: &ContinuationOptions,
     model: &ModelChoice,
@@ -185,12 +188,29 @@ fn check_measures(
             ),
         ));
     }
-    if opts.measures.contains(&Measure::StoredEnergy) && rod.energy().shear_stiffness(0.0).is_some()
-    {
+    let shearable = rod.energy().shear_stiffness(0.0).is_some();
+    for energy in [Measure::StoredEnergy, Measure::TotalPotentialEnergy] {
+        if opts.measures.contains(&energy) && shearable {
+            return Err(invalid(
+                "continuation.measures",
+                format!(
+                    "`{}` integrates W(s, κ); a shearable rod's shear and extension energy is \
+                     not in it",
+                    energy.name()
+                ),
+            ));
+        }
+    }
+    let spins = rod
+        .support()
+        .as_ref()
+        .is_some_and(|s| matches!(s.rotation, crate::model::Freedom::Axial(_)));
+    if opts.measures.contains(&Measure::TotalPotentialEnergy) && spins {
         return Err(invalid(
             "continuation.measures",
-            "`stored_energy` integrates W(s, κ); a shearable rod's shear and extension energy \
-             is not in it",
+            "`total_potential_energy` leaves out the work of a dead tip couple, which is only \
+             right where the tip's rotation is held; this support lets the tip spin about its \
+             axis (support.rotation = \"axial\")",
         ));
     }
     Ok(())
