@@ -339,7 +339,7 @@ fn report(d: &Diagram) {
     for (i, s) in d.special_points.iter().enumerate() {
         println!(
             "special {i}  {} on branch {} at parameter {:.12}, {} block{}, Morse index {}, \
-             multiplicity {}",
+             multiplicity {}, located {}",
             s.kind.name(),
             s.branch,
             s.point.parameter,
@@ -350,7 +350,8 @@ fn report(d: &Diagram) {
                 ""
             },
             s.point.morse_index,
-            s.multiplicity
+            s.multiplicity,
+            s.location.name()
         );
     }
 }
