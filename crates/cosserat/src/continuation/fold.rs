@@ -21,13 +21,19 @@
 //! difference along v gives the whole row g_x (F_xx is symmetric in its
 //! two arguments), one in p gives g_p. These steer Newton only; the
 //! equations it solves, and so the located fold, are exact to the
-//! corrector's tolerance. Dense: used up to
-//! [`super::corrector::DENSE_UP_TO`] unknowns.
+//! corrector's tolerance. Dense, once per fold: used up to
+//! [`FOLD_DENSE_UP_TO`] unknowns (multiple shooting and collocation
+//! included); beyond, the bracketed root is kept and the record says so.
 
 use nalgebra::{DMatrix, DVector};
 
-use super::slice::smallest_pair;
 use super::Run;
+
+/// The most unknowns of a fold located on the augmented system: each
+/// iteration factors five dense F_x-sized matrices (F_x, its transpose and
+/// the difference quotients' evaluations) and the (n + 1)² system — about
+/// 0.1 s at 1000 unknowns, once per fold.
+pub(super) const FOLD_DENSE_UP_TO: usize = 1000;
 
 /// Newton iterations before the augmented system is given up.
 const MAX_ITERATIONS: usize = 12;
@@ -58,6 +64,15 @@ fn bordered(
     Some((sol[n], sol.rows(0, n).into_owned()))
 }
 
+/// The right and left singular vectors of F_x's smallest singular value.
+fn smallest_singular_pair(fx: &DMatrix<f64>) -> Option<(DVector<f64>, DVector<f64>)> {
+    let svd = fx.clone().svd(true, true);
+    let (k, _) = svd.singular_values.argmin();
+    let right = svd.v_t.as_ref()?.row(k).transpose();
+    let left = svd.u.as_ref()?.column(k).into_owned();
+    Some((right, left))
+}
+
 impl Run<'_> {
     /// The fold near the bracketed point (x₀, p₀), by Newton on the
     /// minimally augmented system; `radius` bounds how far (in z) Newton
@@ -67,14 +82,13 @@ impl Run<'_> {
     /// the event tolerance relative to max(|p|, 1). Err says why not.
     pub(super) fn refine_fold(&self, x0: &[f64], p0: f64, radius: f64) -> Result<Fold, String> {
         let n = x0.len();
-        if n > super::corrector::DENSE_UP_TO {
+        if n > FOLD_DENSE_UP_TO {
             return Err(format!(
-                "{n} unknowns: the augmented system is solved dense up to {}",
-                super::corrector::DENSE_UP_TO
+                "{n} unknowns: the augmented system is solved dense up to {FOLD_DENSE_UP_TO}"
             ));
         }
         let fx0 = self.dense_jacobian(x0, p0).map_err(|e| e.to_string())?.1;
-        let (c, b, _) = smallest_pair(&fx0).ok_or("F_x has no singular pair")?;
+        let (c, b) = smallest_singular_pair(&fx0).ok_or("F_x has no singular pair")?;
         let mut z = DVector::from_iterator(n + 1, x0.iter().copied().chain([p0]));
         let start = z.clone();
         for iteration in 1..=MAX_ITERATIONS {

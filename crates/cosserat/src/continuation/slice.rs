@@ -35,7 +35,7 @@ pub(super) fn persistent_kernel(fx: &DMatrix<f64>) -> Option<(DVector<f64>, DVec
 
 /// The right and left singular vectors of F_x's smallest singular value,
 /// and that value over the largest (dense systems only).
-pub(super) fn smallest_pair(fx: &DMatrix<f64>) -> Option<(DVector<f64>, DVector<f64>, f64)> {
+fn smallest_pair(fx: &DMatrix<f64>) -> Option<(DVector<f64>, DVector<f64>, f64)> {
     if fx.nrows() > super::corrector::DENSE_UP_TO {
         return None;
     }
