@@ -29,8 +29,9 @@
 //! quadratic in q. Along the loaded branch k passes π (the symmetric
 //! buckling thrust of the clamped span, where both roots meet at q = π²/2)
 //! and the fold is the maximum of the larger root over k > π: q* = 7.41543
-//! at k = 4.263. The inextensible limit: the extensible shallow arch (Pi &
-//! Bradford 2002) tends to it as its modified slenderness grows.
+//! at k = 4.263. This is the inextensible theory (the axial stiffness
+//! infinite), as the rod model is; the extensible shallow-arch closed forms
+//! (Pi & Bradford 2002) are not compared here.
 
 use nalgebra::{Matrix3, Vector3};
 
