@@ -10,7 +10,7 @@
 
 use cosserat::continuation::{continuation, Diagram, Location, SpecialKind};
 use cosserat::input::Problem;
-use cosserat::references::{arch_elastica_folds, shallow_arch_fold};
+use cosserat::references::{arch_elastica_folds, shallow_arch_fold, strip_elastica_fold};
 
 const ARCH: &str = include_str!("../../../problems/shallow_arch_snap.toml");
 
@@ -162,4 +162,40 @@ fn collocation_folds_are_located_on_the_augmented_system() {
         assert_eq!(*location, Location::Augmented);
         assert!((p - exact).abs() <= 1e-10 * exact, "{p} vs {exact}");
     }
+}
+
+/// The inverted buckled strip (problems/bistable_strip_snap.toml) snaps
+/// when its clamps are turned up by the elastica's fold angle, located on
+/// the augmented system to 1e-10 relative (measured 3e-13); the start is
+/// the inverted state (the crown below the clamps) and stable.
+#[test]
+fn buckled_strip_snaps_at_the_elastica_fold_angle() {
+    const STRIP: &str = include_str!("../../../problems/bistable_strip_snap.toml");
+    let (exact, correction) = strip_elastica_fold(0.9).unwrap();
+    assert!(correction < 1e-10, "Richardson correction {correction:e}");
+    let d = diagram(&Problem::from_str_with(STRIP, &[]).unwrap());
+    assert!(d.warnings.is_empty(), "{:?}", d.warnings);
+    let start = &d.branches[0].points[0];
+    assert!(
+        start.measures[0] > 0.1,
+        "inverted: crown {}",
+        start.measures[0]
+    );
+    assert!(start.stable);
+    let found: Vec<_> = d
+        .special_points
+        .iter()
+        .filter(|s| s.kind == SpecialKind::Fold)
+        .collect();
+    assert_eq!(found.len(), 1, "one fold");
+    assert_eq!(found[0].location, Location::Augmented);
+    // clamp.angle turns the tangent towards d1 (down): −α raises it.
+    let alpha = -found[0].point.parameter;
+    let error = (alpha - exact).abs() / exact;
+    eprintln!("fold α {alpha:.14} vs elastica {exact:.14}: relative {error:.1e}");
+    assert!(error <= 1e-10, "α {alpha} vs {exact}");
+    assert!(
+        (exact - 0.643_051_6).abs() < 1e-7,
+        "the file's comment: {exact}"
+    );
 }

@@ -1,7 +1,10 @@
-//! The snap-through of a shallow circular arch under a central point load
-//! (problems/shallow_arch_snap.toml): the left half of a clamped arch of
-//! half-angle Θ, its crown a guided clamp carrying half the load Q = P/2;
-//! B = ℓ = 1. Two references, neither calling the solvers under test.
+//! Snap-through of symmetric clamped rods posed on their left half, the
+//! crown a guided clamp; B = ℓ = 1. The shallow circular arch under a
+//! central point load (problems/shallow_arch_snap.toml: half-angle Θ, half
+//! the load Q = P/2 on the crown) and the inverted buckled strip whose
+//! clamps are turned (problems/bistable_strip_snap.toml: the clamp angle α
+//! the parameter, no load). Two references, neither calling the solvers
+//! under test.
 //!
 //! **The planar elastica by shooting** ([`arch_elastica_folds`]): θ the
 //! tangent's angle above the horizontal, m the bending moment, H the
@@ -13,7 +16,9 @@
 //! crown height y is the control: (m(0), H, Q) by Newton with the
 //! sensitivities integrated alongside (RK4 on the augmented system, so
 //! the Jacobian is exact for the discrete map), and the folds of Q are the
-//! roots of dQ/dy = (J⁻¹ e₃)_Q, by Illinois in y. Two step counts and
+//! roots of dQ/dy = (J⁻¹ e₃)_Q, by Illinois in y. For the strip Θ = 0,
+//! Q = 0 and the third unknown is θ(0) = α instead of Q
+//! ([`strip_elastica_fold`]). Two step counts and
 //! Richardson's extrapolation (RK4: error ∝ h⁴) give the folds to about
 //! 1e-13.
 //!
@@ -35,25 +40,48 @@
 
 use nalgebra::{Matrix3, Vector3};
 
-/// The state (θ, m, X, Y) and its sensitivities to (m(0), H, Q), row
+/// The state (θ, m, X, Y) and its sensitivities to (m(0), H, p), row
 /// after row: 4 + 4 × 3 numbers.
 type State = [f64; 16];
 
-/// The planar elastica of the half arch, integrated by RK4 in `steps`
-/// equal steps.
-struct HalfArch {
-    theta: f64,
+/// The third unknown p of the shooting, beside m(0) and H: the parameter
+/// whose folds are sought.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Third {
+    /// The crown load Q (the clamp angle fixed).
+    Load,
+    /// The clamp angle θ(0) (no load).
+    ClampAngle,
+}
+
+/// The planar elastica of a half rod — the left half of a symmetric
+/// clamped rod, its crown a guided clamp at X = `span` — integrated by RK4
+/// in `steps` equal steps: θ' = −`curvature` + m, θ(0) = `angle` or p.
+struct HalfRod {
+    curvature: f64,
+    angle: f64,
+    span: f64,
+    third: Third,
     steps: usize,
 }
 
-impl HalfArch {
+impl HalfRod {
+    /// (Q, θ(0)) for the third unknown p.
+    fn load_and_angle(&self, p: f64) -> (f64, f64) {
+        match self.third {
+            Third::Load => (p, self.angle),
+            Third::ClampAngle => (0.0, p),
+        }
+    }
+
     fn rhs(&self, u: &State, h: f64, q: f64) -> State {
         let (c, s) = (u[0].cos(), u[0].sin());
         let mut d = [0.0; 16];
-        d[..4].copy_from_slice(&[-self.theta + u[1], q * c + h * s, c, s]);
+        d[..4].copy_from_slice(&[-self.curvature + u[1], q * c + h * s, c, s]);
+        let dq = if self.third == Third::Load { c } else { 0.0 };
         for j in 0..3 {
             let (dth, dm) = (u[4 + j], u[7 + j]);
-            let explicit = [0.0, s, c][j]; // ∂m'/∂(m(0), H, Q)
+            let explicit = [0.0, s, dq][j]; // ∂m'/∂(m(0), H, p)
             d[4 + j] = dm;
             d[7 + j] = (-q * s + h * c) * dth + explicit;
             d[10 + j] = -s * dth;
@@ -62,11 +90,15 @@ impl HalfArch {
         d
     }
 
-    fn shoot(&self, [m0, h, q]: [f64; 3]) -> State {
+    fn shoot(&self, [m0, h, p]: [f64; 3]) -> State {
+        let (q, angle) = self.load_and_angle(p);
         let mut u = [0.0; 16];
-        u[0] = self.theta;
+        u[0] = angle;
         u[1] = m0;
         u[7] = 1.0;
+        if self.third == Third::ClampAngle {
+            u[6] = 1.0;
+        }
         let dt = 1.0 / self.steps as f64;
         let add =
             |u: &State, k: &State, a: f64| -> State { std::array::from_fn(|i| u[i] + a * k[i]) };
@@ -82,18 +114,17 @@ impl HalfArch {
         u
     }
 
-    /// The end conditions (θ(1), X(1) − sin Θ/Θ, Y(1) − y) and their
-    /// Jacobian in (m(0), H, Q).
+    /// The end conditions (θ(1), X(1) − span, Y(1) − y) and their Jacobian
+    /// in (m(0), H, p).
     fn conditions(&self, z: [f64; 3], y: f64) -> (Vector3<f64>, Matrix3<f64>) {
         let u = self.shoot(z);
-        let span = self.theta.sin() / self.theta;
-        let g = Vector3::new(u[0], u[2] - span, u[3] - y);
+        let g = Vector3::new(u[0], u[2] - self.span, u[3] - y);
         let jacobian = Matrix3::from_fn(|r, c| u[4 + 3 * [0, 2, 3][r] + c]);
         (g, jacobian)
     }
 
-    /// (m(0), H, Q) with the crown at height y, by Newton from `guess`, and
-    /// dQ/dy there; None where Newton does not converge to 1e-12.
+    /// (m(0), H, p) with the crown at height y, by Newton from `guess`, and
+    /// dp/dy there; None where Newton does not converge to 1e-12.
     fn solve(&self, y: f64, guess: [f64; 3]) -> Option<([f64; 3], f64)> {
         let mut z = guess;
         for _ in 0..40 {
@@ -109,37 +140,37 @@ impl HalfArch {
         (g.amax() < 1e-12).then_some((z, dz[2]))
     }
 
-    /// Q at the first two folds of the loaded branch (the snap and the
-    /// restabilization), the crown going down from its unloaded height:
-    /// the sign changes of dQ/dy on a grid of steps of a twentieth of the
-    /// rise, each located by Illinois to 1e-13 in y.
-    fn folds(&self) -> Option<[f64; 2]> {
-        let rise = (1.0 - self.theta.cos()) / self.theta;
+    /// p at the first `count` folds met as the crown height goes from `y`
+    /// (solved from `guess`) by steps `dy` through at most 40 steps: the sign
+    /// changes of dp/dy, each located by Illinois to 1e-13 in y.
+    fn folds(&self, (mut y, guess): (f64, [f64; 3]), dy: f64, count: usize) -> Option<Vec<f64>> {
         let mut found = vec![];
-        let (mut y, mut z) = (rise, [0.0; 3]);
-        let (_, mut slope) = self.solve(y, z)?;
-        while y > -rise && found.len() < 2 {
-            let next = y - rise / 20.0;
+        let (mut z, mut slope) = self.solve(y, guess)?;
+        for _ in 0..40 {
+            if found.len() == count {
+                return Some(found);
+            }
+            let next = y + dy;
             let (zn, sn) = self.solve(next, z)?;
             if sn * slope < 0.0 {
                 found.push(self.fold_between((y, slope, z), (next, sn))?);
             }
             (y, z, slope) = (next, zn, sn);
         }
-        found.try_into().ok()
+        (found.len() == count).then_some(found)
     }
 
-    /// Illinois on dQ/dy between y = lo and y = hi; Q at the root.
+    /// Illinois on dp/dy between y = lo and y = hi; p at the root.
     fn fold_between(
         &self,
         (mut lo, mut f_lo, z): (f64, f64, [f64; 3]),
         (mut hi, mut f_hi): (f64, f64),
     ) -> Option<f64> {
-        let mut q = f64::NAN;
+        let mut p = f64::NAN;
         for _ in 0..100 {
             let mid = hi - f_hi * (hi - lo) / (f_hi - f_lo);
             let (zm, fm) = self.solve(mid, z)?;
-            q = zm[2];
+            p = zm[2];
             if fm * f_hi < 0.0 {
                 (lo, f_lo) = (hi, f_hi);
             } else {
@@ -150,8 +181,25 @@ impl HalfArch {
                 break;
             }
         }
-        Some(q)
+        Some(p)
     }
+}
+
+/// Richardson's extrapolation of `folds` from 400 and 800 RK4 steps: the
+/// values and the larger correction.
+fn extrapolated(folds: impl Fn(usize) -> Option<Vec<f64>>) -> Option<(Vec<f64>, f64)> {
+    let (coarse, fine) = (folds(400)?, folds(800)?);
+    let values = coarse
+        .iter()
+        .zip(&fine)
+        .map(|(c, f)| f + (f - c) / 15.0)
+        .collect();
+    let correction = coarse
+        .iter()
+        .zip(&fine)
+        .map(|(c, f)| (f - c).abs() / 15.0)
+        .fold(0.0, f64::max);
+    Some((values, correction))
 }
 
 /// The two folds of the half arch's elastica, Q = P/2 in units of B/ℓ²
@@ -166,16 +214,53 @@ pub struct ArchFolds {
     pub correction: f64,
 }
 
-/// The folds of the half arch of half-angle Θ (rad, 0 < Θ < π/2); None
-/// where the shooting does not converge.
+/// The folds of the half arch of half-angle Θ (rad, 0 < Θ < π/2), the
+/// crown going down from its unloaded height by twentieths of the rise;
+/// None where the shooting does not converge.
 pub fn arch_elastica_folds(theta: f64) -> Option<ArchFolds> {
-    let coarse = HalfArch { theta, steps: 400 }.folds()?;
-    let fine = HalfArch { theta, steps: 800 }.folds()?;
-    let loads = std::array::from_fn(|i| fine[i] + (fine[i] - coarse[i]) / 15.0);
-    let correction = (0..2)
-        .map(|i| (fine[i] - coarse[i]).abs() / 15.0)
-        .fold(0.0, f64::max);
-    Some(ArchFolds { loads, correction })
+    let rise = (1.0 - theta.cos()) / theta;
+    let (loads, correction) = extrapolated(|steps| {
+        let arch = HalfRod {
+            curvature: theta,
+            angle: theta,
+            span: theta.sin() / theta,
+            third: Third::Load,
+            steps,
+        };
+        arch.folds((rise, [0.0; 3]), -rise / 20.0, 2)
+    })?;
+    Some(ArchFolds {
+        loads: [loads[0], loads[1]],
+        correction,
+    })
+}
+
+/// The fold of the inverted buckled strip under clamp rotation
+/// (problems/bistable_strip_snap.toml): the left half of a straight strip
+/// of length 2, clamped at both ends `2 span` apart and buckled downwards;
+/// both clamps turned upwards by α (mirror-symmetric), the crown a guided
+/// clamp. Returns (α at the fold, the Richardson correction). The scan
+/// starts at α ≈ 0 from the shallow buckled shape w = (A/2)(1 − cos πs),
+/// A = 4√(1 − span)/π (Newton then lands on the elastica), and raises the
+/// crown by steps of A/20.
+pub fn strip_elastica_fold(span: f64) -> Option<(f64, f64)> {
+    let depth = 4.0 * (1.0 - span).sqrt() / std::f64::consts::PI;
+    let guess = [
+        -depth * std::f64::consts::PI.powi(2) / 2.0,
+        -std::f64::consts::PI.powi(2),
+        0.0,
+    ];
+    let (angles, correction) = extrapolated(|steps| {
+        let strip = HalfRod {
+            curvature: 0.0,
+            angle: 0.0,
+            span,
+            third: Third::ClampAngle,
+            steps,
+        };
+        strip.folds((-depth, guess), depth / 20.0, 1)
+    })?;
+    Some((angles[0], correction))
 }
 
 /// The larger root q(k) of the shallow arch's constraint, its integrals by
