@@ -375,7 +375,7 @@ pub(crate) fn report(d: &Diagram) {
     for (i, s) in d.special_points.iter().enumerate() {
         println!(
             "special {i}  {} on branch {} at parameter {:.12}, {} block{}, Morse index {}, \
-             multiplicity {}",
+             multiplicity {}, located {}",
             s.kind.name(),
             s.branch,
             s.point.parameter,
@@ -386,7 +386,8 @@ pub(crate) fn report(d: &Diagram) {
                 ""
             },
             s.point.morse_index,
-            s.multiplicity
+            s.multiplicity,
+            s.location.name()
         );
     }
 }

@@ -35,7 +35,10 @@ fn greenhill_diagram_reports_a_double_branch_point() {
         .find(|l| l.starts_with("special 0"))
         .unwrap_or_else(|| panic!("no special point: {stdout}"));
     assert!(line.contains("branch_point"), "{line}");
-    assert!(line.ends_with("multiplicity 2"), "{line}");
+    assert!(
+        line.ends_with("multiplicity 2, located bracketed"),
+        "{line}"
+    );
     let printed: f64 = line
         .split("at parameter ")
         .nth(1)

@@ -5,12 +5,18 @@
 //! Elliptic integrals: Carlson's symmetric forms R_F, R_D by the
 //! duplication algorithm (DLMF 19.36.i; Carlson, Numer. Algorithms 10,
 //! 1995), Legendre's F, E through DLMF 19.25.5 and 19.25.9. Bessel zeros:
-//! bisection on the power series of J_ν (DLMF 10.2.2).
+//! bisection on the power series of J_ν (DLMF 10.2.2). The snap-through of
+//! the shallow arch and of the buckled strip (`arch`): an independent
+//! shooting of the planar elastica, and the inextensible shallow-arch
+//! limit.
 
 use std::collections::BTreeMap;
 use std::f64::consts::{FRAC_1_SQRT_2, FRAC_PI_2, PI};
 
 use crate::numerics::scalar::bisect;
+
+mod arch;
+pub use arch::{arch_elastica_folds, shallow_arch_fold, strip_elastica_fold, ArchFolds};
 
 /// Carlson's R_F(x, y, z).
 pub fn carlson_rf(x: f64, y: f64, z: f64) -> f64 {

@@ -87,3 +87,22 @@ fn clamped_elastica_reference_starts_at_euler_with_its_slope() {
     }
     assert!(clamped_elastica_load(0.2) > clamped_elastica_load(0.1));
 }
+
+/// The shallow arch's references agree with each other where both hold:
+/// the elastica's fold over Θ approaches the inextensible shallow-arch
+/// limit as Θ → 0 (within 1e-3 at Θ = 0.02, where the O(Θ²) gap is 1e-4),
+/// and the Richardson correction of the elastica is far below 1e-10.
+#[test]
+fn arch_elastica_tends_to_the_shallow_arch_limit() {
+    let limit = cosserat::references::shallow_arch_fold();
+    assert!((limit - 7.415_43).abs() < 1e-5, "{limit}");
+    let theta = 0.02;
+    let folds = cosserat::references::arch_elastica_folds(theta).unwrap();
+    assert!(folds.correction < 1e-11, "{}", folds.correction);
+    let q = folds.loads[0] / theta;
+    assert!((q - limit).abs() < 1e-3 * limit, "{q} vs {limit}");
+    assert!(
+        folds.loads[1] < folds.loads[0],
+        "the restabilization below the snap"
+    );
+}

@@ -54,6 +54,29 @@ impl SpecialKind {
     }
 }
 
+/// How a special point was located.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Location {
+    /// Newton on Govaerts' minimally augmented system (F, g) = 0
+    /// converged (folds; docs/methods.md): exact to the corrector's
+    /// tolerance.
+    Augmented,
+    /// The root of the test function bracketed in the arclength (Illinois
+    /// regula falsi): every branch point, and a fold whose augmented
+    /// Newton failed — the diagram's warnings say why.
+    Bracketed,
+}
+
+impl Location {
+    /// The name in output files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Location::Augmented => "augmented",
+            Location::Bracketed => "bracketed",
+        }
+    }
+}
+
 /// A located fold or branch point.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SpecialPoint {
@@ -83,6 +106,8 @@ pub struct SpecialPoint {
     /// bending modes of an isotropic rod, B1 = B2, whose kernel is a
     /// plane).
     pub multiplicity: usize,
+    /// How it was located.
+    pub location: Location,
 }
 
 /// A followed branch.

@@ -1,6 +1,8 @@
 //! Folds and branch points between two points of a branch: detection,
 //! location by regula falsi (Illinois) in the arclength on a test function
-//! with a simple root, classification, and branch switching.
+//! with a simple root — for a fold then refined by Newton on Govaerts'
+//! minimally augmented system (`fold.rs`) —, classification, and branch
+//! switching.
 //!
 //! A fold is decided by the tangent's parameter component τ_p changing
 //! sign, always, whatever the eigenvalues do; a branch point by a change
@@ -25,7 +27,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::{Point, Run, SpecialKind, SpecialPoint};
+use super::{Location, Point, Run, SpecialKind, SpecialPoint};
 use crate::model::ModelLevel;
 use crate::numerics::scalar::{End, Illinois};
 use crate::numerics::staircase::StaircaseLu;
@@ -70,7 +72,14 @@ impl Run<'_> {
         let (wanted, mut missed) = self.detect(a, b, branch, index);
         let mut found = vec![];
         for (kind, block, multiplicity) in wanted {
-            let located = self.locate(a, b, sign, (branch, index), (kind, block, multiplicity));
+            let located = if kind == SpecialKind::Fold {
+                let (located, note) =
+                    self.locate_fold(a, b, sign, (branch, index), (kind, block, multiplicity));
+                missed.extend(note);
+                located
+            } else {
+                self.locate(a, b, sign, (branch, index), (kind, block, multiplicity))
+            };
             match located.len() {
                 0 => missed.push(format!(
                     "branch {branch}: a {} ({} block, Morse index {} → {}, multiplicity \
@@ -294,10 +303,66 @@ impl Run<'_> {
             sign,
             best,
             (branch, index),
-            (kind, block, multiplicity),
+            ((kind, block, multiplicity), Location::Bracketed),
         )
         .into_iter()
         .collect()
+    }
+
+    /// Locates the fold between `a` and `b`: the root of τ_p bracketed by
+    /// Illinois in the arclength, then refined by Newton on the minimally
+    /// augmented system (`fold.rs`). Where Newton fails the bracketed root
+    /// is kept, recorded as [`Location::Bracketed`], with a note saying why;
+    /// on a branch of symmetric copies (`slice.rs`) it is not tried.
+    fn locate_fold(
+        &self,
+        a: &Point,
+        b: &Point,
+        sign: f64,
+        (branch, index): (usize, usize),
+        wanted: Wanted,
+    ) -> (Vec<SpecialPoint>, Option<String>) {
+        let span = span_of(a, b, sign);
+        let Some((_, best)) = self.root(a, (sign, b.parameter), (0.0, span), &Test::Fold) else {
+            return (vec![], None);
+        };
+        // On a branch of symmetric copies F_x keeps the copies' null vector,
+        // so its kernel at a fold is two-dimensional and the one-bordered
+        // system singular: the fold is the bracketed root, and its record
+        // says so.
+        if self.sliced {
+            let point = self.special_point(
+                a,
+                b,
+                sign,
+                best,
+                (branch, index),
+                (wanted, Location::Bracketed),
+            );
+            return (point.into_iter().collect(), None);
+        }
+        let radius = span.abs().max(distance(a, b));
+        let refined = self
+            .refine_fold(&best.1, best.2, radius)
+            .and_then(|(x, p, _)| {
+                let t = self.tangent(&x, p, &best.3).map_err(|e| e.to_string())?;
+                Ok((0.0, x, p, t))
+            });
+        let (located, location, note) = match refined {
+            Ok(fold) => (fold, Location::Augmented, None),
+            Err(why) => {
+                let note = format!(
+                    "branch {branch}: the fold between points {index} and {} is located only as \
+                     the bracketed root of τ_p, at parameter {:.12}: the minimally augmented \
+                     Newton failed: {why}",
+                    index + 1,
+                    best.2
+                );
+                (best, Location::Bracketed, Some(note))
+            }
+        };
+        let point = self.special_point(a, b, sign, located, (branch, index), (wanted, location));
+        (point.into_iter().collect(), note)
     }
 
     /// Whether the whole of G vanishes at the located point (relative to
@@ -357,7 +422,7 @@ impl Run<'_> {
                 continue;
             };
             let wanted = (SpecialKind::BranchPoint, block, 1);
-            found.extend(self.special_point(a, b, sign, root, at, wanted));
+            found.extend(self.special_point(a, b, sign, root, at, (wanted, Location::Bracketed)));
         }
         found
     }
@@ -405,7 +470,7 @@ impl Run<'_> {
         sign: f64,
         (_, x, p, tangent): Located,
         (branch, index): (usize, usize),
-        (kind, block, multiplicity): Wanted,
+        ((kind, block, multiplicity), location): (Wanted, Location),
     ) -> Option<SpecialPoint> {
         let stored: Vec<f64> = tangent.iter().map(|v| v * sign).collect();
         let (eigenvalue, null_mode) = self.tracker.nearest_zero(self.family, &x, p, block).ok()?;
@@ -432,6 +497,7 @@ impl Run<'_> {
             children: vec![],
             singularity: ((det_here / det_scale).abs(), eigenvalue),
             multiplicity,
+            location,
         })
     }
 
@@ -578,6 +644,17 @@ fn span_of(a: &Point, b: &Point, sign: f64) -> f64 {
             sign * a.tangent[i] * (zb - za)
         })
         .sum()
+}
+
+/// The Euclidean distance between two points in z = (x, p).
+fn distance(a: &Point, b: &Point) -> f64 {
+    let dx: f64 = a
+        .unknowns
+        .iter()
+        .zip(&b.unknowns)
+        .map(|(u, v)| (u - v).powi(2))
+        .sum();
+    (dx + (a.parameter - b.parameter).powi(2)).sqrt()
 }
 
 /// Out-of-plane modes of a planar branch, and bending modes of a straight

@@ -8,7 +8,8 @@
 //! position), its Morse index and a stable flag. Events between two points:
 //! a **fold** where the parameter component of the tangent changes sign; a
 //! **branch point** where the Morse index of a block changes without a
-//! fold. Folds are located where τ_p = 0; branch points where det F_x = 0
+//! fold. Folds are bracketed where τ_p changes sign and located on
+//! Govaerts' minimally augmented system (`fold`); branch points where det F_x = 0
 //! when the model can represent the bifurcating mode (exact to the
 //! integration tolerance), else where the tracked eigenvalue vanishes
 //! (accurate to the finite-element mesh). Branch switching follows the
@@ -29,6 +30,7 @@ mod diagram;
 mod driver;
 mod events;
 mod family;
+mod fold;
 mod landing;
 mod lens;
 mod measure;
@@ -41,7 +43,9 @@ mod status;
 mod tracking;
 
 pub use codim2::{follow_singular, CurveOptions, CurvePoint, Lens2, ParameterOn, SingularCurve};
-pub use diagram::{Branch, ContinuationError, Diagram, Point, Progress, SpecialKind, SpecialPoint};
+pub use diagram::{
+    Branch, ContinuationError, Diagram, Location, Point, Progress, SpecialKind, SpecialPoint,
+};
 pub use driver::continuation;
 pub use family::{tip_angle, Family, FamilyError, PointError};
 pub use lens::{Lens, Parameter, RodLens};

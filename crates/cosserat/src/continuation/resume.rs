@@ -54,6 +54,8 @@ pub struct SavedSpecial {
     pub singularity: (f64, f64),
     /// Eigenvalues crossing zero there ([`SpecialPoint::multiplicity`]).
     pub multiplicity: usize,
+    /// How it was located ([`SpecialPoint::location`]).
+    pub location: super::Location,
     /// Parameter.
     pub parameter: f64,
     /// Unknowns.
@@ -268,5 +270,6 @@ pub(super) fn rebuild_special(
         children: vec![],
         singularity: s.singularity,
         multiplicity: s.multiplicity,
+        location: s.location,
     })
 }

@@ -14,7 +14,10 @@
 //! `/special_points/kind` (strings), `branch`, `index`,
 //! `parameter`, `tip_position` (s×3), `measures` (s×k), `block`, `symmetry_breaking`,
 //! `null_vectors` (s×nodes×3), `singularity` (s×2), `multiplicity` (s:
-//! eigenvalues crossing zero; absent in older files, read as 1); `/warnings` (events
+//! eigenvalues crossing zero; absent in older files, read as 1), `location` (s strings:
+//! `augmented` — a fold on the minimally augmented system —, `bracketed` —
+//! the root of a test function by regula falsi; absent in older files, read
+//! as `bracketed`); `/warnings` (events
 //! detected but not located, as text); the problem text as the
 //! root attribute `problem`, the run's `stop_reason` and the parameter name
 //! as root attributes (the first stage's parameter for a chained run, whose
@@ -26,8 +29,8 @@ use hdf5::types::VarLenUnicode;
 
 use super::hdf5_output::{array, string_attr, text, write_atomically, OutputError};
 use crate::continuation::{
-    stage_of, BranchEnd, Diagram, RunState, SavedBranch, SavedDiagram, SavedSpecial, SpecialKind,
-    Stage,
+    stage_of, BranchEnd, Diagram, Location, RunState, SavedBranch, SavedDiagram, SavedSpecial,
+    SpecialKind, Stage,
 };
 use crate::stability::Block;
 
@@ -242,6 +245,11 @@ fn write_special_points(file: &hdf5::File, d: &Diagram) -> hdf5::Result<()> {
         "multiplicity",
         &sp.iter().map(|s| s.multiplicity as u64).collect::<Vec<_>>(),
     )?;
+    strings(
+        &g,
+        "location",
+        &sp.iter().map(|s| s.location.name()).collect::<Vec<_>>(),
+    )?;
     let nodes = d.nodes.len();
     let null: Vec<f64> = sp
         .iter()
@@ -280,6 +288,22 @@ fn read_string(loc: &hdf5::Location, name: &str) -> hdf5::Result<String> {
         .read_scalar::<VarLenUnicode>()?
         .as_str()
         .to_string())
+}
+
+/// How each of `count` special points was located; files written before
+/// fold location by the augmented system hold bracketed roots only.
+fn locations(g: &hdf5::Group, count: usize) -> hdf5::Result<Vec<Location>> {
+    let Ok(ds) = g.dataset("location") else {
+        return Ok(vec![Location::Bracketed; count]);
+    };
+    ds.read_raw::<VarLenUnicode>()?
+        .iter()
+        .map(|v| match v.as_str() {
+            "augmented" => Ok(Location::Augmented),
+            "bracketed" => Ok(Location::Bracketed),
+            other => Err(format!("unknown location `{other}`").as_str().into()),
+        })
+        .collect()
 }
 
 /// The problem text and what a diagram file keeps of its run (for
@@ -322,6 +346,7 @@ pub fn read_saved(path: &Path) -> hdf5::Result<(String, SavedDiagram)> {
         Ok(ds) => ds.read_raw::<u64>()?,
         Err(_) => vec![1; kinds.len()],
     };
+    let location = locations(&g, kinds.len())?;
     let (x, t) = (rows(&g, "unknowns")?, rows(&g, "tangent")?);
     let count = kinds.len();
     let lengths = [
@@ -332,6 +357,7 @@ pub fn read_saved(path: &Path) -> hdf5::Result<(String, SavedDiagram)> {
         parameter.len(),
         sing.len(),
         multiplicity.len(),
+        location.len(),
         x.len(),
         t.len(),
     ];
@@ -360,6 +386,7 @@ pub fn read_saved(path: &Path) -> hdf5::Result<(String, SavedDiagram)> {
             symmetry_breaking: sym[i] == 1,
             singularity: (sing[i][0], sing[i][1]),
             multiplicity: multiplicity[i] as usize,
+            location: location[i],
             parameter: parameter[i],
             unknowns: x[i].clone(),
             tangent: t[i].clone(),
