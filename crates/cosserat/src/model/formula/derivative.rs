@@ -85,20 +85,7 @@ impl Derivatives {
 }
 
 fn nodes(e: &Expr) -> usize {
-    1 + match e {
-        Expr::Constant(_) | Expr::Variable(_) => 0,
-        Expr::Negate(a) | Expr::PowInteger(a, _) | Expr::PowReal(a, _) | Expr::Apply(_, a) => {
-            nodes(a)
-        }
-        Expr::Add(a, b)
-        | Expr::Subtract(a, b)
-        | Expr::Multiply(a, b)
-        | Expr::Divide(a, b)
-        | Expr::Power(a, b)
-        | Expr::Min(a, b)
-        | Expr::Max(a, b) => nodes(a) + nodes(b),
-        Expr::Less(p) => p.iter().map(nodes).sum(),
-    }
+    1 + e.children().into_iter().map(nodes).sum::<usize>()
 }
 
 fn var(slot: usize) -> Expr {

@@ -211,21 +211,11 @@ fn call(
 
 /// Folds a node whose operands are constants into a constant.
 fn fold(expr: Expr) -> Expr {
-    let constant = |e: &Expr| matches!(e, Expr::Constant(_));
-    let foldable = match &expr {
-        Expr::Constant(_) | Expr::Variable(_) => false,
-        Expr::Negate(a) | Expr::PowInteger(a, _) | Expr::PowReal(a, _) | Expr::Apply(_, a) => {
-            constant(a)
-        }
-        Expr::Add(a, b)
-        | Expr::Subtract(a, b)
-        | Expr::Multiply(a, b)
-        | Expr::Divide(a, b)
-        | Expr::Power(a, b)
-        | Expr::Min(a, b)
-        | Expr::Max(a, b) => constant(a) && constant(b),
-        Expr::Less(parts) => parts.iter().all(constant),
-    };
+    let foldable = !matches!(expr, Expr::Constant(_) | Expr::Variable(_))
+        && expr
+            .children()
+            .iter()
+            .all(|c| matches!(c, Expr::Constant(_)));
     if foldable {
         Expr::Constant(expr.eval::<f64>(&[]))
     } else {
@@ -277,13 +267,12 @@ impl Expr {
         }
     }
 
-    /// Whether the tree reads slot `i`.
-    pub(super) fn reads(&self, i: usize) -> bool {
+    /// The operands of this node.
+    pub(super) fn children(&self) -> Vec<&Expr> {
         match self {
-            Expr::Constant(_) => false,
-            Expr::Variable(j) => *j == i,
+            Expr::Constant(_) | Expr::Variable(_) => vec![],
             Expr::Negate(a) | Expr::PowInteger(a, _) | Expr::PowReal(a, _) | Expr::Apply(_, a) => {
-                a.reads(i)
+                vec![a]
             }
             Expr::Add(a, b)
             | Expr::Subtract(a, b)
@@ -291,8 +280,16 @@ impl Expr {
             | Expr::Divide(a, b)
             | Expr::Power(a, b)
             | Expr::Min(a, b)
-            | Expr::Max(a, b) => a.reads(i) || b.reads(i),
-            Expr::Less(parts) => parts.iter().any(|p| p.reads(i)),
+            | Expr::Max(a, b) => vec![a, b],
+            Expr::Less(parts) => parts.iter().collect(),
+        }
+    }
+
+    /// Whether the tree reads slot `i`.
+    pub(super) fn reads(&self, i: usize) -> bool {
+        match self {
+            Expr::Variable(j) => *j == i,
+            _ => self.children().iter().any(|c| c.reads(i)),
         }
     }
 
