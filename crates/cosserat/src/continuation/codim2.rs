@@ -164,18 +164,7 @@ impl Augmented<'_> {
         b: &DVector<f64>,
         c: &DVector<f64>,
     ) -> Option<(f64, DVector<f64>)> {
-        let n = fx.nrows();
-        let mut m = DMatrix::zeros(n + 1, n + 1);
-        m.view_mut((0, 0), (n, n)).copy_from(fx);
-        m.view_mut((0, n), (n, 1)).copy_from(b);
-        m.view_mut((n, 0), (1, n)).copy_from(&c.transpose());
-        let mut rhs = DVector::zeros(n + 1);
-        rhs[n] = 1.0;
-        let sol = m
-            .lu()
-            .solve(&rhs)
-            .filter(|s| s.iter().all(|v| v.is_finite()))?;
-        Some((sol[n], sol.rows(0, n).into_owned()))
+        super::fold::bordered(fx, b, c)
     }
 
     /// Unknowns: x, p₁, p₂ and, at a branch point, ψ.

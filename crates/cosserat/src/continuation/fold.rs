@@ -45,8 +45,9 @@ pub(super) type Fold = (Vec<f64>, f64, usize);
 
 /// The bordered system's g and its vector (v or w) for `matrix` = F_x or
 /// F_xᵀ with the borders (`column`, `row`): [A column; rowᵀ 0] [v; g] =
-/// [0; 1]. None where the bordered matrix is singular.
-fn bordered(
+/// [0; 1]. None where the bordered matrix is singular (also the
+/// singularity test of a curve of folds, [`super::codim2`]).
+pub(super) fn bordered(
     matrix: &DMatrix<f64>,
     column: &DVector<f64>,
     row: &DVector<f64>,
