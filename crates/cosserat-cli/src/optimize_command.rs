@@ -168,7 +168,12 @@ fn run_search(
     // paths) stops at once, the search's last checkpoint kept.
     signals::set_mode(signals::Mode::NextPoint);
     let mut last_save = Instant::now();
+    let meter = crate::progress::Meter::counted(
+        search.samples + search.starts,
+        progress.samples_done + progress.polishes_done,
+    );
     let mut checkpoint = |p: &SearchProgress| {
+        meter.set_position((p.samples_done + p.polishes_done) as u64);
         if last_save.elapsed() < CHECKPOINT {
             return;
         }
@@ -178,6 +183,7 @@ fn run_search(
         last_save = Instant::now();
     };
     let outcome = arm.search(scene, search, progress, &stop, &mut checkpoint);
+    meter.finish_and_clear();
     signals::set_mode(signals::Mode::Immediate);
     outcome
 }

@@ -1,4 +1,5 @@
-//! Progress where stderr is not a terminal (a cluster log, a pipe): plain
+//! Progress of `continue`, `sweep` and `optimize` where stderr is not a
+//! terminal (a cluster log, a pipe): plain
 //! timed lines with done/total, rate and time left (issue 19, item 6). The
 //! interval is set to 0 s here so every update prints.
 
@@ -50,6 +51,23 @@ fn continuation_and_sweep_report_progress_in_a_log() {
     let last = log.lines().rfind(|l| l.starts_with("progress  "));
     assert!(
         last.is_some_and(|l| l.contains("3/3 points") && l.contains("/s")),
+        "{log}"
+    );
+}
+
+#[test]
+fn an_optimization_reports_progress_in_a_log() {
+    let dir = scratch("progress_lines", "optimize");
+    let out = dir.join("arm.h5");
+    let log = run_logged(&[
+        "optimize",
+        &shipped("longest_arm"),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(
+        log.lines()
+            .any(|l| l.starts_with("progress  ") && l.contains(" points, ")),
         "{log}"
     );
 }
