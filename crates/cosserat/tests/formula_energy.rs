@@ -373,3 +373,50 @@ fn symbolic_derivatives_match_automatic_differentiation() {
         agree(symbolic, &ad, 1e-12);
     }
 }
+
+/// Evenness claims: proved per component for a formula, claimed by the
+/// built-in energies, and a false claim is caught by the check.
+#[test]
+fn claimed_evenness_is_proved_or_caught() {
+    #[derive(Debug)]
+    struct Claims(Arc<dyn StoredEnergy>);
+    impl StoredEnergy for Claims {
+        fn density(&self, s: f64, k: &Vector3<f64>) -> f64 {
+            self.0.density(s, k)
+        }
+        fn moment(&self, s: f64, k: &Vector3<f64>) -> Vector3<f64> {
+            self.0.moment(s, k)
+        }
+        fn stiffness(&self, s: f64, k: &Vector3<f64>) -> Matrix3<f64> {
+            self.0.stiffness(s, k)
+        }
+        fn moment_rate(&self, s: f64, k: &Vector3<f64>) -> Vector3<f64> {
+            self.0.moment_rate(s, k)
+        }
+        fn stiffness_rate(&self, s: f64, k: &Vector3<f64>) -> Matrix3<f64> {
+            self.0.stiffness_rate(s, k)
+        }
+        fn stiffness_derivative(&self, s: f64, k: &Vector3<f64>, v: &Vector3<f64>) -> Matrix3<f64> {
+            self.0.stiffness_derivative(s, k, v)
+        }
+        fn admits_planar_bending(&self) -> bool {
+            false
+        }
+        fn intrinsic_profiles(&self) -> Option<&[Profile; 3]> {
+            self.0.intrinsic_profiles()
+        }
+        fn even_components(&self) -> [bool; 3] {
+            [true; 3]
+        }
+        fn name(&self) -> &'static str {
+            "claims too much"
+        }
+    }
+    let f = formula("B1*k1^2 + B2*k2^2 + B3*k3^2 + k1*k2^2 + k3^4", &[]);
+    assert_eq!(f.even_components(), [false, true, true]);
+    let report = check(&Claims(f), 1.0, 1.0);
+    assert!(
+        report.failures().all(|x| x.property == Property::Evenness) && !report.passed(),
+        "{report}"
+    );
+}

@@ -37,6 +37,14 @@ pub trait StoredEnergy: std::fmt::Debug + Send + Sync {
     /// True when M1 = M3 = 0 whenever κ1 = κ3 = 0, for every κ2 and s: the
     /// energy then admits planar equilibria bent about d2 (planar model).
     fn admits_planar_bending(&self) -> bool;
+    /// The strain components i in which W is claimed even about the
+    /// intrinsic curvature ([`StoredEnergy::intrinsic_profiles`], zero for
+    /// an energy without them): W(s, κ⁰ + u) = W(s, κ⁰ + R_i u), R_i flipping
+    /// the sign of u_i (a cross-section symmetric about a principal axis).
+    /// Checked by [`super::energy_check`]; none claimed by default.
+    fn even_components(&self) -> [bool; 3] {
+        [false; 3]
+    }
     /// A short name for reports ("linear", "quartic", ...).
     fn name(&self) -> &str;
     /// True when H does not depend on κ or on κ⁰ (a quadratic energy in
@@ -236,6 +244,11 @@ impl StoredEnergy for LinearElastic {
         self.intrinsic_curvature[0].is_zero() && self.intrinsic_curvature[2].is_zero()
     }
 
+    /// ½ Σ B_i u_i² is even in each u_i.
+    fn even_components(&self) -> [bool; 3] {
+        [true; 3]
+    }
+
     fn name(&self) -> &'static str {
         "linear"
     }
@@ -385,6 +398,15 @@ impl StoredEnergy for QuarticStiffening {
 
     fn admits_planar_bending(&self) -> bool {
         self.linear.admits_planar_bending()
+    }
+
+    /// Both parts depend on each u_i through u_i² only.
+    fn even_components(&self) -> [bool; 3] {
+        [true; 3]
+    }
+
+    fn intrinsic_profiles(&self) -> Option<&[Profile; 3]> {
+        Some(self.linear.intrinsic_curvature())
     }
 
     fn name(&self) -> &'static str {

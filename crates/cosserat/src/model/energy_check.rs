@@ -57,6 +57,8 @@ pub enum Property {
     Convexity,
     /// M1 = M3 = 0 on κ1 = κ3 = 0, claimed by `admits_planar_bending`.
     PlanarBending,
+    /// W even in a strain component about κ⁰, claimed by `even_components`.
+    Evenness,
 }
 
 impl Property {
@@ -71,6 +73,7 @@ impl Property {
             Property::Symmetry => "symmetry of H",
             Property::Convexity => "positive definite H",
             Property::PlanarBending => "planar bending (M1 = M3 = 0 on κ1 = κ3 = 0)",
+            Property::Evenness => "claimed evenness W(κ⁰ + u) = W(κ⁰ + R_i u)",
         }
     }
 }
@@ -346,6 +349,17 @@ impl Sample<'_> {
         }
         if h.cholesky().is_none() {
             finding(Property::Convexity, h.symmetric_eigenvalues().min());
+        }
+        let kappa0 = intrinsic(self.energy, self.s);
+        let w = self.energy.density(self.s, &self.kappa);
+        for (i, even) in self.energy.even_components().into_iter().enumerate() {
+            let mut mirrored = self.kappa;
+            mirrored[i] = 2.0 * kappa0[i] - self.kappa[i];
+            let off = (self.energy.density(self.s, &mirrored) - w).abs()
+                / w.abs().max(h.amax() * self.hk * self.hk * 1e6);
+            if even && off > 1e-12 {
+                finding(Property::Evenness, off);
+            }
         }
         if self.energy.admits_planar_bending() {
             let k = Vector3::new(0.0, self.kappa[1], 0.0);

@@ -94,6 +94,10 @@ impl StoredEnergy for Shearable {
         self.bending.derivatives_trusted()
     }
 
+    fn even_components(&self) -> [bool; 3] {
+        self.bending.even_components()
+    }
+
     fn shear_stiffness(&self, _s: f64) -> Option<Vector3<f64>> {
         Some(self.shear)
     }

@@ -179,6 +179,11 @@ impl StoredEnergy for FormulaEnergy {
         true
     }
 
+    /// Proved from the formula's structure, component by component.
+    fn even_components(&self) -> [bool; 3] {
+        std::array::from_fn(|i| self.formula.is_even_in(&[Variable::Curvature(i)]))
+    }
+
     fn admits_planar_bending(&self) -> bool {
         Density::admits_planar_bending(self)
     }
