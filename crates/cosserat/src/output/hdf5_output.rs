@@ -112,6 +112,7 @@ pub(crate) fn write_atomically(
     let result = hdf5::File::create(&tmp)
         .and_then(|file| {
             write(&file)?;
+            super::schema::describe_file(&file)?;
             file.flush()
         })
         .map_err(|e| OutputError::Hdf5 {

@@ -13,6 +13,8 @@ mod curve;
 mod diagram;
 #[cfg(feature = "hdf5")]
 mod hdf5_output;
+#[cfg(feature = "hdf5")]
+pub mod schema;
 pub mod seal;
 #[cfg(feature = "hdf5")]
 mod sweep_output;

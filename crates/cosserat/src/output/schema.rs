@@ -1,0 +1,129 @@
+//! What every dataset of a result file means: its `units` and
+//! `description` attributes, attached to every dataset of a file as it is
+//! written, and the file's `schema_version` (docs/hdf5-schema.md lists the
+//! paths). Units are those of the problem file (its documented units: m,
+//! N, N·m); "1" is dimensionless, "" marks text and indices. A dataset
+//! this table does not know gets the description "undescribed" — the
+//! tests read every file the commands write and refuse any such dataset.
+
+use hdf5::types::VarLenUnicode;
+
+/// The version of the layout described by docs/hdf5-schema.md.
+pub const SCHEMA_VERSION: &str = "1";
+
+/// The description given to a dataset the table does not know.
+pub const UNDESCRIBED: &str = "undescribed";
+
+/// (units, description) of the dataset `name` in the group `parent` (its
+/// last path component, "" for the root).
+fn entry(parent: &str, name: &str) -> (&'static str, &'static str) {
+    match (parent, name) {
+        // Equilibria (solve, stability).
+        ("solution", "s") => ("m", "arc length of each sample"),
+        ("solution", "position") => ("m", "centreline r(s), global components"),
+        ("solution", "d1" | "d2" | "d3") => ("1", "director d_i(s), global components"),
+        ("solution", "curvature") => ("1/m", "curvature-twist κ(s), body components"),
+        ("solution", "moment") => ("N·m", "internal moment M(s), body components"),
+        ("solution", "force") => ("N", "internal force n(s), global components"),
+        ("solution", "residual_history") => ("1", "scaled Newton residual per iteration"),
+        ("solution", "unknowns") => ("", "the discrete unknowns of the shooting discretization (κ(0), reactions, segment states)"),
+        (_, "nodes") => ("m", "arc length of the finite-element nodes"),
+        (_, "eigenvalues") => ("N·m (stiffness units of the pencil)", "lowest eigenvalues of the second variation (per row a point, or per block)"),
+        (_, "eigenvectors") => ("1", "eigenvectors at the nodes (three fields per node)"),
+        (_, "null_vector") => ("1", "the mode at the critical load, at the nodes"),
+        (_, "null_vectors") => ("1", "null modes of the special points at the nodes"),
+        (_, "morse_index") => ("", "number of negative eigenvalues of the second variation"),
+        (_, "critical_load") => ("1", "critical load factor of the fixed shape"),
+        (_, "load_factor") => ("1", "the critical load as a factor of the problem's loads"),
+        // Diagrams.
+        ("branches", "eigenvalue_names") => ("", "the tracked block of each eigenvalue column"),
+        ("branches", "measure_names") => ("", "the user's measure of each measure column"),
+        (_, "parameter") => ("as the continued key", "value of the continuation parameter"),
+        (_, "tip_position") => ("m", "tip position r(L), global components"),
+        (_, "tip_angle") => ("rad", "tip angle from d3(0) towards d1(0), unfolded"),
+        (_, "norm") => ("1", "norm of the scaled unknowns"),
+        (_, "measures") => ("as each measure", "the named measures (columns as measure_names)"),
+        (_, "shapes") => ("m", "centreline at equally spaced points"),
+        (_, "unknowns") => ("", "discrete unknowns of the continued discretization"),
+        (_, "tangent") => ("", "unit tangent of the branch in (unknowns, parameter)"),
+        (_, "stable") => ("", "1 where stable (Morse index 0 and conservative loads), else 0"),
+        (_, "held_keys") => ("", "keys held at the values of earlier stages"),
+        (_, "held_values") => ("as each key", "values of the held keys"),
+        ("special_points", "kind") => ("", "fold or branch point"),
+        ("special_points", "branch" | "index") => ("", "branch and point index of the special point"),
+        ("special_points", "block") => ("", "the Hessian block whose eigenvalue crosses zero"),
+        ("special_points", "symmetry_breaking") => ("", "1 where the mode breaks the branch's symmetry"),
+        ("special_points", "singularity") => ("1", "size of the singularity (test function, its bound)"),
+        ("special_points", "multiplicity") => ("", "eigenvalues crossing zero together"),
+        ("special_points", "location") => ("", "augmented (minimally augmented system) or bracketed (regula falsi)"),
+        (_, "warnings") => ("", "events detected but not located, and other warnings"),
+        // Curves of singular points.
+        ("curve", "parameters") => ("as the two keys", "the two parameters along the curve"),
+        ("curve", "singularity") => ("1", "the test function along the curve"),
+        ("curve", "cusps") => ("", "point indices of the cusps"),
+        ("curve", "cusp_parameters") => ("as the two keys", "the two parameters at each cusp"),
+        // Arm studies.
+        (_, "curvature_coefficients" | "shape_coefficients") => ("1", "Taylor coefficients of the loaded shape (per rod length)"),
+        (_, "gamma_crit") => ("1", "critical load factor γ = w L³/B of the design"),
+        (_, "intrinsic_curvature") => ("1/m", "intrinsic curvature κ⁰₂(s) of the design"),
+        (_, "loaded_shape" | "unloaded_shape") => ("m", "centreline of the design, loaded or unloaded"),
+        (_, "reach" | "reach_fine") => ("1", "reach per rod length L"),
+        (_, "reach_error") => ("1", "estimated mesh error of the reach"),
+        (_, "reach_meshes" | "mesh_elements") => ("", "meshes of the convergence study"),
+        (_, "reach_order") => ("1", "measured order of the mesh convergence"),
+        (_, "clamp_angle") => ("rad", "clamp angle of the straight arm"),
+        (_, "leader_points") => ("1", "the best samples' coefficients"),
+        (_, "leader_reach") => ("1", "the best samples' reach per rod length"),
+        // Sweeps.
+        ("grid", "keys") => ("", "the --set key of each axis"),
+        ("grid", "shape") => ("", "points along each axis"),
+        ("grid", n) if n.starts_with("axis_") => ("as the axis key", "values along the axis"),
+        ("points", "parameters") => ("as the axis keys", "the grid values of each point"),
+        (_, "iterations") => ("", "Newton iterations"),
+        (_, "residual") => ("1", "final scaled residual"),
+        (_, "status") => ("", "what happened at the point"),
+        ("points", "index") => ("", "grid index of each point (row-major)"),
+        (_, "index") => ("", "index of the sample in the map"),
+        (_, "curvature_norm") => ("1", "Σ b_k² of the design's curvature coefficients"),
+        (_, "elements") => ("", "finite elements of the mesh the result was computed on"),
+        (_, "evaluations") => ("", "designs evaluated"),
+        (_, "mesh") => ("", "mesh-convergence verdict"),
+        (_, "start") => ("", "how the point started: warm from its predecessor, or cold"),
+        (_, "limit") => ("", "what limits the straight arm"),
+        _ => ("", UNDESCRIBED),
+    }
+}
+
+/// Attaches `units` and `description` to every dataset of `group` and its
+/// subgroups.
+fn describe(group: &hdf5::Group, parent: &str) -> hdf5::Result<()> {
+    for name in group.member_names()? {
+        if let Ok(sub) = group.group(&name) {
+            describe(&sub, &name)?;
+            continue;
+        }
+        let ds = group.dataset(&name)?;
+        let (units, description) = entry(parent, &name);
+        for (key, value) in [("units", units), ("description", description)] {
+            let v: VarLenUnicode = value
+                .parse()
+                .map_err(|e| hdf5::Error::from(format!("{e}")))?;
+            ds.new_attr::<VarLenUnicode>()
+                .create(key)?
+                .write_scalar(&v)?;
+        }
+    }
+    Ok(())
+}
+
+/// Describes every dataset of a file just written and stamps the schema
+/// version on its root.
+pub(crate) fn describe_file(file: &hdf5::File) -> hdf5::Result<()> {
+    describe(file, "")?;
+    let v: VarLenUnicode = SCHEMA_VERSION
+        .parse()
+        .map_err(|e| hdf5::Error::from(format!("{e}")))?;
+    file.new_attr::<VarLenUnicode>()
+        .create("schema_version")?
+        .write_scalar(&v)
+}
