@@ -1,11 +1,16 @@
 //! A one-parameter family of rods and its discretized equilibrium equations
 //! F(x, p) = 0 (shooting unknowns x, parameter p).
 //!
-//! F_x is the exact shooting Jacobian (variational equations). F_p is a
-//! central difference in p of the converged-tolerance residual; it only
-//! steers the predictor and the bordering row, so its O(tolerance/h) error
-//! slows the corrector at worst — the points themselves satisfy F = 0 to
-//! the Newton tolerance.
+//! F_x is the exact shooting Jacobian (variational equations). F_p is
+//! exact too where the lens says how the rod moves with p
+//! ([`Lens::tangent`]): the sensitivity equations z' = f_y z + ∂f/∂p,
+//! z(0) = ∂y(0)/∂p, integrated with the state, and the explicit
+//! p-dependence of the tip residual and of the residuals' units. Elsewhere
+//! (a lens without a tangent, a tip support) it is a central difference in
+//! p, and [`Family::derivative_method`] says so: F_p steers the predictor,
+//! the bordering row and the tangents that locate folds, so its O(h²)
+//! error moves located folds, while the points themselves satisfy F = 0
+//! to the Newton tolerance either way.
 
 use std::sync::Arc;
 
@@ -330,8 +335,46 @@ impl Family {
         Ok(())
     }
 
-    /// F_p by a central difference with h = 1e-4 max(1, |p|).
+    /// F_p = ∂F/∂p at (x, p): exact by the sensitivity equations
+    /// ([`ShootingSystem::parameter_derivative`]) where the lens gives its
+    /// [`crate::model::RodTangent`] and the equations differentiate it,
+    /// otherwise by [`Family::central_difference`]; which one is
+    /// [`Family::derivative_method`].
     pub fn parameter_derivative(&self, x: &[f64], p: f64) -> Result<DVector<f64>, PointError> {
+        if let Some(t) = self.lens.tangent(p) {
+            let rod = self.rod_at(p)?;
+            let eq = equations(&rod, self.level);
+            if eq.differentiates(&t) {
+                let mut fp = DVector::zeros(x.len());
+                self.system(eq.as_ref())
+                    .parameter_derivative(&self.unscaled(x), &t, &mut fp)?;
+                return Ok(fp);
+            }
+        }
+        self.central_difference(x, p)
+    }
+
+    /// How [`Family::parameter_derivative`] computes F_p at p: exact where
+    /// the lens knows how the rod moves and the equations differentiate
+    /// that motion, by central differences elsewhere (a lens without a
+    /// tangent, a key the tangent does not cover, a tip support).
+    pub fn derivative_method(&self, p: f64) -> Result<DerivativeMethod, FamilyError> {
+        let Some(t) = self.lens.tangent(p) else {
+            return Ok(DerivativeMethod::CentralDifference);
+        };
+        let rod = self.rod_at(p)?;
+        Ok(if equations(&rod, self.level).differentiates(&t) {
+            DerivativeMethod::Exact
+        } else {
+            DerivativeMethod::CentralDifference
+        })
+    }
+
+    /// F_p by a central difference with h = 1e-4 max(1, |p|): two extra
+    /// integrations and an O(h²) ≈ 1e-8 relative truncation error, which
+    /// shifts tangents and hence located folds by as much. The fallback
+    /// of [`Family::parameter_derivative`].
+    pub fn central_difference(&self, x: &[f64], p: f64) -> Result<DVector<f64>, PointError> {
         let n = x.len();
         let h = 1e-4 * p.abs().max(1.0);
         let (mut a, mut b) = (DVector::zeros(n), DVector::zeros(n));
@@ -377,6 +420,26 @@ impl Family {
     pub fn tip(&self, x: &[f64], p: f64) -> Result<RodSample, PointError> {
         let l = self.rod_at(p)?.length();
         Ok(self.samples(x, p, &[l])?.remove(0))
+    }
+}
+
+/// How a family computes F_p ([`Family::derivative_method`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DerivativeMethod {
+    /// By the sensitivity equations: exact up to the integration
+    /// tolerance (shooting) or to rounding (collocation).
+    Exact,
+    /// By a central difference in p (h = 1e-4 max(1, |p|)): an O(h²)
+    /// truncation error.
+    CentralDifference,
+}
+
+impl std::fmt::Display for DerivativeMethod {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            DerivativeMethod::Exact => "exact (sensitivity equations)",
+            DerivativeMethod::CentralDifference => "central difference in p",
+        })
     }
 }
 

@@ -41,7 +41,7 @@ mod tracking;
 pub use codim2::{follow_singular, CurveOptions, CurvePoint, Lens2, ParameterOn, SingularCurve};
 pub use diagram::{Branch, ContinuationError, Diagram, Point, Progress, SpecialKind, SpecialPoint};
 pub use driver::continuation;
-pub use family::{tip_angle, Family, FamilyError, PointError};
+pub use family::{tip_angle, DerivativeMethod, Family, FamilyError, PointError};
 pub use lens::{Lens, Parameter, RodLens};
 pub use measure::{Measure, Quantity};
 pub use options::ContinuationOptions;

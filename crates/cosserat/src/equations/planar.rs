@@ -25,7 +25,7 @@
 use nalgebra::{DMatrix, Vector3};
 
 use super::{RodEquations, RodSample};
-use crate::model::{Freedom, Rod, TipSupport};
+use crate::model::{Freedom, Rod, RodTangent, TipSupport};
 
 /// The 4-ODE planar equations of a rod.
 #[derive(Debug, Clone)]
@@ -330,6 +330,77 @@ impl RodEquations for PlanarEquations {
         let mut scales = vec![l, l, 1.0, 1.0 / l];
         scales.resize(self.dim(), self.rod.residual_scales().force);
         scales
+    }
+
+    /// A free tip (a support's conditions are not differentiated yet) and
+    /// a tangent whose energy rates are exact for this rod.
+    fn differentiates(&self, t: &RodTangent) -> bool {
+        self.rod.support().is_none() && t.fits(&self.rod)
+    }
+
+    /// (L'/L) f, plus κ2' = (−N1 − ∂sM2)/H22 moved at fixed (φ, κ2):
+    /// δκ2' = (−δN1 − δ∂sM2 − δH22 κ2')/H22 with δN1 = δn_x cos φ −
+    /// δn_z sin φ, δn_x = δn·d1(0) + n·(ω × d1(0)) (likewise z).
+    fn rhs_parameter(&self, s: f64, y: &[f64], t: &RodTangent, out: &mut [f64]) {
+        self.rhs(s, y, out);
+        let stretch = t.length() / self.rod.length();
+        for v in out.iter_mut() {
+            *v *= stretch;
+        }
+        let c = self.rod.clamp();
+        let (ex, ez) = (c.director(0), c.director(2));
+        let (n, dn) = (
+            self.rod.loads().internal_force(s, self.rod.length()),
+            t.internal_force_rate(&self.rod, s),
+        );
+        let w = t.clamp_spin();
+        let dnx = dn.dot(&ex) + n.dot(&w.cross(&ex));
+        let dnz = dn.dot(&ez) + n.dot(&w.cross(&ez));
+        let (sin, cos) = y[2].sin_cos();
+        let kappa = Self::kappa(y[3]);
+        let e = self.rod.energy();
+        let rate = self.curvature_rate(s, y).0;
+        let de = t.energy_rate(e.as_ref(), s, &kappa);
+        let h22 = e.stiffness(s, &kappa)[(1, 1)];
+        out[3] +=
+            (-(dnx * cos - dnz * sin) - de.moment_rate[1] - de.stiffness[(1, 1)] * rate) / h22;
+    }
+
+    /// Zero but at a hinged base, where κ2(0) solves M2(0, κ2) = 0:
+    /// δκ2(0) = −δM2/H22.
+    fn initial_state_parameter(&self, u: &[f64], t: &RodTangent, out: &mut [f64]) {
+        out.fill(0.0);
+        if self.rod.clamp().hinge {
+            let mut y0 = vec![0.0; self.dim()];
+            self.initial_state(u, &mut y0);
+            let kappa = Self::kappa(y0[3]);
+            let e = self.rod.energy();
+            let dm = t.energy_rate(e.as_ref(), 0.0, &kappa).moment[1];
+            out[3] = -dm / e.stiffness(0.0, &kappa)[(1, 1)];
+        }
+    }
+
+    /// g = (M2(L) − C·d2)/M_s: δg = (δM2 − δC·d2 − C·(ω × d2))/M_s −
+    /// g δM_s/M_s.
+    fn tip_residual_parameter(&self, y: &[f64], t: &RodTangent, out: &mut [f64]) {
+        let l = self.rod.length();
+        let kappa = Self::kappa(y[3]);
+        let e = self.rod.energy();
+        let d2 = self.rod.clamp().director(1);
+        let c = &self.rod.loads().tip_couple;
+        let unit = self.rod.residual_scales().moment[1];
+        let dunit = t.residual_scales_rate(&self.rod).moment[1];
+        let g = (e.moment(l, &kappa)[1] - c.dot(&d2)) / unit;
+        let dm = t.energy_rate(e.as_ref(), l, &kappa).moment[1];
+        let dc = t.loads().tip_couple.dot(&d2) + c.dot(&t.clamp_spin().cross(&d2));
+        out[0] = (dm - dc) / unit - g * dunit / unit;
+    }
+
+    fn state_scales_parameter(&self, t: &RodTangent) -> Vec<f64> {
+        let (l, dl) = (self.rod.length(), t.length());
+        let mut rates = vec![dl, dl, 0.0, -dl / (l * l)];
+        rates.resize(self.dim(), t.residual_scales_rate(&self.rod).force);
+        rates
     }
 }
 

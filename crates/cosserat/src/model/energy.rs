@@ -45,6 +45,13 @@ pub trait StoredEnergy: std::fmt::Debug + Send + Sync {
     fn is_quadratic(&self) -> bool {
         false
     }
+    /// True when W has no explicit s-dependence (every profile constant):
+    /// a length change then moves no material property under the rod's
+    /// points, which the exact length derivative of continuation assumes
+    /// ([`super::RodTangent::fits`]).
+    fn is_uniform(&self) -> bool {
+        false
+    }
     /// The stiffnesses S = (S1, S2, S3) of a quadratic shear and extension
     /// energy ½ (ν − e3)ᵀ diag(S) (ν − e3) at s (see [`super::Shearable`]);
     /// None for an unshearable, inextensible (Kirchhoff) rod.
@@ -235,6 +242,10 @@ impl StoredEnergy for LinearElastic {
         true
     }
 
+    fn is_uniform(&self) -> bool {
+        LinearElastic::is_uniform(self)
+    }
+
     fn intrinsic_profiles(&self) -> Option<&[Profile; 3]> {
         Some(&self.intrinsic_curvature)
     }
@@ -376,6 +387,10 @@ impl StoredEnergy for QuarticStiffening {
 
     fn name(&self) -> &'static str {
         "quartic"
+    }
+
+    fn is_uniform(&self) -> bool {
+        self.linear.is_uniform()
     }
 }
 

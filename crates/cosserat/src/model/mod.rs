@@ -13,6 +13,7 @@ mod profile;
 mod rod;
 mod shear;
 mod support;
+mod tangent;
 
 pub use catalog::{EnergyBuilder, EnergyCatalog, EnergySpec, EnergySpecError};
 pub use energy::{LinearElastic, ProfileKind, QuarticStiffening, StoredEnergy};
@@ -24,3 +25,4 @@ pub use profile::{Extremes, Knots, Profile, SplineKnots};
 pub use rod::{Clamp, ResidualScales, Rod};
 pub use shear::Shearable;
 pub use support::{across, Freedom, TipSupport};
+pub use tangent::{EnergyRate, RodTangent};

@@ -16,9 +16,11 @@ use std::sync::Mutex;
 use super::rod::build_rod;
 use super::sections::ProblemFile;
 use super::{invalid, overrides, ProblemError};
-use crate::continuation::{FamilyError, Lens, Lens2};
+use nalgebra::Vector3;
+
+use crate::continuation::{FamilyError, Lens, Lens2, Parameter, RodLens};
 use crate::input::strict;
-use crate::model::{EnergyCatalog, Rod};
+use crate::model::{EnergyCatalog, Rod, RodTangent};
 
 /// The tables whose numbers make the rod.
 const ROD_TABLES: [&str; 5] = ["rod", "energy", "clamp", "support", "loads"];
@@ -87,6 +89,25 @@ impl KeyLens {
         })
     }
 
+    /// The unit axis of a turn table (`clamp.turn.axis`), None when the
+    /// document does not give three finite numbers with a non-zero norm.
+    fn turn_axis(&self, key: &str) -> Option<Vector3<f64>> {
+        let toml::Value::Array(a) = overrides::get_key(&self.doc, key)? else {
+            return None;
+        };
+        let v: Vec<f64> = a
+            .iter()
+            .map(|x| match x {
+                toml::Value::Float(f) => Some(*f),
+                toml::Value::Integer(i) => Some(*i as f64),
+                _ => None,
+            })
+            .collect::<Option<_>>()?;
+        let axis = Vector3::from_column_slice(v.get(..3).filter(|_| v.len() == 3)?);
+        let norm = axis.norm();
+        (norm.is_finite() && norm > 0.0).then(|| axis / norm)
+    }
+
     fn build(&self, p: f64) -> Result<Rod, ProblemError> {
         let mut doc = self.doc.clone();
         overrides::set_key(&mut doc, &self.key, toml::Value::Float(p))
@@ -99,6 +120,23 @@ impl KeyLens {
 impl Lens for KeyLens {
     fn key(&self) -> String {
         self.key.clone()
+    }
+
+    /// The rates of the library's own [`Parameter`] where the key is one
+    /// (a load component, `rod.length`, a constant `energy.stiffness[i]` or
+    /// `energy.intrinsic_curvature[i]`, `clamp.angle`: the reader sets the
+    /// rod's number to the key's value, so the rod moves as
+    /// [`crate::continuation::RodLens`] moves it), the spin of
+    /// `clamp.turn.angle` (the frame turned about the fixed unit axis); None for
+    /// every other key, whose F_p is then a central difference
+    /// ([`crate::continuation::Family::derivative_method`]).
+    fn tangent(&self, p: f64) -> Option<RodTangent> {
+        if self.key == "clamp.turn.angle" {
+            let axis = self.turn_axis("clamp.turn.axis")?;
+            return RodTangent::zero().with_clamp_spin(axis).ok();
+        }
+        let parameter = Parameter::from_key(&self.key).filter(|q| q.is_file_key())?;
+        RodLens::new(self.rod_at(p).ok()?, parameter).tangent(p)
     }
 
     fn rod_at(&self, p: f64) -> Result<Rod, FamilyError> {
