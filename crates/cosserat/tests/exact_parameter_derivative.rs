@@ -18,7 +18,9 @@
 use std::sync::Arc;
 
 use cosserat::continuation::{DerivativeMethod, Family, Parameter};
-use cosserat::model::{Clamp, DeadLoads, LinearElastic, ModelLevel, Rod, Shearable};
+use cosserat::model::{
+    Clamp, DeadLoads, Frame, Freedom, LinearElastic, ModelLevel, Rod, Shearable, TipSupport,
+};
 use cosserat::numerics::integrator::Tolerances;
 use nalgebra::{DVector, Vector3};
 
@@ -68,6 +70,18 @@ fn cosserat_rod() -> Rod {
     rod.with_energy(Arc::new(energy))
 }
 
+/// `rod` held at its tip as `translation`, `rotation` say: at a point
+/// off the unloaded tip, in a frame turned about d2 by 0.3 rad.
+fn supported(rod: Rod, translation: Freedom, rotation: Freedom) -> Rod {
+    let support = TipSupport {
+        position: Vector3::new(0.25, 0.0, 0.9 * rod.length()),
+        frame: Frame::identity().turned(1, 0.3).unwrap(),
+        translation,
+        rotation,
+    };
+    rod.with_support(Some(support)).unwrap()
+}
+
 /// The base rod's own value of the parameter.
 fn value(rod: &Rod, parameter: Parameter) -> f64 {
     let loads = rod.loads();
@@ -103,15 +117,15 @@ fn reference(family: &Family, x: &[f64], p: f64, h: f64) -> DVector<f64> {
     (r2 * 16.0 - r1) / 15.0
 }
 
-/// Unknowns off the solution (the straight-rod guess integrated, then
-/// moved), so that matching and tip residuals and their units' rates all
-/// enter F_p.
+/// Unknowns off the solution: the straight-rod guess integrated on the
+/// rod at a nearby value p + δ, so that every matching residual and the
+/// tip residuals, and hence their units' rates, enter F_p at p. The
+/// directors stay orthonormal, as at every point of a branch (the held
+/// frame's tip Jacobian is exact there).
 fn unknowns(family: &Family, p: f64) -> Vec<f64> {
-    let mut x = family.initial_unknowns(p).unwrap();
-    for (i, v) in x.iter_mut().enumerate() {
-        *v += 0.02 * (1.0 + i as f64).sin();
-    }
-    x
+    family
+        .initial_unknowns(p + 0.05 * p.abs().max(1.0))
+        .unwrap()
 }
 
 fn check(rod: &Rod, level: ModelLevel, parameters: &[Parameter]) {
@@ -194,6 +208,47 @@ const SPATIAL: [Parameter; 17] = [
     Parameter::ClampAngle,
 ];
 
+/// A pinned tip and a sliding clamp in the plane.
+#[test]
+fn planar_parameters_with_a_supported_tip() {
+    use Parameter::*;
+    let kinds = [
+        LoadScale,
+        TipForce(0),
+        TipCouple(1),
+        DistributedForce(2),
+        Length,
+        Stiffness(1),
+        IntrinsicCurvature(1),
+        ClampAngle,
+    ];
+    let pinned = supported(planar_rod(), Freedom::Fixed, Freedom::Free);
+    check(&pinned, ModelLevel::Planar, &kinds);
+    let sliding = supported(planar_rod(), Freedom::Axial(Vector3::z()), Freedom::Fixed);
+    check(&sliding, ModelLevel::Planar, &kinds);
+}
+
+/// Every spatial support kind: clamped, pinned, a sliding pin, a clamp
+/// free to spin, on the Kirchhoff and the Cosserat level.
+#[test]
+fn spatial_parameters_with_a_supported_tip() {
+    let axis = Vector3::new(0.2, 0.1, 1.0).normalize();
+    let supports = [
+        (Freedom::Fixed, Freedom::Fixed),
+        (Freedom::Fixed, Freedom::Free),
+        (Freedom::Axial(axis), Freedom::Free),
+        (Freedom::Fixed, Freedom::Axial(axis)),
+    ];
+    for (translation, rotation) in supports {
+        for (rod, level) in [
+            (spatial_rod(), ModelLevel::Kirchhoff),
+            (cosserat_rod(), ModelLevel::Cosserat),
+        ] {
+            check(&supported(rod, translation, rotation), level, &SPATIAL);
+        }
+    }
+}
+
 #[test]
 fn kirchhoff_parameters() {
     check(&spatial_rod(), ModelLevel::Kirchhoff, &SPATIAL);
@@ -217,4 +272,67 @@ fn the_central_difference_misses_the_reference() {
     let central = (&family.central_difference(&x, p).unwrap() - &fd).amax();
     assert!(central > 1e-10 * fd.amax(), "{central:e}");
     assert!(exact < 1e-2 * central, "{exact:e} vs {central:e}");
+}
+
+/// A problem-file key (the problem reread with the key set) is exact
+/// where it names a number the tangent covers — the held tip position,
+/// the held frame's turn, a load of a supported rod, the clamp's turn —
+/// and a central difference, said so, elsewhere (the support's axis).
+#[test]
+fn file_keys_are_exact_where_the_tangent_covers_them() {
+    let cases = [
+        (
+            include_str!("../../../problems/clamped_elastica_displacement.toml"),
+            "support.position[2]",
+        ),
+        (
+            include_str!("../../../problems/twisted_rod.toml"),
+            "support.turn.angle",
+        ),
+        (
+            include_str!("../../../problems/greenhill.toml"),
+            "loads.tip_force[2]",
+        ),
+        (
+            include_str!("../../../problems/twisted_rod.toml"),
+            "clamp.angle",
+        ),
+    ];
+    for (text, key) in cases {
+        let set = [format!("continuation.parameter={key}")];
+        let problem = cosserat::input::Problem::from_str_with(text, &set).unwrap();
+        let (family, opts) = problem.continuation.clone().unwrap();
+        let p = opts.start;
+        assert_eq!(
+            family.derivative_method(p).unwrap(),
+            DerivativeMethod::Exact,
+            "{key}"
+        );
+        // These problems shoot once: the unknowns are the clamp's free
+        // values (κ(0), the reaction), moved off the straight rod's balance.
+        let mut x = unknowns(&family, p);
+        for (i, v) in x.iter_mut().enumerate() {
+            *v += 0.3 * (1.0 + i as f64).sin();
+        }
+        let exact = family.parameter_derivative(&x, p).unwrap();
+        let fd = reference(&family, &x, p, 1e-2 * p.abs().max(1.0));
+        let err = (&exact - &fd).amax();
+        assert!(
+            err <= 1e-10 * fd.amax(),
+            "{key}: |F_p − reference| = {err:e}, |F_p| = {:e}",
+            fd.amax()
+        );
+    }
+    let text = include_str!("../../../problems/greenhill.toml");
+    let set = [
+        "continuation.parameter=support.axis[2]".to_string(),
+        "continuation.start=-1.0".to_string(),
+        "continuation.bounds=[-1.5, -0.5]".to_string(),
+    ];
+    let problem = cosserat::input::Problem::from_str_with(text, &set).unwrap();
+    let (family, opts) = problem.continuation.clone().unwrap();
+    assert_eq!(
+        family.derivative_method(opts.start).unwrap(),
+        DerivativeMethod::CentralDifference
+    );
 }

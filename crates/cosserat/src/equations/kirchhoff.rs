@@ -22,7 +22,7 @@
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
 use super::planar::straight_rod_clamp_moment;
-use super::tip::{conditions, TipState};
+use super::tip::{condition_rates, conditions, rates_cover, TipRates, TipState};
 use super::{RodEquations, RodSample};
 use crate::model::{Rod, RodTangent, StoredEnergy, TipSupport};
 use crate::numerics::newton::{self, Convergence, Damping, Options, System};
@@ -391,10 +391,14 @@ impl RodEquations for KirchhoffEquations {
         scales
     }
 
-    /// A free tip (a support's conditions are not differentiated yet) and
-    /// a tangent whose energy rates are exact for this rod.
+    /// A tangent whose energy rates are exact for this rod, and a support
+    /// whose motion [`super::tip::condition_rates`] covers.
     fn differentiates(&self, t: &RodTangent) -> bool {
-        self.rod.support().is_none() && t.fits(&self.rod)
+        t.fits(&self.rod)
+            && self
+                .rod
+                .support()
+                .is_none_or(|s| rates_cover(s, t.support_spin()))
     }
 
     /// (L'/L) f, plus the balance H κ' = M × κ + N × ν − ∂sM moved at
@@ -432,7 +436,8 @@ impl RodEquations for KirchhoffEquations {
     }
 
     /// g_i = (M_i(L) − C·d_i)/M_s,i: δg_i = (δM_i − δC·d_i)/M_s,i −
-    /// g_i δM_s,i/M_s,i.
+    /// g_i δM_s,i/M_s,i; a support's conditions by
+    /// [`super::tip::condition_rates`].
     fn tip_residual_parameter(&self, y: &[f64], t: &RodTangent, out: &mut [f64]) {
         let st = State::read(y);
         let l = self.rod.length();
@@ -440,6 +445,26 @@ impl RodEquations for KirchhoffEquations {
         let m = e.moment(l, &st.kappa);
         let dm = t.energy_rate(e.as_ref(), l, &st.kappa).moment;
         let (c, dc) = (&self.rod.loads().tip_couple, &t.loads().tip_couple);
+        if let Some(support) = self.rod.support() {
+            let tip = TipState {
+                d: [st.d1, st.d2, st.d3],
+                r: Vector3::new(y[9], y[10], y[11]),
+                m,
+                h: e.stiffness(l, &st.kappa),
+                reaction: st.reaction,
+                couple: c,
+            };
+            let rates = TipRates {
+                m: dm,
+                couple: dc,
+                position: t.support_shift(),
+                spin: t.support_spin(),
+                scales: t.residual_scales_rate(&self.rod),
+            };
+            let scales = self.rod.residual_scales();
+            out.copy_from_slice(&condition_rates(support, &tip, &scales, &rates));
+            return;
+        }
         let unit = self.rod.residual_scales().moment;
         let dunit = t.residual_scales_rate(&self.rod).moment;
         let d = [st.d1, st.d2, st.d3];

@@ -154,6 +154,86 @@ impl PlanarEquations {
     }
 }
 
+impl PlanarEquations {
+    /// ∂/∂p of [`PlanarEquations::supported_tip`]'s residuals at a fixed
+    /// tip state, row by row: the in-plane coordinates (p_x, p_z) of the
+    /// held position and (a_x, a_z) of a sliding axis move with the
+    /// support's shift δX and the clamp's spin ω (δe_x = ω × e_x), the held
+    /// angle atan2(u, v) of d̂3 (spinning with the support, δd̂3 = Ω × d̂3)
+    /// by (v δu − u δv)/(u² + v²), the moment row as at a
+    /// free tip; every row's unit by its rate (value = q/u: δq/u −
+    /// value δu/u).
+    fn supported_tip_rates(&self, support: &TipSupport, y: &[f64], t: &RodTangent) -> Vec<f64> {
+        let l = self.rod.length();
+        let (scales, rates) = (
+            self.rod.residual_scales(),
+            t.residual_scales_rate(&self.rod),
+        );
+        let c = self.rod.clamp();
+        let w = t.clamp_spin();
+        let (ex, ez) = (c.director(0), c.director(2));
+        let (dex, dez) = (w.cross(&ex), w.cross(&ez));
+        let target = support.position - c.position;
+        let dtarget = t.support_shift();
+        let (px, pz) = (target.dot(&ex), target.dot(&ez));
+        let (dpx, dpz) = (
+            dtarget.dot(&ex) + target.dot(&dex),
+            dtarget.dot(&ez) + target.dot(&dez),
+        );
+        let ratio = |value: f64, dq: f64, u: f64, du: f64| dq / u - value * du / u;
+        let dl = t.length();
+        let mut out = Vec::with_capacity(3);
+        match support.translation {
+            Freedom::Free => {}
+            Freedom::Fixed => {
+                out.push(ratio((y[0] - px) / l, -dpx, l, dl));
+                out.push(ratio((y[1] - pz) / l, -dpz, l, dl));
+            }
+            Freedom::Axial(a) => {
+                let (ax, az) = (a.dot(&ex), a.dot(&ez));
+                let (dax, daz) = (a.dot(&dex), a.dot(&dez));
+                let value = (-(y[0] - px) * az + (y[1] - pz) * ax) / l;
+                let dq = dpx * az - (y[0] - px) * daz - dpz * ax + (y[1] - pz) * dax;
+                out.push(ratio(value, dq, l, dl));
+                let f = scales.force;
+                let value = (y[4] * ax + y[5] * az) / f;
+                out.push(ratio(value, y[4] * dax + y[5] * daz, f, rates.force));
+            }
+        }
+        match support.rotation {
+            Freedom::Fixed => {
+                let d3 = support.frame.column(2).into_owned();
+                let dd3 = t.support_spin().cross(&d3);
+                let (u, v) = (d3.dot(&ex), d3.dot(&ez));
+                let (du, dv) = (d3.dot(&dex) + dd3.dot(&ex), d3.dot(&dez) + dd3.dot(&ez));
+                out.push(-(v * du - u * dv) / (u * u + v * v));
+            }
+            Freedom::Free | Freedom::Axial(_) => {
+                let mut g = [0.0];
+                self.free_tip_rate(y, t, &mut g);
+                out.push(g[0]);
+            }
+        }
+        out
+    }
+
+    /// g = (M2(L) − C·d2)/M_s: δg = (δM2 − δC·d2 − C·(ω × d2))/M_s −
+    /// g δM_s/M_s.
+    fn free_tip_rate(&self, y: &[f64], t: &RodTangent, out: &mut [f64]) {
+        let l = self.rod.length();
+        let kappa = Self::kappa(y[3]);
+        let e = self.rod.energy();
+        let d2 = self.rod.clamp().director(1);
+        let c = &self.rod.loads().tip_couple;
+        let unit = self.rod.residual_scales().moment[1];
+        let dunit = t.residual_scales_rate(&self.rod).moment[1];
+        let g = (e.moment(l, &kappa)[1] - c.dot(&d2)) / unit;
+        let dm = t.energy_rate(e.as_ref(), l, &kappa).moment[1];
+        let dc = t.loads().tip_couple.dot(&d2) + c.dot(&t.clamp_spin().cross(&d2));
+        out[0] = (dm - dc) / unit - g * dunit / unit;
+    }
+}
+
 impl RodEquations for PlanarEquations {
     fn dim(&self) -> usize {
         if self.reacts() {
@@ -332,10 +412,9 @@ impl RodEquations for PlanarEquations {
         scales
     }
 
-    /// A free tip (a support's conditions are not differentiated yet) and
-    /// a tangent whose energy rates are exact for this rod.
+    /// A tangent whose energy rates are exact for this rod.
     fn differentiates(&self, t: &RodTangent) -> bool {
-        self.rod.support().is_none() && t.fits(&self.rod)
+        t.fits(&self.rod)
     }
 
     /// (L'/L) f, plus κ2' = (−N1 − ∂sM2)/H22 moved at fixed (φ, κ2):
@@ -380,20 +459,13 @@ impl RodEquations for PlanarEquations {
         }
     }
 
-    /// g = (M2(L) − C·d2)/M_s: δg = (δM2 − δC·d2 − C·(ω × d2))/M_s −
-    /// g δM_s/M_s.
+    /// The free tip's [`PlanarEquations::free_tip_rate`], a support's
+    /// [`PlanarEquations::supported_tip_rates`].
     fn tip_residual_parameter(&self, y: &[f64], t: &RodTangent, out: &mut [f64]) {
-        let l = self.rod.length();
-        let kappa = Self::kappa(y[3]);
-        let e = self.rod.energy();
-        let d2 = self.rod.clamp().director(1);
-        let c = &self.rod.loads().tip_couple;
-        let unit = self.rod.residual_scales().moment[1];
-        let dunit = t.residual_scales_rate(&self.rod).moment[1];
-        let g = (e.moment(l, &kappa)[1] - c.dot(&d2)) / unit;
-        let dm = t.energy_rate(e.as_ref(), l, &kappa).moment[1];
-        let dc = t.loads().tip_couple.dot(&d2) + c.dot(&t.clamp_spin().cross(&d2));
-        out[0] = (dm - dc) / unit - g * dunit / unit;
+        match self.rod.support() {
+            Some(support) => out.copy_from_slice(&self.supported_tip_rates(support, y, t)),
+            None => self.free_tip_rate(y, t, out),
+        }
     }
 
     fn state_scales_parameter(&self, t: &RodTangent) -> Vec<f64> {

@@ -5,7 +5,8 @@
 //! A [`RodTangent`] holds dP/dp, dC/dp, df/dp of the dead loads, dL/dp,
 //! the rates dB/dp and dκ⁰/dp of constant bending stiffnesses and
 //! intrinsic curvatures of a quadratic energy W = ½ Σ B_i (κ_i − κ⁰_i)²,
-//! and the clamp's spin ω (d d_i(0)/dp = ω × d_i(0)). Derivatives are taken
+//! the clamp's spin ω (d d_i(0)/dp = ω × d_i(0)), the rate dX/dp of a tip
+//! support's held position and the spin Ω of its held frame. Derivatives are taken
 //! at a fixed fraction σ = s/L of the rod, so a length rate moves every
 //! point of the rod with it.
 
@@ -22,6 +23,8 @@ pub struct RodTangent {
     stiffness: Vector3<f64>,
     intrinsic_curvature: Vector3<f64>,
     clamp_spin: Vector3<f64>,
+    support_shift: Vector3<f64>,
+    support_spin: Vector3<f64>,
 }
 
 /// The rates of the energy's moment M = ∂W/∂κ, stiffness H = ∂²W/∂κ² and
@@ -62,6 +65,8 @@ impl RodTangent {
             stiffness: Vector3::zeros(),
             intrinsic_curvature: Vector3::zeros(),
             clamp_spin: Vector3::zeros(),
+            support_shift: Vector3::zeros(),
+            support_spin: Vector3::zeros(),
         }
     }
 
@@ -102,6 +107,31 @@ impl RodTangent {
         finite("clamp spin", &spin)?;
         self.clamp_spin = spin;
         Ok(self)
+    }
+
+    /// With the rate dX/dp of the tip support's held position (global).
+    pub fn with_support_shift(mut self, shift: Vector3<f64>) -> Result<Self, ModelError> {
+        finite("support shift", &shift)?;
+        self.support_shift = shift;
+        Ok(self)
+    }
+
+    /// With the spin Ω of the tip support's held frame (global):
+    /// d d̂_i/dp = Ω × d̂_i.
+    pub fn with_support_spin(mut self, spin: Vector3<f64>) -> Result<Self, ModelError> {
+        finite("support spin", &spin)?;
+        self.support_spin = spin;
+        Ok(self)
+    }
+
+    /// The spin Ω of the support's held frame.
+    pub fn support_spin(&self) -> &Vector3<f64> {
+        &self.support_spin
+    }
+
+    /// dX/dp of the support's held position.
+    pub fn support_shift(&self) -> &Vector3<f64> {
+        &self.support_shift
     }
 
     /// The load rates.

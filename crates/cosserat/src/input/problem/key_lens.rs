@@ -117,6 +117,15 @@ impl KeyLens {
     }
 }
 
+/// i of a key `prefix[i]`, i < 3.
+fn indexed(key: &str, prefix: &str) -> Option<usize> {
+    let rest = key
+        .strip_prefix(prefix)?
+        .strip_prefix('[')?
+        .strip_suffix(']')?;
+    rest.parse().ok().filter(|i| *i < 3)
+}
+
 impl Lens for KeyLens {
     fn key(&self) -> String {
         self.key.clone()
@@ -127,13 +136,24 @@ impl Lens for KeyLens {
     /// `energy.intrinsic_curvature[i]`, `clamp.angle`: the reader sets the
     /// rod's number to the key's value, so the rod moves as
     /// [`crate::continuation::RodLens`] moves it), the spin of
-    /// `clamp.turn.angle` (the frame turned about the fixed unit axis); None for
-    /// every other key, whose F_p is then a central difference
+    /// `clamp.turn.angle` and `support.turn.angle` (the frame turned about
+    /// the fixed unit axis), the shift of `support.position[i]` (the held
+    /// position, global); None for every other key (a shear stiffness, a
+    /// registered energy's parameter, the support's axes), whose F_p is then a central difference
     /// ([`crate::continuation::Family::derivative_method`]).
     fn tangent(&self, p: f64) -> Option<RodTangent> {
         if self.key == "clamp.turn.angle" {
             let axis = self.turn_axis("clamp.turn.axis")?;
             return RodTangent::zero().with_clamp_spin(axis).ok();
+        }
+        if self.key == "support.turn.angle" {
+            let axis = self.turn_axis("support.turn.axis")?;
+            return RodTangent::zero().with_support_spin(axis).ok();
+        }
+        if let Some(i) = indexed(&self.key, "support.position") {
+            return RodTangent::zero()
+                .with_support_shift(Vector3::ith(i, 1.0))
+                .ok();
         }
         let parameter = Parameter::from_key(&self.key).filter(|q| q.is_file_key())?;
         RodLens::new(self.rod_at(p).ok()?, parameter).tangent(p)
