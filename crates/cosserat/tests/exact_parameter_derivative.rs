@@ -156,6 +156,12 @@ fn check(rod: &Rod, level: ModelLevel, parameters: &[Parameter]) {
             let exact = family.parameter_derivative(&x, p).unwrap();
             let fd = reference(&family, &x, p, h);
             let err = (&exact - &fd).amax();
+            // F_p carried by the integration of F and F_x at (x, p).
+            let n = x.len();
+            let (mut r, mut fx) = (DVector::zeros(n), nalgebra::DMatrix::zeros(n, n));
+            family.residual(&x, p, &mut r, &mut fx).unwrap();
+            let carried = family.parameter_derivative(&x, p).unwrap();
+            let err = err.max((&carried - &fd).amax());
             assert!(
                 err <= 1e-10 * fd.amax(),
                 "{parameter}, {level:?}, {method}: |F_p − reference| = {err:e}, \

@@ -125,7 +125,7 @@ impl<'a> ShootingSystem<'a> {
             let (dy, dphi) = d.split_at_mut(n);
             eq.rhs_linearized(s, &y[..n], cols, &y[n..], dy, dphi);
             if let Some(t) = forcing {
-                eq.rhs_parameter(s, &y[..n], t, &mut fp);
+                eq.rhs_parameter(s, &y[..n], dy, t, &mut fp);
                 let last = &mut dphi[n * (cols - 1)..];
                 last.iter_mut().zip(&fp).for_each(|(a, b)| *a += b);
             }
@@ -281,23 +281,61 @@ impl<'a> ShootingSystem<'a> {
         r: &mut DVector<f64>,
         a: &mut Staircase,
     ) -> Result<(), IntegrationError> {
+        self.evaluate_staircase_forced(x, r, a, None)
+    }
+
+    /// [`ShootingSystem::evaluate_staircase`], and with `forcing` = (t, F_p)
+    /// also F_p of [`ShootingSystem::parameter_derivative`] from the same
+    /// integration: the sensitivity z is one more column of Φ (z(0) =
+    /// ∂y(0)/∂p after the free values' columns, zero after the identity at
+    /// interior nodes), so F, F_x and F_p share one step sequence and F_p
+    /// costs no integration of its own. Only where
+    /// [`ShootingSystem::differentiates`] `t`.
+    pub fn evaluate_staircase_forced(
+        &mut self,
+        x: &[f64],
+        r: &mut DVector<f64>,
+        a: &mut Staircase,
+        mut forcing: Option<(&RodTangent, &mut DVector<f64>)>,
+    ) -> Result<(), IntegrationError> {
         let (n, p, k) = (self.eq.dim(), self.eq.unknowns(), self.segments);
+        let scale_rates = match &forcing {
+            Some((t, _)) => self.eq.state_scales_parameter(t),
+            None => Vec::new(),
+        };
         for j in 0..k {
             let start = self.node_state(x, j);
-            let phi0 = if j == 0 {
+            let seed = if j == 0 {
                 self.eq.initial_sensitivity()
             } else {
                 DMatrix::identity(n, n)
             };
-            let (end, phi) = self.segment(j, &start, &phi0)?;
+            let cols = seed.ncols();
+            let phi0 = match &forcing {
+                None => seed,
+                Some((t, _)) => {
+                    let mut phi0 = seed.insert_column(cols, 0.0);
+                    if j == 0 {
+                        let mut z0 = vec![0.0; n];
+                        self.eq.initial_state_parameter(&x[..p], t, &mut z0);
+                        phi0.column_mut(cols).copy_from_slice(&z0);
+                    }
+                    phi0
+                }
+            };
+            let tangent = forcing.as_ref().map(|(t, _)| *t);
+            let (end, phi) = self.forced_segment(j, &start, &phi0, tangent)?;
             if j + 1 < k {
                 let next = self.node_state(x, j + 1);
                 let block = a.block_mut(j);
                 for i in 0..n {
                     let w = 1.0 / self.scales[i];
                     r[n * j + i] = (end[i] - next[i]) * w;
-                    for c in 0..phi.ncols() {
+                    for c in 0..cols {
                         block[(i, c)] = phi[(i, c)] * w;
+                    }
+                    if let Some((_, fp)) = forcing.as_mut() {
+                        fp[n * j + i] = (phi[(i, cols)] - r[n * j + i] * scale_rates[i]) * w;
                     }
                 }
                 for (d, s) in a.coupling_mut(j).iter_mut().zip(&self.scales) {
@@ -310,7 +348,14 @@ impl<'a> ShootingSystem<'a> {
                 for i in 0..p {
                     r[n * (k - 1) + i] = g[i];
                 }
-                a.block_mut(j).copy_from(&gj);
+                a.block_mut(j).copy_from(&gj.columns(0, cols));
+                if let Some((t, fp)) = forcing.as_mut() {
+                    let mut gp = vec![0.0; p];
+                    self.eq.tip_residual_parameter(&end, t, &mut gp);
+                    for i in 0..p {
+                        fp[n * (k - 1) + i] = gj[(i, cols)] + gp[i];
+                    }
+                }
             }
         }
         Ok(())

@@ -18,7 +18,6 @@ use nalgebra::{DMatrix, DVector, Matrix3};
 
 use super::lens::{Lens, Parameter, RodLens};
 
-use crate::bvp::newton::NonlinearSystem;
 use crate::bvp::{equations, ShootingSystem};
 use crate::equations::RodSample;
 use crate::model::{ModelLevel, Rod};
@@ -44,6 +43,68 @@ pub struct Family {
     tolerances: Tolerances,
     /// The unknowns' scales, computed once ([`Family::cached_weights`]).
     weights: std::sync::OnceLock<Vec<f64>>,
+    /// The exact F_p of the last residual evaluation.
+    last_fp: DerivativeCache,
+}
+
+/// The exact F_p integrated with the last F and F_x ([`Family::residual`],
+/// [`Family::residual_staircase`]) at (x, p), so that
+/// [`Family::parameter_derivative`] at the same point — the corrector's
+/// bordering column, the tangent at a converged point — costs no
+/// integration. A clone starts empty (another family's lens may differ).
+#[derive(Debug, Default)]
+struct DerivativeCache(std::sync::Mutex<Option<CachedDerivative>>);
+
+#[derive(Debug)]
+struct CachedDerivative {
+    x: Vec<f64>,
+    p: f64,
+    fp: DVector<f64>,
+}
+
+impl Clone for DerivativeCache {
+    fn clone(&self) -> Self {
+        DerivativeCache::default()
+    }
+}
+
+impl DerivativeCache {
+    fn lock(&self) -> std::sync::MutexGuard<'_, Option<CachedDerivative>> {
+        // A panic while the entry was written leaves at worst a stale
+        // entry of another point, which the key comparison rejects.
+        self.0
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
+
+    /// F_p at exactly (x, p), if the last evaluation was there.
+    fn get(&self, x: &[f64], p: f64) -> Option<DVector<f64>> {
+        let entry = self.lock();
+        let e = entry.as_ref()?;
+        (e.p.to_bits() == p.to_bits()
+            && e.x.len() == x.len()
+            && e.x.iter().zip(x).all(|(a, b)| a.to_bits() == b.to_bits()))
+        .then(|| e.fp.clone())
+    }
+
+    /// Keeps F_p at (x, p), reusing the entry's buffers.
+    fn put(&self, x: &[f64], p: f64, fp: &DVector<f64>) {
+        let mut entry = self.lock();
+        match entry.as_mut() {
+            Some(e) if e.x.len() == x.len() && e.fp.len() == fp.len() => {
+                e.x.copy_from_slice(x);
+                e.p = p;
+                e.fp.copy_from(fp);
+            }
+            _ => {
+                *entry = Some(CachedDerivative {
+                    x: x.to_vec(),
+                    p,
+                    fp: fp.clone(),
+                });
+            }
+        }
+    }
 }
 
 /// Why a rod could not be built at a parameter value.
@@ -125,6 +186,7 @@ impl Family {
             stages: None,
             tolerances,
             weights: std::sync::OnceLock::new(),
+            last_fp: DerivativeCache::default(),
         }
     }
 
@@ -298,9 +360,34 @@ impl Family {
         let rod = self.rod_at(p)?;
         let eq = equations(&rod, self.level);
         let mut sys = self.system(eq.as_ref());
-        sys.evaluate(&self.unscaled(x), r, jac)?;
+        let mut a = sys.staircase();
+        self.evaluate_with_derivative(&mut sys, x, p, r, &mut a)?;
+        a.write_dense(jac);
         for (mut column, w) in jac.column_iter_mut().zip(self.cached_weights()) {
             column *= *w;
+        }
+        Ok(())
+    }
+
+    /// F and F_x (raw unknowns' columns) into `r`, `a`; with the exact F_p
+    /// from the same integration kept for [`Family::parameter_derivative`]
+    /// where the lens gives a tangent the equations differentiate.
+    fn evaluate_with_derivative(
+        &self,
+        sys: &mut ShootingSystem,
+        x: &[f64],
+        p: f64,
+        r: &mut DVector<f64>,
+        a: &mut Staircase,
+    ) -> Result<(), PointError> {
+        let raw = self.unscaled(x);
+        match self.lens.tangent(p).filter(|t| sys.differentiates(t)) {
+            Some(t) => {
+                let mut fp = DVector::zeros(x.len());
+                sys.evaluate_staircase_forced(&raw, r, a, Some((&t, &mut fp)))?;
+                self.last_fp.put(x, p, &fp);
+            }
+            None => sys.evaluate_staircase(&raw, r, a)?,
         }
         Ok(())
     }
@@ -330,17 +417,22 @@ impl Family {
         let rod = self.rod_at(p)?;
         let eq = equations(&rod, self.level);
         let mut sys = self.system(eq.as_ref());
-        sys.evaluate_staircase(&self.unscaled(x), r, jac)?;
+        self.evaluate_with_derivative(&mut sys, x, p, r, jac)?;
         jac.scale_columns(self.cached_weights());
         Ok(())
     }
 
     /// F_p = ∂F/∂p at (x, p): exact by the sensitivity equations
-    /// ([`ShootingSystem::parameter_derivative`]) where the lens gives its
+    /// ([`ShootingSystem::parameter_derivative`]; free when F and F_x were
+    /// just evaluated at (x, p), whose integration carried it) where the
+    /// lens gives its
     /// [`crate::model::RodTangent`] and the equations differentiate it,
     /// otherwise by [`Family::central_difference`]; which one is
     /// [`Family::derivative_method`].
     pub fn parameter_derivative(&self, x: &[f64], p: f64) -> Result<DVector<f64>, PointError> {
+        if let Some(fp) = self.last_fp.get(x, p) {
+            return Ok(fp);
+        }
         if let Some(t) = self.lens.tangent(p) {
             let rod = self.rod_at(p)?;
             let eq = equations(&rod, self.level);

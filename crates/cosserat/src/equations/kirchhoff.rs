@@ -404,13 +404,12 @@ impl RodEquations for KirchhoffEquations {
     /// (L'/L) f, plus the balance H κ' = M × κ + N × ν − ∂sM moved at
     /// fixed y: δκ' = H⁻¹ (δM × κ + δN × ν + N × δν − δ∂sM − δH κ'),
     /// δN_i = δn·d_i, δν = c∘δN, and δr' = δν_i d_i.
-    fn rhs_parameter(&self, s: f64, y: &[f64], t: &RodTangent, out: &mut [f64]) {
+    fn rhs_parameter(&self, s: f64, y: &[f64], f: &[f64], t: &RodTangent, out: &mut [f64]) {
         let st = State::read(y);
         let b = self.balance(s, &st);
-        Self::write_rates(&st, &b, out);
         let stretch = t.length() / self.rod.length();
-        for v in out.iter_mut() {
-            *v *= stretch;
+        for (o, v) in out.iter_mut().zip(f) {
+            *o = v * stretch;
         }
         let dn = t.internal_force_rate(&self.rod, s);
         let body_n = Vector3::new(b.n.dot(&st.d1), b.n.dot(&st.d2), b.n.dot(&st.d3));

@@ -96,12 +96,13 @@ pub trait RodEquations: Send + Sync {
     fn differentiates(&self, _t: &RodTangent) -> bool {
         false
     }
-    /// ∂f/∂p at (s, y): the explicit dependence of the right-hand side on
-    /// p at a fixed fraction σ = s/L, so that z = ∂y/∂p|σ obeys the
-    /// sensitivity equation z' = f_y z + ∂f/∂p. With s = Lσ a length rate
-    /// L' contributes (L'/L) (f + s ∂sf) + L' ∂Lf. Only called where
-    /// [`RodEquations::differentiates`] `t`; NaN otherwise.
-    fn rhs_parameter(&self, _s: f64, _y: &[f64], _t: &RodTangent, out: &mut [f64]) {
+    /// ∂f/∂p at (s, y), given f = f(s, y) there: the explicit dependence
+    /// of the right-hand side on p at a fixed fraction σ = s/L, so that
+    /// z = ∂y/∂p|σ obeys the sensitivity equation z' = f_y z + ∂f/∂p. With
+    /// s = Lσ a length rate L' contributes (L'/L) (f + s ∂sf) + L' ∂Lf.
+    /// Only called where [`RodEquations::differentiates`] `t`; NaN
+    /// otherwise.
+    fn rhs_parameter(&self, _s: f64, _y: &[f64], _f: &[f64], _t: &RodTangent, out: &mut [f64]) {
         out.fill(f64::NAN);
     }
     /// ∂y(0)/∂p at fixed free values u (the clamp's spin turns the

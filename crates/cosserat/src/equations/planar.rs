@@ -67,9 +67,9 @@ impl PlanarEquations {
         )
     }
 
-    /// (κ2', ∂κ2'/∂φ, ∂κ2'/∂κ2) at (s, y); ∂κ2'/∂(R_x, R_z) =
-    /// (−cos φ, sin φ)/H22.
-    fn curvature_rate(&self, s: f64, y: &[f64]) -> (f64, f64, f64) {
+    /// κ2' at (s, y) with the pieces its linearization and p-derivative
+    /// share; ∂κ2'/∂(R_x, R_z) = (−cos φ, sin φ)/H22.
+    fn curvature_rate(&self, s: f64, y: &[f64]) -> Curving {
         let (phi, k2) = (y[2], y[3]);
         let e = &self.rod.energy();
         let kappa = Self::kappa(k2);
@@ -78,11 +78,36 @@ impl PlanarEquations {
         let n1 = nx * cos - nz * sin;
         let h22 = e.stiffness(s, &kappa)[(1, 1)];
         let rate = (-n1 - e.moment_rate(s, &kappa)[1]) / h22;
-        let dn1 = -nx * sin - nz * cos;
-        let t22 = e.stiffness_derivative(s, &kappa, &Self::kappa(rate))[(1, 1)];
-        let hs22 = e.stiffness_rate(s, &kappa)[(1, 1)];
-        (rate, -dn1 / h22, -(hs22 + t22) / h22)
+        Curving {
+            rate,
+            sin,
+            cos,
+            h22,
+            nx,
+            nz,
+        }
     }
+
+    /// (∂κ2'/∂φ, ∂κ2'/∂κ2) at (s, y) given its [`Curving`].
+    fn curvature_rate_slopes(&self, s: f64, y: &[f64], c: &Curving) -> (f64, f64) {
+        let e = &self.rod.energy();
+        let kappa = Self::kappa(y[3]);
+        let dn1 = -c.nx * c.sin - c.nz * c.cos;
+        let t22 = e.stiffness_derivative(s, &kappa, &Self::kappa(c.rate))[(1, 1)];
+        let hs22 = e.stiffness_rate(s, &kappa)[(1, 1)];
+        (-dn1 / c.h22, -(hs22 + t22) / c.h22)
+    }
+}
+
+/// κ2' and what it was computed from: sin φ, cos φ, H22 and the in-plane
+/// force (n_x, n_z).
+struct Curving {
+    rate: f64,
+    sin: f64,
+    cos: f64,
+    h22: f64,
+    nx: f64,
+    nz: f64,
 }
 
 impl PlanarEquations {
@@ -274,11 +299,11 @@ impl RodEquations for PlanarEquations {
     }
 
     fn rhs(&self, s: f64, y: &[f64], dy: &mut [f64]) {
-        let (sin, cos) = y[2].sin_cos();
-        dy[0] = sin;
-        dy[1] = cos;
+        let c = self.curvature_rate(s, y);
+        dy[0] = c.sin;
+        dy[1] = c.cos;
         dy[2] = y[3];
-        dy[3] = self.curvature_rate(s, y).0;
+        dy[3] = c.rate;
         dy[4..].fill(0.0);
     }
 
@@ -291,12 +316,12 @@ impl RodEquations for PlanarEquations {
         dy: &mut [f64],
         dphi: &mut [f64],
     ) {
-        let (sin, cos) = y[2].sin_cos();
-        let (rate, d_phi, d_k2) = self.curvature_rate(s, y);
-        dy[..4].copy_from_slice(&[sin, cos, y[3], rate]);
+        let c = self.curvature_rate(s, y);
+        let (d_phi, d_k2) = self.curvature_rate_slopes(s, y, &c);
+        let (sin, cos, h22) = (c.sin, c.cos, c.h22);
+        dy[..4].copy_from_slice(&[sin, cos, y[3], c.rate]);
         dy[4..].fill(0.0);
         let n = self.dim();
-        let h22 = self.rod.energy().stiffness(s, &Self::kappa(y[3]))[(1, 1)];
         for c in 0..cols {
             let v = &phi[n * c..n * (c + 1)];
             let out = &mut dphi[n * c..n * (c + 1)];
@@ -420,11 +445,10 @@ impl RodEquations for PlanarEquations {
     /// (L'/L) f, plus κ2' = (−N1 − ∂sM2)/H22 moved at fixed (φ, κ2):
     /// δκ2' = (−δN1 − δ∂sM2 − δH22 κ2')/H22 with δN1 = δn_x cos φ −
     /// δn_z sin φ, δn_x = δn·d1(0) + n·(ω × d1(0)) (likewise z).
-    fn rhs_parameter(&self, s: f64, y: &[f64], t: &RodTangent, out: &mut [f64]) {
-        self.rhs(s, y, out);
+    fn rhs_parameter(&self, s: f64, y: &[f64], f: &[f64], t: &RodTangent, out: &mut [f64]) {
         let stretch = t.length() / self.rod.length();
-        for v in out.iter_mut() {
-            *v *= stretch;
+        for (o, v) in out.iter_mut().zip(f) {
+            *o = v * stretch;
         }
         let c = self.rod.clamp();
         let (ex, ez) = (c.director(0), c.director(2));
@@ -435,10 +459,9 @@ impl RodEquations for PlanarEquations {
         let w = t.clamp_spin();
         let dnx = dn.dot(&ex) + n.dot(&w.cross(&ex));
         let dnz = dn.dot(&ez) + n.dot(&w.cross(&ez));
-        let (sin, cos) = y[2].sin_cos();
+        let (sin, cos, rate) = (f[0], f[1], f[3]);
         let kappa = Self::kappa(y[3]);
         let e = self.rod.energy();
-        let rate = self.curvature_rate(s, y).0;
         let de = t.energy_rate(e.as_ref(), s, &kappa);
         let h22 = e.stiffness(s, &kappa)[(1, 1)];
         out[3] +=

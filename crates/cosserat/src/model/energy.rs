@@ -116,6 +116,9 @@ pub enum ProfileKind {
 pub struct LinearElastic {
     stiffness: [Profile; 3],
     intrinsic_curvature: [Profile; 3],
+    /// (B, κ⁰) when every profile is a constant, read once: the energy's
+    /// values sit in the innermost loop of every integration.
+    uniform: Option<(Vector3<f64>, Vector3<f64>)>,
 }
 
 impl LinearElastic {
@@ -147,9 +150,21 @@ impl LinearElastic {
         if let Some(index) = intrinsic_curvature.iter().position(|k| !k.is_finite()) {
             return Err(ModelError::IntrinsicCurvature { index });
         }
+        let constant = |p: &[Profile; 3]| -> Option<Vector3<f64>> {
+            let mut v = Vector3::zeros();
+            for (i, profile) in p.iter().enumerate() {
+                let Profile::Constant(c) = profile else {
+                    return None;
+                };
+                v[i] = *c;
+            }
+            Some(v)
+        };
+        let uniform = constant(&stiffness).zip(constant(&intrinsic_curvature));
         Ok(LinearElastic {
             stiffness,
             intrinsic_curvature,
+            uniform,
         })
     }
 
@@ -170,6 +185,9 @@ impl LinearElastic {
     }
 
     fn b(&self, s: f64) -> Vector3<f64> {
+        if let Some((b, _)) = self.uniform {
+            return b;
+        }
         Vector3::from_fn(|i, _| self.stiffness[i].value(s))
     }
 
@@ -179,6 +197,9 @@ impl LinearElastic {
 
     /// κ⁰(s).
     pub fn kappa0(&self, s: f64) -> Vector3<f64> {
+        if let Some((_, k0)) = self.uniform {
+            return k0;
+        }
         Vector3::from_fn(|i, _| self.intrinsic_curvature[i].value(s))
     }
 
@@ -190,10 +211,7 @@ impl LinearElastic {
     /// so its s-derivatives vanish without evaluating six profiles (a fast
     /// path: they sit in the innermost loop of every integration).
     fn is_uniform(&self) -> bool {
-        self.stiffness
-            .iter()
-            .chain(&self.intrinsic_curvature)
-            .all(|p| matches!(p, Profile::Constant(_)))
+        self.uniform.is_some()
     }
 }
 
