@@ -392,7 +392,7 @@ impl RodEquations for KirchhoffEquations {
     }
 
     /// A tangent whose energy rates are exact for this rod, and a support
-    /// whose motion [`super::tip::condition_rates`] covers.
+    /// whose motion the support conditions' rates (`tip.rs`) cover.
     fn differentiates(&self, t: &RodTangent) -> bool {
         t.fits(&self.rod)
             && self
@@ -435,8 +435,8 @@ impl RodEquations for KirchhoffEquations {
     }
 
     /// g_i = (M_i(L) − C·d_i)/M_s,i: δg_i = (δM_i − δC·d_i)/M_s,i −
-    /// g_i δM_s,i/M_s,i; a support's conditions by
-    /// [`super::tip::condition_rates`].
+    /// g_i δM_s,i/M_s,i; a support's conditions by their rates in
+    /// `tip.rs` (`condition_rates`).
     fn tip_residual_parameter(&self, y: &[f64], t: &RodTangent, out: &mut [f64]) {
         let st = State::read(y);
         let l = self.rod.length();

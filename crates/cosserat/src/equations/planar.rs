@@ -482,8 +482,8 @@ impl RodEquations for PlanarEquations {
         }
     }
 
-    /// The free tip's [`PlanarEquations::free_tip_rate`], a support's
-    /// [`PlanarEquations::supported_tip_rates`].
+    /// The free tip's rate (`free_tip_rate`), a support's row by row
+    /// (`supported_tip_rates`).
     fn tip_residual_parameter(&self, y: &[f64], t: &RodTangent, out: &mut [f64]) {
         match self.rod.support() {
             Some(support) => out.copy_from_slice(&self.supported_tip_rates(support, y, t)),
