@@ -152,13 +152,12 @@ pub(crate) fn gauss_step(
     let stages = stage_states(tab, h, y0, &k);
     let jac = stage_jacobians(eq, tab, s, h, &stages);
     let mut rhs = DMatrix::zeros(m * n, cols);
-    let (mut f, mut fp) = (vec![0.0; n], vec![0.0; n]);
+    let mut fp = vec![0.0; n];
     for (i, ji) in jac.iter().enumerate() {
         rhs.view_mut((i * n, 0), (n, cols)).copy_from(&(ji * phi0));
         if let Some(t) = forcing {
-            let si = s + tab.c[i] * h;
-            eq.rhs(si, &stages[i], &mut f);
-            eq.rhs_parameter(si, &stages[i], &f, t, &mut fp);
+            // K_i = f(s_i, Y_i) to the stage Newton's 1e-15.
+            eq.rhs_parameter(s + tab.c[i] * h, &stages[i], &k[i], t, &mut fp);
             for (r, v) in fp.iter().enumerate() {
                 rhs[(i * n + r, cols - 1)] += v;
             }

@@ -217,6 +217,8 @@ impl Family {
         );
         Family {
             stages: Some(stages),
+            // Another discretization: no F_p of the old one is reused.
+            last_fp: DerivativeCache::default(),
             ..self
         }
     }
