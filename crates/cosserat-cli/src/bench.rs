@@ -105,6 +105,12 @@ fn continue_diagram(path: &Path, set: &[String], repeat: usize) -> ExitCode {
     let diagram = last.expect("at least the warm-up run");
     times.sort_by(f64::total_cmp);
     println!("problem   {}", path.display());
+    if let Ok(method) = family.derivative_method(opts.start) {
+        println!(
+            "F_p       {}",
+            crate::continue_command::derivative_line(method)
+        );
+    }
     println!(
         "time      median {:.3} ms, min {:.3} ms, max {:.3} ms over {repeat} runs (after 1 warm-up)",
         median(times.clone()) * 1e3,

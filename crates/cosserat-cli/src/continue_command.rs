@@ -139,6 +139,10 @@ pub fn run_continue(args: &ContinueArgs) -> ExitCode {
     if let Some(stored) = &stored {
         println!("from      {}", stored.summary);
     }
+    // A rod refused at the start is the run's error, reported below.
+    if let Ok(method) = family.derivative_method(opts.start) {
+        println!("F_p       {}", derivative_line(method));
+    }
     let bar = Meter::spinner();
     let start = Instant::now();
     let run = Run {
@@ -353,6 +357,19 @@ pub fn run_plot(diagram: &Path, measure: &str, output: &Path, force: bool) -> Ex
             ExitCode::SUCCESS
         }
         Err(e) => fail(OUTPUT, e),
+    }
+}
+
+/// How ∂F/∂p is computed, as the run header says it: a central
+/// difference is named with its cost in accuracy, never passed off as exact.
+pub(crate) fn derivative_line(method: cosserat::continuation::DerivativeMethod) -> String {
+    use cosserat::continuation::DerivativeMethod;
+    match method {
+        DerivativeMethod::Exact => method.to_string(),
+        DerivativeMethod::CentralDifference => format!(
+            "{method} (h = 1e-4 max(1, |p|): no exact derivative of this parameter on this rod; \
+             tangents and located folds carry its ~1e-8 relative truncation error)"
+        ),
     }
 }
 

@@ -15,6 +15,7 @@ use nalgebra::{DMatrix, DVector};
 
 use super::collocation::Tableau;
 use crate::equations::RodEquations;
+use crate::model::RodTangent;
 use crate::numerics::integrator::IntegrationError;
 
 /// The stage Jacobians J_i = ∂f/∂y (n × n each) at the stage states.
@@ -73,6 +74,13 @@ fn stage_states(tab: &Tableau, h: f64, y0: &[f64], k: &[Vec<f64>]) -> Vec<Vec<f6
 
 /// y(s + h) and Φ(s + h) = ∂y(s + h)/∂(unknowns) from y0 and Φ0 (n × cols,
 /// cols may be 0) by one Gauss step.
+///
+/// With `forcing`, the last column of Φ is the parameter sensitivity
+/// z = ∂y/∂p at fixed σ = s/L: its stage equations gain the explicit
+/// ∂f/∂p ([`RodEquations::rhs_parameter`]), (I − h A ⊗ J) dK =
+/// (J_i z0 + ∂f/∂p(s_i, Y_i))_i. A Gauss step on s = Lσ with h = L/K is
+/// the same step on σ with 1/K, so this is the exact p-derivative of the
+/// discrete step, a length rate included.
 pub(crate) fn gauss_step(
     eq: &dyn RodEquations,
     tab: &Tableau,
@@ -80,6 +88,7 @@ pub(crate) fn gauss_step(
     h: f64,
     y0: &[f64],
     phi0: &DMatrix<f64>,
+    forcing: Option<&RodTangent>,
 ) -> Result<(Vec<f64>, DMatrix<f64>), IntegrationError> {
     let (m, n) = (tab.m, eq.dim());
     let mut f0 = vec![0.0; n];
@@ -143,8 +152,16 @@ pub(crate) fn gauss_step(
     let stages = stage_states(tab, h, y0, &k);
     let jac = stage_jacobians(eq, tab, s, h, &stages);
     let mut rhs = DMatrix::zeros(m * n, cols);
+    let mut fp = vec![0.0; n];
     for (i, ji) in jac.iter().enumerate() {
         rhs.view_mut((i * n, 0), (n, cols)).copy_from(&(ji * phi0));
+        if let Some(t) = forcing {
+            // K_i = f(s_i, Y_i) to the stage Newton's 1e-15.
+            eq.rhs_parameter(s + tab.c[i] * h, &stages[i], &k[i], t, &mut fp);
+            for (r, v) in fp.iter().enumerate() {
+                rhs[(i * n + r, cols - 1)] += v;
+            }
+        }
     }
     let Some(dk) = stage_matrix(tab, h, &jac).lu().solve(&rhs) else {
         return Err(IntegrationError::StepSizeUnderflow { s });
@@ -186,14 +203,14 @@ mod tests {
         let mut y0 = vec![0.0; 12];
         eq.initial_state(&[0.2, -0.5, 0.1], &mut y0);
         let (h, s) = (0.125, 0.25);
-        let (_, phi) = gauss_step(&eq, &tab, s, h, &y0, &DMatrix::identity(12, 12)).unwrap();
+        let (_, phi) = gauss_step(&eq, &tab, s, h, &y0, &DMatrix::identity(12, 12), None).unwrap();
         let none = DMatrix::zeros(12, 0);
         for j in 0..12 {
             let (mut a, mut b) = (y0.clone(), y0.clone());
             a[j] += 1e-6;
             b[j] -= 1e-6;
-            let ya = gauss_step(&eq, &tab, s, h, &a, &none).unwrap().0;
-            let yb = gauss_step(&eq, &tab, s, h, &b, &none).unwrap().0;
+            let ya = gauss_step(&eq, &tab, s, h, &a, &none, None).unwrap().0;
+            let yb = gauss_step(&eq, &tab, s, h, &b, &none, None).unwrap().0;
             for i in 0..12 {
                 let fd = (ya[i] - yb[i]) / 2e-6;
                 assert!(

@@ -16,6 +16,7 @@ use super::collocation::Tableau;
 use super::gauss_step::gauss_step;
 use super::newton::NonlinearSystem;
 use crate::equations::{RodEquations, RodSample};
+use crate::model::RodTangent;
 use crate::numerics::integrator::{Dop853, IntegrationError, IntegrationStats, Stops, Tolerances};
 use crate::numerics::staircase::Staircase;
 
@@ -95,20 +96,39 @@ impl<'a> ShootingSystem<'a> {
         start: &[f64],
         phi0: &DMatrix<f64>,
     ) -> Result<(Vec<f64>, DMatrix<f64>), IntegrationError> {
+        self.forced_segment(j, start, phi0, None)
+    }
+
+    /// [`ShootingSystem::segment`], with `forcing` the last column the
+    /// parameter sensitivity z' = f_y z + ∂f/∂p
+    /// ([`RodEquations::rhs_parameter`]).
+    fn forced_segment(
+        &mut self,
+        j: usize,
+        start: &[f64],
+        phi0: &DMatrix<f64>,
+        forcing: Option<&RodTangent>,
+    ) -> Result<(Vec<f64>, DMatrix<f64>), IntegrationError> {
         let n = self.eq.dim();
         if let Some(tab) = &self.gauss {
             let (a, b) = (self.node(j), self.node(j + 1));
             self.stats.accepted += 1;
-            return gauss_step(self.eq, tab, a, b - a, start, phi0);
+            return gauss_step(self.eq, tab, a, b - a, start, phi0, forcing);
         }
         let cols = phi0.ncols();
         let mut y = Vec::with_capacity(n * (cols + 1));
         y.extend_from_slice(start);
         y.extend_from_slice(phi0.as_slice());
         let eq = self.eq;
+        let mut fp = vec![0.0; if forcing.is_some() { n } else { 0 }];
         let rhs = |s: f64, y: &[f64], d: &mut [f64]| {
             let (dy, dphi) = d.split_at_mut(n);
             eq.rhs_linearized(s, &y[..n], cols, &y[n..], dy, dphi);
+            if let Some(t) = forcing {
+                eq.rhs_parameter(s, &y[..n], dy, t, &mut fp);
+                let last = &mut dphi[n * (cols - 1)..];
+                last.iter_mut().zip(&fp).for_each(|(a, b)| *a += b);
+            }
         };
         let (a, b) = (self.node(j), self.node(j + 1));
         // Error control covers the sensitivities too (CVODES' "full" error
@@ -261,23 +281,61 @@ impl<'a> ShootingSystem<'a> {
         r: &mut DVector<f64>,
         a: &mut Staircase,
     ) -> Result<(), IntegrationError> {
+        self.evaluate_staircase_forced(x, r, a, None)
+    }
+
+    /// [`ShootingSystem::evaluate_staircase`], and with `forcing` = (t, F_p)
+    /// also F_p of [`ShootingSystem::parameter_derivative`] from the same
+    /// integration: the sensitivity z is one more column of Φ (z(0) =
+    /// ∂y(0)/∂p after the free values' columns, zero after the identity at
+    /// interior nodes), so F, F_x and F_p share one step sequence and F_p
+    /// costs no integration of its own. Only where
+    /// [`ShootingSystem::differentiates`] `t`.
+    pub fn evaluate_staircase_forced(
+        &mut self,
+        x: &[f64],
+        r: &mut DVector<f64>,
+        a: &mut Staircase,
+        mut forcing: Option<(&RodTangent, &mut DVector<f64>)>,
+    ) -> Result<(), IntegrationError> {
         let (n, p, k) = (self.eq.dim(), self.eq.unknowns(), self.segments);
+        let scale_rates = match &forcing {
+            Some((t, _)) => self.eq.state_scales_parameter(t),
+            None => Vec::new(),
+        };
         for j in 0..k {
             let start = self.node_state(x, j);
-            let phi0 = if j == 0 {
+            let seed = if j == 0 {
                 self.eq.initial_sensitivity()
             } else {
                 DMatrix::identity(n, n)
             };
-            let (end, phi) = self.segment(j, &start, &phi0)?;
+            let cols = seed.ncols();
+            let phi0 = match &forcing {
+                None => seed,
+                Some((t, _)) => {
+                    let mut phi0 = seed.insert_column(cols, 0.0);
+                    if j == 0 {
+                        let mut z0 = vec![0.0; n];
+                        self.eq.initial_state_parameter(&x[..p], t, &mut z0);
+                        phi0.column_mut(cols).copy_from_slice(&z0);
+                    }
+                    phi0
+                }
+            };
+            let tangent = forcing.as_ref().map(|(t, _)| *t);
+            let (end, phi) = self.forced_segment(j, &start, &phi0, tangent)?;
             if j + 1 < k {
                 let next = self.node_state(x, j + 1);
                 let block = a.block_mut(j);
                 for i in 0..n {
                     let w = 1.0 / self.scales[i];
                     r[n * j + i] = (end[i] - next[i]) * w;
-                    for c in 0..phi.ncols() {
+                    for c in 0..cols {
                         block[(i, c)] = phi[(i, c)] * w;
+                    }
+                    if let Some((_, fp)) = forcing.as_mut() {
+                        fp[n * j + i] = (phi[(i, cols)] - r[n * j + i] * scale_rates[i]) * w;
                     }
                 }
                 for (d, s) in a.coupling_mut(j).iter_mut().zip(&self.scales) {
@@ -290,7 +348,63 @@ impl<'a> ShootingSystem<'a> {
                 for i in 0..p {
                     r[n * (k - 1) + i] = g[i];
                 }
-                a.block_mut(j).copy_from(&gj);
+                a.block_mut(j).copy_from(&gj.columns(0, cols));
+                if let Some((t, fp)) = forcing.as_mut() {
+                    let mut gp = vec![0.0; p];
+                    self.eq.tip_residual_parameter(&end, t, &mut gp);
+                    for i in 0..p {
+                        fp[n * (k - 1) + i] = gj[(i, cols)] + gp[i];
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether [`ShootingSystem::parameter_derivative`] is exact for the
+    /// rod moving along `t` ([`RodEquations::differentiates`]).
+    pub fn differentiates(&self, t: &RodTangent) -> bool {
+        self.eq.differentiates(t)
+    }
+
+    /// F_p = ∂r/∂p at fixed unknowns x for the rod moving along `t`, by the
+    /// sensitivity equations: on each segment z' = f_y z + ∂f/∂p with
+    /// z(s_0) = ∂y(0)/∂p on the first segment (the clamp's motion) and
+    /// z(s_j) = 0 at the interior nodes (unknowns, fixed); matching rows
+    /// ((Y_j − y_{j+1})/w)_p = z/w − r w_p/w, tip rows g_y z + g_p. One
+    /// integration of 2n equations instead of a difference's two of n,
+    /// and exact: no step h, no truncation error. Only where
+    /// [`ShootingSystem::differentiates`] `t`.
+    pub fn parameter_derivative(
+        &mut self,
+        x: &[f64],
+        t: &RodTangent,
+        fp: &mut DVector<f64>,
+    ) -> Result<(), IntegrationError> {
+        let (n, p, k) = (self.eq.dim(), self.eq.unknowns(), self.segments);
+        let scale_rates = self.eq.state_scales_parameter(t);
+        for j in 0..k {
+            let start = self.node_state(x, j);
+            let mut z0 = DMatrix::zeros(n, 1);
+            if j == 0 {
+                self.eq
+                    .initial_state_parameter(&x[..p], t, z0.as_mut_slice());
+            }
+            let (end, z) = self.forced_segment(j, &start, &z0, Some(t))?;
+            if j + 1 < k {
+                let next = self.node_state(x, j + 1);
+                for i in 0..n {
+                    let w = self.scales[i];
+                    let r = (end[i] - next[i]) / w;
+                    fp[n * j + i] = z[(i, 0)] / w - r * scale_rates[i] / w;
+                }
+            } else {
+                let mut gp = vec![0.0; p];
+                self.eq.tip_residual_parameter(&end, t, &mut gp);
+                let gz = self.eq.tip_residual_jacobian(&end) * &z;
+                for i in 0..p {
+                    fp[n * (k - 1) + i] = gz[(i, 0)] + gp[i];
+                }
             }
         }
         Ok(())

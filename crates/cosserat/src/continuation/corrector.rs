@@ -240,14 +240,19 @@ impl System for FixedParameter<'_> {
 /// so that the second row is Keller's (1977) arclength constraint
 /// ⟨x − x₀, ẋ₀⟩ + (p − p₀)ṗ₀ − Δs = 0. Its Jacobian is the bordered matrix
 /// [F_x F_p; τᵀ], regular at folds where F_x alone is singular, with F_p
-/// taken once at the predictor (a chord in the parameter column). The
+/// taken once at the predictor (a chord in the parameter column), when
+/// the first Newton step linearizes there: an exact F_p then comes with
+/// that evaluation's integration ([`Family::parameter_derivative`]). The
 /// constraint row is linear, so one step satisfies it to round-off; it is
 /// measured against an absolute 1e-13 (its residual scale is 1e-13/τ).
 struct PseudoArclength<'a> {
     family: &'a Family,
     pred: &'a [f64],
     tangent: &'a [f64],
-    fp: DVector<f64>,
+    /// F_p at the predictor, from the first linearization.
+    fp: Option<DVector<f64>>,
+    /// Why F_p could not be had (the corrector's error).
+    failure: Option<PointError>,
     tolerance: f64,
     r: DVector<f64>,
     /// F_x at the last evaluated point (the corrected one on success).
@@ -257,19 +262,14 @@ struct PseudoArclength<'a> {
 }
 
 impl<'a> PseudoArclength<'a> {
-    fn new(
-        family: &'a Family,
-        pred: &'a [f64],
-        tangent: &'a [f64],
-        fp: DVector<f64>,
-        tolerance: f64,
-    ) -> Self {
+    fn new(family: &'a Family, pred: &'a [f64], tangent: &'a [f64], tolerance: f64) -> Self {
         let n = pred.len() - 1;
         PseudoArclength {
             family,
             pred,
             tangent,
-            fp,
+            fp: None,
+            failure: None,
             tolerance,
             r: DVector::zeros(n),
             fx: Linearization::of(family),
@@ -300,26 +300,35 @@ impl System for PseudoArclength<'_> {
         Ok(())
     }
 
-    fn linearize(&mut self, _z: &[f64]) -> bool {
+    fn linearize(&mut self, z: &[f64]) -> bool {
         let n = self.r.len();
+        if self.fp.is_none() {
+            match self.family.parameter_derivative(&z[..n], z[n]) {
+                Ok(fp) => self.fp = Some(fp),
+                Err(e) => {
+                    self.failure = Some(e);
+                    return false;
+                }
+            }
+        }
+        let Some(fp) = &self.fp else {
+            return false;
+        };
         let (row, corner) = self.tangent.split_at(n);
         self.bordered
-            .factor(&self.fx, self.fp.as_slice(), row, corner[0]);
+            .factor(&self.fx, fp.as_slice(), row, corner[0]);
         true
     }
 
     fn solve(&mut self, f: &[f64], delta: &mut [f64]) -> bool {
         let n = self.r.len();
+        let Some(fp) = &self.fp else {
+            return false;
+        };
         self.rhs.iter_mut().zip(f).for_each(|(r, v)| *r = -v);
         let (row, corner) = self.tangent.split_at(n);
-        self.bordered.solve(
-            &self.fx,
-            self.fp.as_slice(),
-            row,
-            corner[0],
-            &self.rhs,
-            delta,
-        )
+        self.bordered
+            .solve(&self.fx, fp.as_slice(), row, corner[0], &self.rhs, delta)
     }
 
     fn residual_scales(&self) -> Vec<f64> {
@@ -410,17 +419,22 @@ impl Run<'_> {
         pred: &[f64],
         tangent: &[f64],
     ) -> Result<Option<Corrected>, PointError> {
-        let n = pred.len() - 1;
-        let fp = self.family.parameter_derivative(&pred[..n], pred[n])?;
-        let mut system = PseudoArclength::new(self.family, pred, tangent, fp, self.opts.tolerance);
+        let mut system = PseudoArclength::new(self.family, pred, tangent, self.opts.tolerance);
         let opts = Options {
             tolerance: self.opts.tolerance,
             max_iterations: 9,
             damping: Damping::Full,
         };
         let mut z = pred.to_vec();
-        Ok(match newton::solve(&mut system, &mut z, &opts) {
+        let outcome = newton::solve(&mut system, &mut z, &opts);
+        if let Some(e) = system.failure {
+            return Err(e);
+        }
+        Ok(match outcome {
             Ok(report) => Some((z, report.iterations, system.fx)),
+            // Not evaluable at the predictor: the error F_p there gave
+            // before Newton started, as when it was taken first.
+            Err(NewtonError::BadStart(e)) => return Err(e),
             Err(_) => None,
         })
     }

@@ -1,11 +1,16 @@
 //! A one-parameter family of rods and its discretized equilibrium equations
 //! F(x, p) = 0 (shooting unknowns x, parameter p).
 //!
-//! F_x is the exact shooting Jacobian (variational equations). F_p is a
-//! central difference in p of the converged-tolerance residual; it only
-//! steers the predictor and the bordering row, so its O(tolerance/h) error
-//! slows the corrector at worst — the points themselves satisfy F = 0 to
-//! the Newton tolerance.
+//! F_x is the exact shooting Jacobian (variational equations). F_p is
+//! exact too where the lens says how the rod moves with p
+//! ([`Lens::tangent`]): the sensitivity equations z' = f_y z + ∂f/∂p,
+//! z(0) = ∂y(0)/∂p, integrated with the state, and the explicit
+//! p-dependence of the tip residual and of the residuals' units. Elsewhere
+//! (a lens without a tangent, a tip support) it is a central difference in
+//! p, and [`Family::derivative_method`] says so: F_p steers the predictor,
+//! the bordering row and the tangents that locate folds, so its O(h²)
+//! error moves located folds, while the points themselves satisfy F = 0
+//! to the Newton tolerance either way.
 
 use std::sync::Arc;
 
@@ -13,7 +18,6 @@ use nalgebra::{DMatrix, DVector, Matrix3};
 
 use super::lens::{Lens, Parameter, RodLens};
 
-use crate::bvp::newton::NonlinearSystem;
 use crate::bvp::{equations, ShootingSystem};
 use crate::equations::RodSample;
 use crate::model::{ModelLevel, Rod};
@@ -39,6 +43,68 @@ pub struct Family {
     tolerances: Tolerances,
     /// The unknowns' scales, computed once ([`Family::cached_weights`]).
     weights: std::sync::OnceLock<Vec<f64>>,
+    /// The exact F_p of the last residual evaluation.
+    last_fp: DerivativeCache,
+}
+
+/// The exact F_p integrated with the last F and F_x ([`Family::residual`],
+/// [`Family::residual_staircase`]) at (x, p), so that
+/// [`Family::parameter_derivative`] at the same point — the corrector's
+/// bordering column, the tangent at a converged point — costs no
+/// integration. A clone starts empty (another family's lens may differ).
+#[derive(Debug, Default)]
+struct DerivativeCache(std::sync::Mutex<Option<CachedDerivative>>);
+
+#[derive(Debug)]
+struct CachedDerivative {
+    x: Vec<f64>,
+    p: f64,
+    fp: DVector<f64>,
+}
+
+impl Clone for DerivativeCache {
+    fn clone(&self) -> Self {
+        DerivativeCache::default()
+    }
+}
+
+impl DerivativeCache {
+    fn lock(&self) -> std::sync::MutexGuard<'_, Option<CachedDerivative>> {
+        // A panic while the entry was written leaves at worst a stale
+        // entry of another point, which the key comparison rejects.
+        self.0
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner)
+    }
+
+    /// F_p at exactly (x, p), if the last evaluation was there.
+    fn get(&self, x: &[f64], p: f64) -> Option<DVector<f64>> {
+        let entry = self.lock();
+        let e = entry.as_ref()?;
+        (e.p.to_bits() == p.to_bits()
+            && e.x.len() == x.len()
+            && e.x.iter().zip(x).all(|(a, b)| a.to_bits() == b.to_bits()))
+        .then(|| e.fp.clone())
+    }
+
+    /// Keeps F_p at (x, p), reusing the entry's buffers.
+    fn put(&self, x: &[f64], p: f64, fp: &DVector<f64>) {
+        let mut entry = self.lock();
+        match entry.as_mut() {
+            Some(e) if e.x.len() == x.len() && e.fp.len() == fp.len() => {
+                e.x.copy_from_slice(x);
+                e.p = p;
+                e.fp.copy_from(fp);
+            }
+            _ => {
+                *entry = Some(CachedDerivative {
+                    x: x.to_vec(),
+                    p,
+                    fp: fp.clone(),
+                });
+            }
+        }
+    }
 }
 
 /// Why a rod could not be built at a parameter value.
@@ -120,6 +186,7 @@ impl Family {
             stages: None,
             tolerances,
             weights: std::sync::OnceLock::new(),
+            last_fp: DerivativeCache::default(),
         }
     }
 
@@ -150,6 +217,8 @@ impl Family {
         );
         Family {
             stages: Some(stages),
+            // Another discretization: no F_p of the old one is reused.
+            last_fp: DerivativeCache::default(),
             ..self
         }
     }
@@ -318,9 +387,34 @@ impl Family {
         let rod = self.rod_at(p)?;
         let eq = equations(&rod, self.level);
         let mut sys = self.system(eq.as_ref());
-        sys.evaluate(&self.unscaled(x), r, jac)?;
+        let mut a = sys.staircase();
+        self.evaluate_with_derivative(&mut sys, x, p, r, &mut a)?;
+        a.write_dense(jac);
         for (mut column, w) in jac.column_iter_mut().zip(self.cached_weights()) {
             column *= *w;
+        }
+        Ok(())
+    }
+
+    /// F and F_x (raw unknowns' columns) into `r`, `a`; with the exact F_p
+    /// from the same integration kept for [`Family::parameter_derivative`]
+    /// where the lens gives a tangent the equations differentiate.
+    fn evaluate_with_derivative(
+        &self,
+        sys: &mut ShootingSystem,
+        x: &[f64],
+        p: f64,
+        r: &mut DVector<f64>,
+        a: &mut Staircase,
+    ) -> Result<(), PointError> {
+        let raw = self.unscaled(x);
+        match self.lens.tangent(p).filter(|t| sys.differentiates(t)) {
+            Some(t) => {
+                let mut fp = DVector::zeros(x.len());
+                sys.evaluate_staircase_forced(&raw, r, a, Some((&t, &mut fp)))?;
+                self.last_fp.put(x, p, &fp);
+            }
+            None => sys.evaluate_staircase(&raw, r, a)?,
         }
         Ok(())
     }
@@ -350,13 +444,56 @@ impl Family {
         let rod = self.rod_at(p)?;
         let eq = equations(&rod, self.level);
         let mut sys = self.system(eq.as_ref());
-        sys.evaluate_staircase(&self.unscaled(x), r, jac)?;
+        self.evaluate_with_derivative(&mut sys, x, p, r, jac)?;
         jac.scale_columns(self.cached_weights());
         Ok(())
     }
 
-    /// F_p by a central difference with h = 1e-4 max(1, |p|).
+    /// F_p = ∂F/∂p at (x, p): exact by the sensitivity equations
+    /// ([`ShootingSystem::parameter_derivative`]; free when F and F_x were
+    /// just evaluated at (x, p), whose integration carried it) where the
+    /// lens gives its
+    /// [`crate::model::RodTangent`] and the equations differentiate it,
+    /// otherwise by [`Family::central_difference`]; which one is
+    /// [`Family::derivative_method`].
     pub fn parameter_derivative(&self, x: &[f64], p: f64) -> Result<DVector<f64>, PointError> {
+        if let Some(fp) = self.last_fp.get(x, p) {
+            return Ok(fp);
+        }
+        if let Some(t) = self.lens.tangent(p) {
+            let rod = self.rod_at(p)?;
+            let eq = equations(&rod, self.level);
+            if eq.differentiates(&t) {
+                let mut fp = DVector::zeros(x.len());
+                self.system(eq.as_ref())
+                    .parameter_derivative(&self.unscaled(x), &t, &mut fp)?;
+                return Ok(fp);
+            }
+        }
+        self.central_difference(x, p)
+    }
+
+    /// How [`Family::parameter_derivative`] computes F_p at p: exact where
+    /// the lens knows how the rod moves and the equations differentiate
+    /// that motion, by central differences elsewhere (a lens without a
+    /// tangent, a key the tangent does not cover, a tip support).
+    pub fn derivative_method(&self, p: f64) -> Result<DerivativeMethod, FamilyError> {
+        let Some(t) = self.lens.tangent(p) else {
+            return Ok(DerivativeMethod::CentralDifference);
+        };
+        let rod = self.rod_at(p)?;
+        Ok(if equations(&rod, self.level).differentiates(&t) {
+            DerivativeMethod::Exact
+        } else {
+            DerivativeMethod::CentralDifference
+        })
+    }
+
+    /// F_p by a central difference with h = 1e-4 max(1, |p|): two extra
+    /// integrations and an O(h²) ≈ 1e-8 relative truncation error, which
+    /// shifts tangents and hence located folds by as much. The fallback
+    /// of [`Family::parameter_derivative`].
+    pub fn central_difference(&self, x: &[f64], p: f64) -> Result<DVector<f64>, PointError> {
         let n = x.len();
         let h = 1e-4 * p.abs().max(1.0);
         let (mut a, mut b) = (DVector::zeros(n), DVector::zeros(n));
@@ -402,6 +539,26 @@ impl Family {
     pub fn tip(&self, x: &[f64], p: f64) -> Result<RodSample, PointError> {
         let l = self.rod_at(p)?.length();
         Ok(self.samples(x, p, &[l])?.remove(0))
+    }
+}
+
+/// How a family computes F_p ([`Family::derivative_method`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DerivativeMethod {
+    /// By the sensitivity equations: exact up to the integration
+    /// tolerance (shooting) or to rounding (collocation).
+    Exact,
+    /// By a central difference in p (h = 1e-4 max(1, |p|)): an O(h²)
+    /// truncation error.
+    CentralDifference,
+}
+
+impl std::fmt::Display for DerivativeMethod {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            DerivativeMethod::Exact => "exact (sensitivity equations)",
+            DerivativeMethod::CentralDifference => "central difference in p",
+        })
     }
 }
 

@@ -14,7 +14,9 @@
 use std::sync::Arc;
 
 use super::family::FamilyError;
-use crate::model::{ProfileKind, Rod, StoredEnergy};
+use nalgebra::Vector3;
+
+use crate::model::{Profile, ProfileKind, Rod, RodTangent, StoredEnergy};
 
 /// A number of a rod problem that continuation varies.
 pub trait Lens: std::fmt::Debug + Send + Sync {
@@ -25,6 +27,13 @@ pub trait Lens: std::fmt::Debug + Send + Sync {
     /// same p gives the same rod. A value the problem refuses is an error
     /// naming the key, never a clamped rod.
     fn rod_at(&self, p: f64) -> Result<Rod, FamilyError>;
+    /// How the rod moves with p at p ([`RodTangent`]), from which the
+    /// family's ∂F/∂p is computed exactly; None where the lens does not
+    /// know (the family then differentiates by central differences and
+    /// says so, [`super::family::DerivativeMethod`]).
+    fn tangent(&self, _p: f64) -> Option<RodTangent> {
+        None
+    }
 }
 
 /// Which number of the rod the parameter sets.
@@ -182,9 +191,73 @@ impl RodLens {
     }
 }
 
+/// The constant intrinsic curvature of an energy (None when it has no κ⁰
+/// profiles or one of them varies along the rod).
+fn constant_intrinsic(e: &dyn StoredEnergy) -> Option<Vector3<f64>> {
+    let profiles = e.intrinsic_profiles()?;
+    let mut k = Vector3::zeros();
+    for (i, profile) in profiles.iter().enumerate() {
+        match profile {
+            Profile::Constant(v) => k[i] = *v,
+            _ => return None,
+        }
+    }
+    Some(k)
+}
+
+impl RodLens {
+    /// d(rod)/dp of [`RodLens::rod_at`]: p enters linearly (loads, a
+    /// profile, the length) or as the clamp's turn about its fixed d2, so
+    /// the rates are constants of the base rod; None where κ⁰ is not a
+    /// constant (a varying profile's rate is a function of s, which
+    /// [`RodTangent`] does not carry) or the length moves an energy with
+    /// explicit s-dependence ([`RodTangent::fits`] decides at the rod).
+    fn rates(&self) -> Option<RodTangent> {
+        let unit = |i: usize| Vector3::ith(i, 1.0);
+        let zero = RodTangent::zero();
+        let loads = self.base.loads();
+        let energy = self.base.energy();
+        let tangent = match self.parameter {
+            Parameter::LoadScale => zero.with_loads(loads.clone()),
+            Parameter::ControlScale => {
+                let k0 = constant_intrinsic(energy.as_ref())?;
+                zero.with_loads(loads.clone())
+                    .and_then(|t| t.with_intrinsic_curvature(k0))
+            }
+            Parameter::CurvatureTowards => {
+                let from = constant_intrinsic(energy.as_ref())?;
+                let to = constant_intrinsic(self.target.as_ref()?.as_ref())?;
+                zero.with_loads(loads.clone())
+                    .and_then(|t| t.with_intrinsic_curvature(to - from))
+            }
+            Parameter::TipForce(i) => zero.with_loads(crate::model::DeadLoads {
+                tip_force: unit(i),
+                ..Default::default()
+            }),
+            Parameter::TipCouple(i) => zero.with_loads(crate::model::DeadLoads {
+                tip_couple: unit(i),
+                ..Default::default()
+            }),
+            Parameter::DistributedForce(i) => zero.with_loads(crate::model::DeadLoads {
+                distributed_force: unit(i),
+                ..Default::default()
+            }),
+            Parameter::Length => zero.with_length(1.0),
+            Parameter::Stiffness(i) => zero.with_stiffness(unit(i)),
+            Parameter::IntrinsicCurvature(i) => zero.with_intrinsic_curvature(unit(i)),
+            Parameter::ClampAngle => zero.with_clamp_spin(self.base.clamp().director(1)),
+        };
+        tangent.ok()
+    }
+}
+
 impl Lens for RodLens {
     fn key(&self) -> String {
         self.parameter.to_string()
+    }
+
+    fn tangent(&self, _p: f64) -> Option<RodTangent> {
+        self.rates()
     }
 
     fn rod_at(&self, p: f64) -> Result<Rod, FamilyError> {

@@ -22,9 +22,9 @@
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
 use super::planar::straight_rod_clamp_moment;
-use super::tip::{conditions, TipState};
+use super::tip::{condition_rates, conditions, rates_cover, TipRates, TipState};
 use super::{RodEquations, RodSample};
-use crate::model::{Rod, StoredEnergy, TipSupport};
+use crate::model::{Rod, RodTangent, StoredEnergy, TipSupport};
 use crate::numerics::newton::{self, Convergence, Damping, Options, System};
 
 /// The 9-ODE Kirchhoff equations (12 with the position), or the Cosserat
@@ -389,6 +389,97 @@ impl RodEquations for KirchhoffEquations {
         scales[9..12].fill(l);
         scales[12..].fill(self.rod.residual_scales().force);
         scales
+    }
+
+    /// A tangent whose energy rates are exact for this rod, and a support
+    /// whose motion the support conditions' rates (`tip.rs`) cover.
+    fn differentiates(&self, t: &RodTangent) -> bool {
+        t.fits(&self.rod)
+            && self
+                .rod
+                .support()
+                .is_none_or(|s| rates_cover(s, t.support_spin()))
+    }
+
+    /// (L'/L) f, plus the balance H κ' = M × κ + N × ν − ∂sM moved at
+    /// fixed y: δκ' = H⁻¹ (δM × κ + δN × ν + N × δν − δ∂sM − δH κ'),
+    /// δN_i = δn·d_i, δν = c∘δN, and δr' = δν_i d_i.
+    fn rhs_parameter(&self, s: f64, y: &[f64], f: &[f64], t: &RodTangent, out: &mut [f64]) {
+        let st = State::read(y);
+        let b = self.balance(s, &st);
+        let stretch = t.length() / self.rod.length();
+        for (o, v) in out.iter_mut().zip(f) {
+            *o = v * stretch;
+        }
+        let dn = t.internal_force_rate(&self.rod, s);
+        let body_n = Vector3::new(b.n.dot(&st.d1), b.n.dot(&st.d2), b.n.dot(&st.d3));
+        let d_body_n = Vector3::new(dn.dot(&st.d1), dn.dot(&st.d2), dn.dot(&st.d3));
+        let dnu = self.compliance.component_mul(&d_body_n);
+        let de = t.energy_rate(self.rod.energy().as_ref(), s, &st.kappa);
+        let dq = de.moment.cross(&st.kappa) + d_body_n.cross(&b.nu) + body_n.cross(&dnu);
+        let drate = b.h_inv * (dq - de.moment_rate - de.stiffness * b.rate);
+        let dr = st.d1 * dnu[0] + st.d2 * dnu[1] + st.d3 * dnu[2];
+        for i in 0..3 {
+            out[6 + i] += drate[i];
+            out[9 + i] += dr[i];
+        }
+    }
+
+    /// The clamp's spin turns d1(0), d2(0): δd_i = ω × d_i.
+    fn initial_state_parameter(&self, _u: &[f64], t: &RodTangent, out: &mut [f64]) {
+        out.fill(0.0);
+        let c = self.rod.clamp();
+        let w = t.clamp_spin();
+        out[0..3].copy_from_slice(w.cross(&c.director(0)).as_slice());
+        out[3..6].copy_from_slice(w.cross(&c.director(1)).as_slice());
+    }
+
+    /// g_i = (M_i(L) − C·d_i)/M_s,i: δg_i = (δM_i − δC·d_i)/M_s,i −
+    /// g_i δM_s,i/M_s,i; a support's conditions by their rates in
+    /// `tip.rs` (`condition_rates`).
+    fn tip_residual_parameter(&self, y: &[f64], t: &RodTangent, out: &mut [f64]) {
+        let st = State::read(y);
+        let l = self.rod.length();
+        let e = self.rod.energy();
+        let m = e.moment(l, &st.kappa);
+        let dm = t.energy_rate(e.as_ref(), l, &st.kappa).moment;
+        let (c, dc) = (&self.rod.loads().tip_couple, &t.loads().tip_couple);
+        if let Some(support) = self.rod.support() {
+            let tip = TipState {
+                d: [st.d1, st.d2, st.d3],
+                r: Vector3::new(y[9], y[10], y[11]),
+                m,
+                h: e.stiffness(l, &st.kappa),
+                reaction: st.reaction,
+                couple: c,
+            };
+            let rates = TipRates {
+                m: dm,
+                couple: dc,
+                position: t.support_shift(),
+                spin: t.support_spin(),
+                scales: t.residual_scales_rate(&self.rod),
+            };
+            let scales = self.rod.residual_scales();
+            out.copy_from_slice(&condition_rates(support, &tip, &scales, &rates));
+            return;
+        }
+        let unit = self.rod.residual_scales().moment;
+        let dunit = t.residual_scales_rate(&self.rod).moment;
+        let d = [st.d1, st.d2, st.d3];
+        for i in 0..3 {
+            let g = (m[i] - c.dot(&d[i])) / unit[i];
+            out[i] = (dm[i] - dc.dot(&d[i])) / unit[i] - g * dunit[i] / unit[i];
+        }
+    }
+
+    fn state_scales_parameter(&self, t: &RodTangent) -> Vec<f64> {
+        let (l, dl) = (self.rod.length(), t.length());
+        let mut rates = vec![0.0; self.dim()];
+        rates[6..9].fill(-dl / (l * l));
+        rates[9..12].fill(dl);
+        rates[12..].fill(t.residual_scales_rate(&self.rod).force);
+        rates
     }
 }
 

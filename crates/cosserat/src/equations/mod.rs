@@ -16,6 +16,8 @@ pub use planar::PlanarEquations;
 
 use nalgebra::{DMatrix, Vector3};
 
+use crate::model::RodTangent;
+
 /// The rod's state at one arc length, in the quantities users read.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RodSample {
@@ -87,6 +89,37 @@ pub trait RodEquations: Send + Sync {
     /// collocation residuals dimensionless: lengths L, curvatures 1/L,
     /// angles and directors 1.
     fn state_scales(&self) -> Vec<f64>;
+
+    /// Whether the four `*_parameter` methods below give the exact
+    /// p-derivatives for the rod moving along `t` (false by default: the
+    /// caller then differentiates by differences and says so).
+    fn differentiates(&self, _t: &RodTangent) -> bool {
+        false
+    }
+    /// ∂f/∂p at (s, y), given f = f(s, y) there: the explicit dependence
+    /// of the right-hand side on p at a fixed fraction σ = s/L, so that
+    /// z = ∂y/∂p|σ obeys the sensitivity equation z' = f_y z + ∂f/∂p. With
+    /// s = Lσ a length rate L' contributes (L'/L) (f + s ∂sf) + L' ∂Lf.
+    /// Only called where [`RodEquations::differentiates`] `t`; NaN
+    /// otherwise.
+    fn rhs_parameter(&self, _s: f64, _y: &[f64], _f: &[f64], _t: &RodTangent, out: &mut [f64]) {
+        out.fill(f64::NAN);
+    }
+    /// ∂y(0)/∂p at fixed free values u (the clamp's spin turns the
+    /// initial directors). NaN where not [`RodEquations::differentiates`].
+    fn initial_state_parameter(&self, _u: &[f64], _t: &RodTangent, out: &mut [f64]) {
+        out.fill(f64::NAN);
+    }
+    /// ∂g/∂p of the tip residuals at a fixed tip state y(L), their units'
+    /// rates included. NaN where not [`RodEquations::differentiates`].
+    fn tip_residual_parameter(&self, _y: &[f64], _t: &RodTangent, out: &mut [f64]) {
+        out.fill(f64::NAN);
+    }
+    /// d/dp of [`RodEquations::state_scales`]. NaN where not
+    /// [`RodEquations::differentiates`].
+    fn state_scales_parameter(&self, _t: &RodTangent) -> Vec<f64> {
+        vec![f64::NAN; self.dim()]
+    }
 }
 
 impl RodSample {

@@ -25,7 +25,7 @@
 use nalgebra::{DMatrix, Vector3};
 
 use super::{RodEquations, RodSample};
-use crate::model::{Freedom, Rod, TipSupport};
+use crate::model::{Freedom, Rod, RodTangent, TipSupport};
 
 /// The 4-ODE planar equations of a rod.
 #[derive(Debug, Clone)]
@@ -67,9 +67,9 @@ impl PlanarEquations {
         )
     }
 
-    /// (κ2', ∂κ2'/∂φ, ∂κ2'/∂κ2) at (s, y); ∂κ2'/∂(R_x, R_z) =
-    /// (−cos φ, sin φ)/H22.
-    fn curvature_rate(&self, s: f64, y: &[f64]) -> (f64, f64, f64) {
+    /// κ2' at (s, y) with the pieces its linearization and p-derivative
+    /// share; ∂κ2'/∂(R_x, R_z) = (−cos φ, sin φ)/H22.
+    fn curvature_rate(&self, s: f64, y: &[f64]) -> Curving {
         let (phi, k2) = (y[2], y[3]);
         let e = &self.rod.energy();
         let kappa = Self::kappa(k2);
@@ -78,11 +78,36 @@ impl PlanarEquations {
         let n1 = nx * cos - nz * sin;
         let h22 = e.stiffness(s, &kappa)[(1, 1)];
         let rate = (-n1 - e.moment_rate(s, &kappa)[1]) / h22;
-        let dn1 = -nx * sin - nz * cos;
-        let t22 = e.stiffness_derivative(s, &kappa, &Self::kappa(rate))[(1, 1)];
-        let hs22 = e.stiffness_rate(s, &kappa)[(1, 1)];
-        (rate, -dn1 / h22, -(hs22 + t22) / h22)
+        Curving {
+            rate,
+            sin,
+            cos,
+            h22,
+            nx,
+            nz,
+        }
     }
+
+    /// (∂κ2'/∂φ, ∂κ2'/∂κ2) at (s, y) given its [`Curving`].
+    fn curvature_rate_slopes(&self, s: f64, y: &[f64], c: &Curving) -> (f64, f64) {
+        let e = &self.rod.energy();
+        let kappa = Self::kappa(y[3]);
+        let dn1 = -c.nx * c.sin - c.nz * c.cos;
+        let t22 = e.stiffness_derivative(s, &kappa, &Self::kappa(c.rate))[(1, 1)];
+        let hs22 = e.stiffness_rate(s, &kappa)[(1, 1)];
+        (-dn1 / c.h22, -(hs22 + t22) / c.h22)
+    }
+}
+
+/// κ2' and what it was computed from: sin φ, cos φ, H22 and the in-plane
+/// force (n_x, n_z).
+struct Curving {
+    rate: f64,
+    sin: f64,
+    cos: f64,
+    h22: f64,
+    nx: f64,
+    nz: f64,
 }
 
 impl PlanarEquations {
@@ -154,6 +179,86 @@ impl PlanarEquations {
     }
 }
 
+impl PlanarEquations {
+    /// ∂/∂p of [`PlanarEquations::supported_tip`]'s residuals at a fixed
+    /// tip state, row by row: the in-plane coordinates (p_x, p_z) of the
+    /// held position and (a_x, a_z) of a sliding axis move with the
+    /// support's shift δX and the clamp's spin ω (δe_x = ω × e_x), the held
+    /// angle atan2(u, v) of d̂3 (spinning with the support, δd̂3 = Ω × d̂3)
+    /// by (v δu − u δv)/(u² + v²), the moment row as at a
+    /// free tip; every row's unit by its rate (value = q/u: δq/u −
+    /// value δu/u).
+    fn supported_tip_rates(&self, support: &TipSupport, y: &[f64], t: &RodTangent) -> Vec<f64> {
+        let l = self.rod.length();
+        let (scales, rates) = (
+            self.rod.residual_scales(),
+            t.residual_scales_rate(&self.rod),
+        );
+        let c = self.rod.clamp();
+        let w = t.clamp_spin();
+        let (ex, ez) = (c.director(0), c.director(2));
+        let (dex, dez) = (w.cross(&ex), w.cross(&ez));
+        let target = support.position - c.position;
+        let dtarget = t.support_shift();
+        let (px, pz) = (target.dot(&ex), target.dot(&ez));
+        let (dpx, dpz) = (
+            dtarget.dot(&ex) + target.dot(&dex),
+            dtarget.dot(&ez) + target.dot(&dez),
+        );
+        let ratio = |value: f64, dq: f64, u: f64, du: f64| dq / u - value * du / u;
+        let dl = t.length();
+        let mut out = Vec::with_capacity(3);
+        match support.translation {
+            Freedom::Free => {}
+            Freedom::Fixed => {
+                out.push(ratio((y[0] - px) / l, -dpx, l, dl));
+                out.push(ratio((y[1] - pz) / l, -dpz, l, dl));
+            }
+            Freedom::Axial(a) => {
+                let (ax, az) = (a.dot(&ex), a.dot(&ez));
+                let (dax, daz) = (a.dot(&dex), a.dot(&dez));
+                let value = (-(y[0] - px) * az + (y[1] - pz) * ax) / l;
+                let dq = dpx * az - (y[0] - px) * daz - dpz * ax + (y[1] - pz) * dax;
+                out.push(ratio(value, dq, l, dl));
+                let f = scales.force;
+                let value = (y[4] * ax + y[5] * az) / f;
+                out.push(ratio(value, y[4] * dax + y[5] * daz, f, rates.force));
+            }
+        }
+        match support.rotation {
+            Freedom::Fixed => {
+                let d3 = support.frame.column(2).into_owned();
+                let dd3 = t.support_spin().cross(&d3);
+                let (u, v) = (d3.dot(&ex), d3.dot(&ez));
+                let (du, dv) = (d3.dot(&dex) + dd3.dot(&ex), d3.dot(&dez) + dd3.dot(&ez));
+                out.push(-(v * du - u * dv) / (u * u + v * v));
+            }
+            Freedom::Free | Freedom::Axial(_) => {
+                let mut g = [0.0];
+                self.free_tip_rate(y, t, &mut g);
+                out.push(g[0]);
+            }
+        }
+        out
+    }
+
+    /// g = (M2(L) − C·d2)/M_s: δg = (δM2 − δC·d2 − C·(ω × d2))/M_s −
+    /// g δM_s/M_s.
+    fn free_tip_rate(&self, y: &[f64], t: &RodTangent, out: &mut [f64]) {
+        let l = self.rod.length();
+        let kappa = Self::kappa(y[3]);
+        let e = self.rod.energy();
+        let d2 = self.rod.clamp().director(1);
+        let c = &self.rod.loads().tip_couple;
+        let unit = self.rod.residual_scales().moment[1];
+        let dunit = t.residual_scales_rate(&self.rod).moment[1];
+        let g = (e.moment(l, &kappa)[1] - c.dot(&d2)) / unit;
+        let dm = t.energy_rate(e.as_ref(), l, &kappa).moment[1];
+        let dc = t.loads().tip_couple.dot(&d2) + c.dot(&t.clamp_spin().cross(&d2));
+        out[0] = (dm - dc) / unit - g * dunit / unit;
+    }
+}
+
 impl RodEquations for PlanarEquations {
     fn dim(&self) -> usize {
         if self.reacts() {
@@ -194,11 +299,11 @@ impl RodEquations for PlanarEquations {
     }
 
     fn rhs(&self, s: f64, y: &[f64], dy: &mut [f64]) {
-        let (sin, cos) = y[2].sin_cos();
-        dy[0] = sin;
-        dy[1] = cos;
+        let c = self.curvature_rate(s, y);
+        dy[0] = c.sin;
+        dy[1] = c.cos;
         dy[2] = y[3];
-        dy[3] = self.curvature_rate(s, y).0;
+        dy[3] = c.rate;
         dy[4..].fill(0.0);
     }
 
@@ -211,12 +316,12 @@ impl RodEquations for PlanarEquations {
         dy: &mut [f64],
         dphi: &mut [f64],
     ) {
-        let (sin, cos) = y[2].sin_cos();
-        let (rate, d_phi, d_k2) = self.curvature_rate(s, y);
-        dy[..4].copy_from_slice(&[sin, cos, y[3], rate]);
+        let c = self.curvature_rate(s, y);
+        let (d_phi, d_k2) = self.curvature_rate_slopes(s, y, &c);
+        let (sin, cos, h22) = (c.sin, c.cos, c.h22);
+        dy[..4].copy_from_slice(&[sin, cos, y[3], c.rate]);
         dy[4..].fill(0.0);
         let n = self.dim();
-        let h22 = self.rod.energy().stiffness(s, &Self::kappa(y[3]))[(1, 1)];
         for c in 0..cols {
             let v = &phi[n * c..n * (c + 1)];
             let out = &mut dphi[n * c..n * (c + 1)];
@@ -330,6 +435,67 @@ impl RodEquations for PlanarEquations {
         let mut scales = vec![l, l, 1.0, 1.0 / l];
         scales.resize(self.dim(), self.rod.residual_scales().force);
         scales
+    }
+
+    /// A tangent whose energy rates are exact for this rod.
+    fn differentiates(&self, t: &RodTangent) -> bool {
+        t.fits(&self.rod)
+    }
+
+    /// (L'/L) f, plus κ2' = (−N1 − ∂sM2)/H22 moved at fixed (φ, κ2):
+    /// δκ2' = (−δN1 − δ∂sM2 − δH22 κ2')/H22 with δN1 = δn_x cos φ −
+    /// δn_z sin φ, δn_x = δn·d1(0) + n·(ω × d1(0)) (likewise z).
+    fn rhs_parameter(&self, s: f64, y: &[f64], f: &[f64], t: &RodTangent, out: &mut [f64]) {
+        let stretch = t.length() / self.rod.length();
+        for (o, v) in out.iter_mut().zip(f) {
+            *o = v * stretch;
+        }
+        let c = self.rod.clamp();
+        let (ex, ez) = (c.director(0), c.director(2));
+        let (n, dn) = (
+            self.rod.loads().internal_force(s, self.rod.length()),
+            t.internal_force_rate(&self.rod, s),
+        );
+        let w = t.clamp_spin();
+        let dnx = dn.dot(&ex) + n.dot(&w.cross(&ex));
+        let dnz = dn.dot(&ez) + n.dot(&w.cross(&ez));
+        let (sin, cos, rate) = (f[0], f[1], f[3]);
+        let kappa = Self::kappa(y[3]);
+        let e = self.rod.energy();
+        let de = t.energy_rate(e.as_ref(), s, &kappa);
+        let h22 = e.stiffness(s, &kappa)[(1, 1)];
+        out[3] +=
+            (-(dnx * cos - dnz * sin) - de.moment_rate[1] - de.stiffness[(1, 1)] * rate) / h22;
+    }
+
+    /// Zero but at a hinged base, where κ2(0) solves M2(0, κ2) = 0:
+    /// δκ2(0) = −δM2/H22.
+    fn initial_state_parameter(&self, u: &[f64], t: &RodTangent, out: &mut [f64]) {
+        out.fill(0.0);
+        if self.rod.clamp().hinge {
+            let mut y0 = vec![0.0; self.dim()];
+            self.initial_state(u, &mut y0);
+            let kappa = Self::kappa(y0[3]);
+            let e = self.rod.energy();
+            let dm = t.energy_rate(e.as_ref(), 0.0, &kappa).moment[1];
+            out[3] = -dm / e.stiffness(0.0, &kappa)[(1, 1)];
+        }
+    }
+
+    /// The free tip's rate (`free_tip_rate`), a support's row by row
+    /// (`supported_tip_rates`).
+    fn tip_residual_parameter(&self, y: &[f64], t: &RodTangent, out: &mut [f64]) {
+        match self.rod.support() {
+            Some(support) => out.copy_from_slice(&self.supported_tip_rates(support, y, t)),
+            None => self.free_tip_rate(y, t, out),
+        }
+    }
+
+    fn state_scales_parameter(&self, t: &RodTangent) -> Vec<f64> {
+        let (l, dl) = (self.rod.length(), t.length());
+        let mut rates = vec![dl, dl, 0.0, -dl / (l * l)];
+        rates.resize(self.dim(), t.residual_scales_rate(&self.rod).force);
+        rates
     }
 }
 

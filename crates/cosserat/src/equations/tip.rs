@@ -275,3 +275,96 @@ fn spin_row(tip: &TipState, a: &Vector3<f64>, unit: f64) -> Row {
         ],
     }
 }
+
+/// What moves at a fixed tip state as p moves: the body moment's rate
+/// δM(L) at fixed κ, the tip couple's δC, the support position's δX, the
+/// spin Ω of the held frame (δd̂_i = Ω × d̂_i; a sliding or spin axis does
+/// not move) and the residual units' rates.
+pub struct TipRates<'a> {
+    pub m: Vector3<f64>,
+    pub couple: &'a Vector3<f64>,
+    pub position: &'a Vector3<f64>,
+    pub spin: &'a Vector3<f64>,
+    pub scales: ResidualScales,
+}
+
+/// Whether [`condition_rates`] covers a support moving as `rates` say: a
+/// held frame may spin unless the tip is free to spin about an axis (its
+/// swing reads the frame through c = F̂ᵀa, not differentiated here).
+pub fn rates_cover(support: &TipSupport, spin: &Vector3<f64>) -> bool {
+    *spin == Vector3::zeros() || !matches!(support.rotation, Freedom::Axial(_))
+}
+
+/// ∂/∂p of [`conditions`] at a fixed tip state, row by row in the same
+/// order: each row is a numerator over its unit, value = q/u, so
+/// δvalue = δq/u − value δu/u. Positions: δq = −δX·b, u = L; the axial
+/// force: δq = 0, u the force scale; natural rows: δq = δM_i − δC·d_i;
+/// the spin row δq = δM·(d_i·a) − δC·a over the smallest moment scale;
+/// the turn ω(d, d̂) of a held frame moves with the held frame's spin Ω
+/// only: ω is equivariant (ω(Gd, Gd̂) = G ω(d, d̂) for a rotation G), so
+/// δω = Ω × ω − ∂ω/∂d (Ω × d), the last term from the rows' own gradients
+/// in d1, d2; a swing has no rate ([`rates_cover`]).
+pub fn condition_rates(
+    support: &TipSupport,
+    tip: &TipState,
+    scales: &ResidualScales,
+    rates: &TipRates,
+) -> Vec<f64> {
+    let ratio = |value: f64, dq: f64, u: f64, du: f64| dq / u - value * du / u;
+    let mut out = Vec::with_capacity(6);
+    if support.holds_position() {
+        let dr = tip.r - support.position;
+        let (l, dl) = (scales.length, rates.scales.length);
+        let mut position = |b: Vector3<f64>| {
+            out.push(ratio(dr.dot(&b) / l, -rates.position.dot(&b), l, dl));
+        };
+        match support.translation {
+            Freedom::Free => {}
+            Freedom::Fixed => (0..3).for_each(|j| position(Vector3::ith(j, 1.0))),
+            Freedom::Axial(a) => {
+                across(&a).into_iter().for_each(&mut position);
+                let value = tip.reaction.dot(&a) / scales.force;
+                out.push(ratio(value, 0.0, scales.force, rates.scales.force));
+            }
+        }
+    }
+    match support.rotation {
+        Freedom::Free => {
+            for i in 0..3 {
+                let (u, du) = (scales.moment[i], rates.scales.moment[i]);
+                let value = (tip.m[i] - tip.couple.dot(&tip.d[i])) / u;
+                out.push(ratio(
+                    value,
+                    rates.m[i] - rates.couple.dot(&tip.d[i]),
+                    u,
+                    du,
+                ));
+            }
+        }
+        Freedom::Fixed => {
+            let turn = Turn::frame(support, tip);
+            let omega = turn.v * turn.f;
+            let spin = rates.spin;
+            let moved = [-spin.cross(&tip.d[0]), -spin.cross(&tip.d[1])];
+            for j in 0..3 {
+                let b = Vector3::ith(j, 1.0);
+                let row = turn.row(b);
+                let inner: f64 = row
+                    .grad
+                    .iter()
+                    .map(|(col, g)| g.dot(&moved[usize::from(*col == D2)]))
+                    .sum();
+                out.push(b.dot(&spin.cross(&omega)) + inner);
+            }
+        }
+        Freedom::Axial(a) => {
+            out.extend([0.0; 2]);
+            let i = scales.moment.imin();
+            let (u, du) = (scales.moment[i], rates.scales.moment[i]);
+            let da = Vector3::new(tip.d[0].dot(&a), tip.d[1].dot(&a), tip.d[2].dot(&a));
+            let value = (tip.m.dot(&da) - tip.couple.dot(&a)) / u;
+            out.push(ratio(value, rates.m.dot(&da) - rates.couple.dot(&a), u, du));
+        }
+    }
+    out
+}

@@ -62,6 +62,13 @@ pub trait StoredEnergy: std::fmt::Debug + Send + Sync {
     fn derivatives_trusted(&self) -> bool {
         false
     }
+    /// True when W has no explicit s-dependence (every profile constant):
+    /// a length change then moves no material property under the rod's
+    /// points, which the exact length derivative of continuation assumes
+    /// ([`super::RodTangent::fits`]).
+    fn is_uniform(&self) -> bool {
+        false
+    }
     /// The stiffnesses S = (S1, S2, S3) of a quadratic shear and extension
     /// energy ½ (ν − e3)ᵀ diag(S) (ν − e3) at s (see [`super::Shearable`]);
     /// None for an unshearable, inextensible (Kirchhoff) rod.
@@ -126,6 +133,9 @@ pub enum ProfileKind {
 pub struct LinearElastic {
     stiffness: [Profile; 3],
     intrinsic_curvature: [Profile; 3],
+    /// (B, κ⁰) when every profile is a constant, read once: the energy's
+    /// values sit in the innermost loop of every integration.
+    uniform: Option<(Vector3<f64>, Vector3<f64>)>,
 }
 
 impl LinearElastic {
@@ -157,9 +167,21 @@ impl LinearElastic {
         if let Some(index) = intrinsic_curvature.iter().position(|k| !k.is_finite()) {
             return Err(ModelError::IntrinsicCurvature { index });
         }
+        let constant = |p: &[Profile; 3]| -> Option<Vector3<f64>> {
+            let mut v = Vector3::zeros();
+            for (i, profile) in p.iter().enumerate() {
+                let Profile::Constant(c) = profile else {
+                    return None;
+                };
+                v[i] = *c;
+            }
+            Some(v)
+        };
+        let uniform = constant(&stiffness).zip(constant(&intrinsic_curvature));
         Ok(LinearElastic {
             stiffness,
             intrinsic_curvature,
+            uniform,
         })
     }
 
@@ -180,6 +202,9 @@ impl LinearElastic {
     }
 
     fn b(&self, s: f64) -> Vector3<f64> {
+        if let Some((b, _)) = self.uniform {
+            return b;
+        }
         Vector3::from_fn(|i, _| self.stiffness[i].value(s))
     }
 
@@ -189,6 +214,9 @@ impl LinearElastic {
 
     /// κ⁰(s).
     pub fn kappa0(&self, s: f64) -> Vector3<f64> {
+        if let Some((_, k0)) = self.uniform {
+            return k0;
+        }
         Vector3::from_fn(|i, _| self.intrinsic_curvature[i].value(s))
     }
 
@@ -200,10 +228,7 @@ impl LinearElastic {
     /// so its s-derivatives vanish without evaluating six profiles (a fast
     /// path: they sit in the innermost loop of every integration).
     fn is_uniform(&self) -> bool {
-        self.stiffness
-            .iter()
-            .chain(&self.intrinsic_curvature)
-            .all(|p| matches!(p, Profile::Constant(_)))
+        self.uniform.is_some()
     }
 }
 
@@ -259,6 +284,10 @@ impl StoredEnergy for LinearElastic {
 
     fn derivatives_trusted(&self) -> bool {
         true
+    }
+
+    fn is_uniform(&self) -> bool {
+        LinearElastic::is_uniform(self)
     }
 
     fn intrinsic_profiles(&self) -> Option<&[Profile; 3]> {
@@ -415,6 +444,10 @@ impl StoredEnergy for QuarticStiffening {
 
     fn derivatives_trusted(&self) -> bool {
         true
+    }
+
+    fn is_uniform(&self) -> bool {
+        self.linear.is_uniform()
     }
 }
 

@@ -16,6 +16,7 @@ mod profile;
 mod rod;
 mod shear;
 mod support;
+mod tangent;
 
 pub use autodiff::{lift, AutoDiff, Density};
 pub use catalog::{EnergyBuilder, EnergyCatalog, EnergySpec, EnergySpecError};
@@ -32,3 +33,4 @@ pub use profile::{Extremes, Knots, Profile, SplineKnots};
 pub use rod::{Clamp, ResidualScales, Rod};
 pub use shear::Shearable;
 pub use support::{across, Freedom, TipSupport};
+pub use tangent::{EnergyRate, RodTangent};

@@ -98,6 +98,10 @@ impl StoredEnergy for Shearable {
         self.bending.even_components()
     }
 
+    fn is_uniform(&self) -> bool {
+        self.bending.is_uniform()
+    }
+
     fn shear_stiffness(&self, _s: f64) -> Option<Vector3<f64>> {
         Some(self.shear)
     }

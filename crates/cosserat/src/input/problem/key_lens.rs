@@ -16,9 +16,11 @@ use std::sync::Mutex;
 use super::rod::build_rod;
 use super::sections::ProblemFile;
 use super::{invalid, overrides, ProblemError};
-use crate::continuation::{FamilyError, Lens, Lens2};
+use nalgebra::Vector3;
+
+use crate::continuation::{FamilyError, Lens, Lens2, Parameter, RodLens};
 use crate::input::strict;
-use crate::model::{EnergyCatalog, Rod};
+use crate::model::{EnergyCatalog, Rod, RodTangent};
 
 /// The tables whose numbers make the rod.
 const ROD_TABLES: [&str; 5] = ["rod", "energy", "clamp", "support", "loads"];
@@ -87,6 +89,25 @@ impl KeyLens {
         })
     }
 
+    /// The unit axis of a turn table (`clamp.turn.axis`), None when the
+    /// document does not give three finite numbers with a non-zero norm.
+    fn turn_axis(&self, key: &str) -> Option<Vector3<f64>> {
+        let toml::Value::Array(a) = overrides::get_key(&self.doc, key)? else {
+            return None;
+        };
+        let v: Vec<f64> = a
+            .iter()
+            .map(|x| match x {
+                toml::Value::Float(f) => Some(*f),
+                toml::Value::Integer(i) => Some(*i as f64),
+                _ => None,
+            })
+            .collect::<Option<_>>()?;
+        let axis = Vector3::from_column_slice(v.get(..3).filter(|_| v.len() == 3)?);
+        let norm = axis.norm();
+        (norm.is_finite() && norm > 0.0).then(|| axis / norm)
+    }
+
     fn build(&self, p: f64) -> Result<Rod, ProblemError> {
         let mut doc = self.doc.clone();
         overrides::set_key(&mut doc, &self.key, toml::Value::Float(p))
@@ -96,9 +117,46 @@ impl KeyLens {
     }
 }
 
+/// i of a key `prefix[i]`, i < 3.
+fn indexed(key: &str, prefix: &str) -> Option<usize> {
+    let rest = key
+        .strip_prefix(prefix)?
+        .strip_prefix('[')?
+        .strip_suffix(']')?;
+    rest.parse().ok().filter(|i| *i < 3)
+}
+
 impl Lens for KeyLens {
     fn key(&self) -> String {
         self.key.clone()
+    }
+
+    /// The rates of the library's own [`Parameter`] where the key is one
+    /// (a load component, `rod.length`, a constant `energy.stiffness[i]` or
+    /// `energy.intrinsic_curvature[i]`, `clamp.angle`: the reader sets the
+    /// rod's number to the key's value, so the rod moves as
+    /// [`crate::continuation::RodLens`] moves it), the spin of
+    /// `clamp.turn.angle` and `support.turn.angle` (the frame turned about
+    /// the fixed unit axis), the shift of `support.position[i]` (the held
+    /// position, global); None for every other key (a shear stiffness, a
+    /// registered energy's parameter, the support's axes), whose F_p is then a central difference
+    /// ([`crate::continuation::Family::derivative_method`]).
+    fn tangent(&self, p: f64) -> Option<RodTangent> {
+        if self.key == "clamp.turn.angle" {
+            let axis = self.turn_axis("clamp.turn.axis")?;
+            return RodTangent::zero().with_clamp_spin(axis).ok();
+        }
+        if self.key == "support.turn.angle" {
+            let axis = self.turn_axis("support.turn.axis")?;
+            return RodTangent::zero().with_support_spin(axis).ok();
+        }
+        if let Some(i) = indexed(&self.key, "support.position") {
+            return RodTangent::zero()
+                .with_support_shift(Vector3::ith(i, 1.0))
+                .ok();
+        }
+        let parameter = Parameter::from_key(&self.key).filter(|q| q.is_file_key())?;
+        RodLens::new(self.rod_at(p).ok()?, parameter).tangent(p)
     }
 
     fn rod_at(&self, p: f64) -> Result<Rod, FamilyError> {

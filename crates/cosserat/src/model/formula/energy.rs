@@ -179,6 +179,14 @@ impl StoredEnergy for FormulaEnergy {
         true
     }
 
+    /// Constant profiles and a formula that does not read s.
+    fn is_uniform(&self) -> bool {
+        let constant = |p: &Profile| matches!(p, Profile::Constant(_));
+        self.stiffness.iter().all(constant)
+            && self.kappa0.iter().all(constant)
+            && !self.formula.reads(Variable::ArcLength)
+    }
+
     /// Proved from the formula's structure, component by component.
     fn even_components(&self) -> [bool; 3] {
         std::array::from_fn(|i| self.formula.is_even_in(&[Variable::Curvature(i)]))
