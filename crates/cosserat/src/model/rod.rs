@@ -94,7 +94,7 @@ pub struct Rod {
 }
 
 /// Refuses a vector with a non-finite component.
-fn finite(what: &'static str, v: &Vector3<f64>) -> Result<(), ModelError> {
+pub(super) fn finite(what: &'static str, v: &Vector3<f64>) -> Result<(), ModelError> {
     if v.iter().all(|x| x.is_finite()) {
         Ok(())
     } else {

@@ -12,6 +12,7 @@
 
 use nalgebra::{Matrix3, Vector3};
 
+use super::rod::finite;
 use super::{DeadLoads, ModelError, ResidualScales, Rod, StoredEnergy};
 
 /// d(rod data)/dp along a one-parameter family of rods; zero in every part
@@ -37,17 +38,6 @@ pub struct EnergyRate {
     pub stiffness: Matrix3<f64>,
     /// d(∂sM)/dp.
     pub moment_rate: Vector3<f64>,
-}
-
-fn finite(what: &'static str, v: &Vector3<f64>) -> Result<(), ModelError> {
-    if v.iter().all(|x| x.is_finite()) {
-        Ok(())
-    } else {
-        Err(ModelError::NotFinite {
-            what,
-            value: [v[0], v[1], v[2]],
-        })
-    }
 }
 
 impl Default for RodTangent {
