@@ -39,6 +39,12 @@ max_step = 0.5
 axes = [{ key = "energy.parameters.stiffening", values = [0.25, 0.5] }]
 "#;
 
+/// The two tests run one after the other: the first writes HDF5 files in
+/// this process (the C library opens them without close-on-exec), and a
+/// child the second spawns meanwhile would inherit that descriptor and its
+/// file lock, so the first could not reopen its own file.
+static SERIAL: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 fn run(args: &[&str]) -> ExitCode {
     cosserat_cli::run(Cli::parse_from(
         std::iter::once("cosserat").chain(args.iter().copied()),
@@ -47,6 +53,9 @@ fn run(args: &[&str]) -> ExitCode {
 
 #[test]
 fn a_programs_energy_runs_through_every_command() {
+    let _serial = SERIAL
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
     assert!(cosserat_cli::energies::install(own_energy::catalog()));
     let dir = common::run::scratch("own_energy", "files");
     std::fs::create_dir_all(&dir).unwrap();
@@ -93,6 +102,9 @@ fn a_programs_energy_runs_through_every_command() {
 /// the material instability (exit 2).
 #[test]
 fn check_energy_reports_a_material_instability() {
+    let _serial = SERIAL
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
     let dir = common::run::scratch("own_energy", "check");
     std::fs::create_dir_all(&dir).unwrap();
     let file = |name: &str, density: &str| {

@@ -171,56 +171,37 @@ pub(super) fn jet<E: Density + ?Sized>(e: &E, id: u64, s: f64, kappa: &Vector3<f
     jet
 }
 
-/// The six quantities of [`StoredEnergy`] for any [`Density`] (the
-/// implementing type has `density_ref()` and an `id` field).
-macro_rules! differentiated {
-    () => {
-        fn moment(&self, s: f64, kappa: &Vector3<f64>) -> Vector3<f64> {
-            jet(self.density_ref(), self.id, s, kappa).m
-        }
-
-        fn stiffness(&self, s: f64, kappa: &Vector3<f64>) -> Matrix3<f64> {
-            jet(self.density_ref(), self.id, s, kappa).h
-        }
-
-        fn moment_rate(&self, s: f64, kappa: &Vector3<f64>) -> Vector3<f64> {
-            jet(self.density_ref(), self.id, s, kappa).m_s
-        }
-
-        fn stiffness_rate(&self, s: f64, kappa: &Vector3<f64>) -> Matrix3<f64> {
-            jet(self.density_ref(), self.id, s, kappa).h_s
-        }
-
-        fn stiffness_derivative(
-            &self,
-            s: f64,
-            kappa: &Vector3<f64>,
-            v: &Vector3<f64>,
-        ) -> Matrix3<f64> {
-            second_order(self.density_ref(), s, kappa, along(v))
-                .1
-                .map(|d| d.eps)
-        }
-
-        /// Exact by automatic differentiation.
-        fn derivatives_trusted(&self) -> bool {
-            true
-        }
-    };
-}
-
-impl<E: Density> AutoDiff<E> {
-    fn density_ref(&self) -> &E {
-        &self.density
-    }
-}
-
 impl<E: Density> StoredEnergy for AutoDiff<E> {
     fn density(&self, s: f64, kappa: &Vector3<f64>) -> f64 {
         self.density.density(s, [kappa[0], kappa[1], kappa[2]])
     }
 
-    differentiated!();
+    fn moment(&self, s: f64, kappa: &Vector3<f64>) -> Vector3<f64> {
+        jet(&self.density, self.id, s, kappa).m
+    }
+
+    fn stiffness(&self, s: f64, kappa: &Vector3<f64>) -> Matrix3<f64> {
+        jet(&self.density, self.id, s, kappa).h
+    }
+
+    fn moment_rate(&self, s: f64, kappa: &Vector3<f64>) -> Vector3<f64> {
+        jet(&self.density, self.id, s, kappa).m_s
+    }
+
+    fn stiffness_rate(&self, s: f64, kappa: &Vector3<f64>) -> Matrix3<f64> {
+        jet(&self.density, self.id, s, kappa).h_s
+    }
+
+    fn stiffness_derivative(&self, s: f64, kappa: &Vector3<f64>, v: &Vector3<f64>) -> Matrix3<f64> {
+        second_order(&self.density, s, kappa, along(v))
+            .1
+            .map(|d| d.eps)
+    }
+
+    /// Exact by automatic differentiation.
+    fn derivatives_trusted(&self) -> bool {
+        true
+    }
 
     fn admits_planar_bending(&self) -> bool {
         self.density.admits_planar_bending()
