@@ -88,8 +88,7 @@ cluster_start() {
     slurmd -f "$SLURM_CONF"
     cluster_wait_file "$dir/slurmd.pid" "$dir/log/slurmd.log"
     cluster_pids+=("$(cat "$dir/slurmd.pid")")
-    local i
-    for i in $(seq 1 60); do
+    for _ in $(seq 1 60); do
         if [ "$(sinfo --noheader --format=%t 2>/dev/null)" = idle ]; then
             return 0
         fi
@@ -103,8 +102,8 @@ cluster_start() {
 
 # Waits for a daemon's pid file; shows its log if it never comes.
 cluster_wait_file() {
-    local file=$1 log=$2 i
-    for i in $(seq 1 40); do
+    local file=$1 log=$2
+    for _ in $(seq 1 40); do
         if [ -s "$file" ]; then
             return 0
         fi
@@ -116,15 +115,17 @@ cluster_wait_file() {
 }
 
 # Stops the daemons cluster_start started (slurmd, slurmctld, munged), by
-# their process ids, and waits for them to exit.
+# their process ids, all at once (each takes a second or two), and waits
+# for them to exit.
 cluster_stop() {
-    local i pid
-    for ((i = ${#cluster_pids[@]} - 1; i >= 0; i--)); do
-        pid=${cluster_pids[i]}
-        kill "$pid" 2>/dev/null || continue
-        for _ in $(seq 1 40); do
+    local pid
+    for pid in "${cluster_pids[@]}"; do
+        kill "$pid" 2>/dev/null || true
+    done
+    for pid in "${cluster_pids[@]}"; do
+        for _ in $(seq 1 100); do
             kill -0 "$pid" 2>/dev/null || break
-            sleep 0.25
+            sleep 0.1
         done
     done
     cluster_pids=()

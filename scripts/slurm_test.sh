@@ -1,7 +1,7 @@
 #!/bin/bash
 # The Slurm scripts under a real Slurm (issue 19, item 7): on a one-node
 # cluster started here (scripts/slurm_cluster.sh), the shipped Fig. 6 sweep
-# (problems/longest_arm_fig6.toml on a small grid, 4 lines of 12 points,
+# (problems/longest_arm_fig6.toml on a small grid, 4 lines of 10 points,
 # with a cheap search) runs as a 4-task job array of scripts/slurm_sweep.sh,
 # with the merge job of scripts/slurm_merge.sh depending on it. Midway
 # through one task, once its log shows progress, the task is cancelled
@@ -25,7 +25,9 @@
 #   COSSERAT=path/to/cosserat scripts/slurm_test.sh
 #
 # Exit 0 only when everything holds. The working directory (logs, shard
-# files, the cluster's files) is removed on success, kept on failure.
+# files, the cluster's files) is removed on success (kept with
+# SLURM_TEST_KEEP=1), kept on failure. It takes about a minute (40 s of it
+# the sweeps), plus about 30 s when it installs the packages.
 
 set -euo pipefail
 start=$SECONDS
@@ -50,9 +52,14 @@ install_tools() {
         return
     fi
     say "installing slurm-wlm, munge, python3-h5py"
-    export DEBIAN_FRONTEND=noninteractive
-    apt-get update -qq
-    apt-get install -y -qq --no-install-recommends slurm-wlm munge python3-h5py >/dev/null
+    local log
+    log=$(mktemp)
+    if ! (export DEBIAN_FRONTEND=noninteractive && apt-get update -qq &&
+        apt-get install -y -qq --no-install-recommends slurm-wlm munge python3-h5py) >"$log" 2>&1; then
+        tail -n 20 "$log" >&2
+        fail "apt-get install slurm-wlm munge python3-h5py failed"
+    fi
+    rm -f "$log"
 }
 
 find_binary() {
@@ -85,7 +92,7 @@ cleanup() {
     fi
     cluster_stop
     if [ -n "$work" ]; then
-        if ((rc == 0)); then
+        if ((rc == 0)) && [ -z "${SLURM_TEST_KEEP:-}" ]; then
             rm -rf "$work"
         else
             echo "kept for inspection: $work" >&2
@@ -132,6 +139,7 @@ EOF
 install_tools
 find_binary
 trap cleanup EXIT
+trap 'exit 130' INT TERM HUP
 work=$(mktemp -d /tmp/cosserat-slurm.XXXXXX)
 mkdir "$work/cluster" "$work/run"
 say "starting munged, slurmctld, slurmd in $work/cluster"
@@ -140,17 +148,18 @@ sinfo
 
 problem=$repo/problems/longest_arm_fig6.toml
 shards=4
-# 4 lines (B̄1) of 12 points (B̄3): one line per shard. A cheap search (one
-# family, 20 elements, 4 coefficients, few samples) keeps a point near a
-# third of a second.
+# 4 lines (B̄1) of 10 points (B̄3): one line per shard. A cheap search (one
+# family, 4 coefficients, 40 samples, one polish of 100 iterations) keeps a
+# point near a quarter of a second of one core.
 sweep_args=(
-    --set 'sweep.axes=[{key="energy.stiffness[0]",linspace=[0.25,7,4]},{key="energy.stiffness[2]",linspace=[0.1666666666666667,4.666666666666667,12]}]'
+    --set 'sweep.axes=[{key="energy.stiffness[0]",linspace=[0.25,7,4]},{key="energy.stiffness[2]",linspace=[0.1666666666666667,4.666666666666667,10]}]'
     --set sweep.families=1 --set sweep.warm_iterations=100
     --set arm.coefficients=4 --set 'arm.bounds=[[-4,4],[-2,2],[-0.5,0.5]]'
-    --set arm.elements=20 --set arm.samples=40 --set arm.starts=1 --set arm.iterations=100
+    --set arm.samples=40 --set arm.starts=1 --set arm.iterations=100
 )
-per_shard=12
-export COSSERAT_PROGRESS_SECONDS=1
+per_shard=10
+# A progress line every half second, so that one shows the task midway.
+export COSSERAT_PROGRESS_SECONDS=0.5
 cd "$work/run"
 
 say "sbatch --array=0-$((shards - 1)) scripts/slurm_sweep.sh (and the merge job after it)"
