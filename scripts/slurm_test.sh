@@ -9,7 +9,9 @@
 # the merge job is pointed at the resubmitted task, and the test checks:
 #
 #   - the killed task's log has progress lines (a cluster log shows the run
-#     is alive) and its shard file holds some, not all, of its points;
+#     is alive) and its shard file holds some, not all, of its points, and
+#     the merge job waits; slurm_merge.sh refuses (exit 1) to merge it, or
+#     a set without it;
 #   - the resumed task reports those points as done and computes only the
 #     others (`resume    K finished points`, `time ... for M points`,
 #     K + M = the shard's points): no finished point is redone;
@@ -34,6 +36,10 @@ start=$SECONDS
 repo=$(pwd)
 if [ ! -f "$repo/scripts/slurm_sweep.sh" ]; then
     echo "slurm_test.sh: run it from the repository root" >&2
+    exit 2
+fi
+if [ "$(id -u)" != 0 ]; then
+    echo "slurm_test.sh: run it as root (it installs packages and starts munged, slurmctld, slurmd)" >&2
     exit 2
 fi
 python=/usr/bin/python3
@@ -202,6 +208,7 @@ tail -n 2 "$killed_log" | sed 's/^/  log: /'
 merge_wait=$(scontrol show job "$merge" | grep -o 'JobState=[A-Z]* Reason=[A-Za-z]*')
 echo "merge job after the cancel: $merge_wait (afterok on the array cannot be met now)"
 [[ $merge_wait == JobState=PENDING* ]] || fail "the merge job did not wait: $merge_wait"
+cp "$shard_file" killed.h5
 
 say "sbatch --array=$victim (resume) and the merge job pointed at it"
 resumed=$(sbatch --parsable --array="$victim" --cpus-per-task=1 \
@@ -233,6 +240,24 @@ echo "resumed task: '$resume_line'; '$time_line'"
 ((reported + computed == per_shard)) ||
     fail "the resumed task computed $computed points after $reported done: $per_shard in the shard"
 echo "merge job: $(grep '^merged ' "cosserat-merge-${merge}.out")"
+
+say "slurm_merge.sh by hand on the killed shard, then without it"
+mkdir incomplete
+for ((k = 0; k < shards; k++)); do
+    cp "fig6.shard-${k}-of-${shards}.h5" incomplete/
+done
+cp killed.h5 "incomplete/$shard_file"
+if (cd incomplete && "$repo/scripts/slurm_merge.sh" fig6 "$shards") >incomplete.out 2>&1; then
+    fail "slurm_merge.sh accepted an interrupted shard"
+fi
+grep -q '^merged .*(partial)' incomplete.out || fail "slurm_merge.sh: $(tail -n 3 incomplete.out)"
+echo "with the killed shard: $(grep '^merged ' incomplete.out); exit 1"
+rm "incomplete/$shard_file"
+if (cd incomplete && "$repo/scripts/slurm_merge.sh" fig6 "$shards") >missing.out 2>&1; then
+    fail "slurm_merge.sh accepted a missing shard"
+fi
+grep -q "no file for shard(s) $victim of" missing.out || fail "slurm_merge.sh: $(tail -n 3 missing.out)"
+echo "without it: $(cat missing.out); exit 1"
 
 say "comparing the merged file with the single-process run"
 "$python" "$repo/scripts/same_hdf5.py" fig6.h5 single.h5 --ignore /@shard ||
