@@ -164,8 +164,8 @@ sweep_args=(
     --set arm.samples=40 --set arm.starts=1 --set arm.iterations=100
 )
 per_shard=10
-# A progress line every half second, so that one shows the task midway.
-export COSSERAT_PROGRESS_SECONDS=0.5
+# A progress line every quarter second, so that several show the task midway.
+export COSSERAT_PROGRESS_SECONDS=0.25
 cd "$work/run"
 
 say "sbatch --array=0-$((shards - 1)) scripts/slurm_sweep.sh (and the merge job after it)"
