@@ -32,7 +32,7 @@ fn cli_writes_the_diagram_contract_and_a_plot() {
     let f = common::h5::open(&out);
     assert!(f.attrs.has("problem"));
     let b0 = f.group("branches/0").unwrap();
-    let m = read_f64(&b0, "parameter").len();
+    let m = read_f64(b0, "parameter").len();
     assert!(m > 10);
     assert_eq!(b0.dataset("tip_position").unwrap().shape(), vec![m, 3]);
     assert_eq!(b0.dataset("eigenvalues").unwrap().shape()[0], m);
@@ -59,7 +59,7 @@ fn cli_writes_the_diagram_contract_and_a_plot() {
 
 /// The parameter at the points of a diagram's first branch.
 fn first_branch(f: &Group) -> Vec<f64> {
-    read_f64(&f.group("branches/0").unwrap(), "parameter")
+    read_f64(f.group("branches/0").unwrap(), "parameter")
 }
 
 /// `cosserat continue` on the Euler column with the arclength step fixed

@@ -316,7 +316,7 @@ fn a_solve_file_starts_the_continuation() {
         let path = format!("branches/{i}");
         let (ga, gb) = (a.group(&path).unwrap(), b.group(&path).unwrap());
         for name in ["parameter", "unknowns"] {
-            let (u, v) = (read_f64(&ga, name), read_f64(&gb, name));
+            let (u, v) = (read_f64(ga, name), read_f64(gb, name));
             assert_eq!(u.len(), v.len(), "branch {i} {name}");
             worst = u
                 .iter()

@@ -34,8 +34,8 @@ fn text_attr(g: &Group, name: &str) -> String {
 /// checking they have as many points.
 fn largest_difference(a: &Group, ba: usize, b: &Group, bb: usize) -> f64 {
     let (pa, pb) = (
-        read_f64(&branch(a, ba), "parameter"),
-        read_f64(&branch(b, bb), "parameter"),
+        read_f64(branch(a, ba), "parameter"),
+        read_f64(branch(b, bb), "parameter"),
     );
     assert_eq!(pa.len(), pb.len(), "points of branch {ba} and {bb}");
     let (xa, xb) = (rows(a, ba, "unknowns"), rows(b, bb, "unknowns"));
@@ -113,17 +113,17 @@ fn a_chained_run_equals_its_stages_run_one_by_one() {
     );
 
     let (b0, b1) = (branch(&c, 0), branch(&c, 1));
-    assert_eq!(text_attr(&b0, "parameter_name"), "support.position[2]");
-    assert_eq!(text_attr(&b1, "parameter_name"), "support.turn.angle");
+    assert_eq!(text_attr(b0, "parameter_name"), "support.position[2]");
+    assert_eq!(text_attr(b1, "parameter_name"), "support.turn.angle");
     let stage = |g: &Group| g.attrs.count("stage").unwrap();
-    assert_eq!((stage(&b0), stage(&b1)), (1, 2));
+    assert_eq!((stage(b0), stage(b1)), (1, 2));
     let held = b1.dataset("held_keys").unwrap();
     let keys = held.texts().unwrap().to_vec();
     assert_eq!(keys.len(), 1);
     assert_eq!(keys[0].as_str(), "support.position[2]");
-    let last = *read_f64(&b0, "parameter").last().unwrap();
-    assert_eq!(read_f64(&b1, "held_values"), [last]);
-    assert!(read_f64(&b0, "held_values").is_empty());
+    let last = *read_f64(b0, "parameter").last().unwrap();
+    assert_eq!(read_f64(b1, "held_values"), [last]);
+    assert!(read_f64(b0, "held_values").is_empty());
 }
 
 /// Stage 1 of the shipped scene is the clamped–clamped elastica: the
@@ -147,7 +147,7 @@ fn the_first_stage_follows_the_clamped_elastica() {
         .map(|s| s.as_str().to_string())
         .collect();
     assert_eq!(names[0], "force[2]@1");
-    let z = read_f64(&branch(&f, 0), "parameter");
+    let z = read_f64(branch(&f, 0), "parameter");
     let measures = rows(&f, 0, "measures");
     assert!(z.len() > 20);
     for (z, m) in z.iter().zip(&measures) {
@@ -292,7 +292,7 @@ fn a_later_stage_restarts_with_its_held_keys() {
     let c = common::h5::open(&chained);
     let start = format!(
         "continuation.start={}",
-        read_f64(&branch(&c, 1), "parameter")[10]
+        read_f64(branch(&c, 1), "parameter")[10]
     );
     let o = run(&[
         "continue",
@@ -321,7 +321,7 @@ fn a_later_stage_restarts_with_its_held_keys() {
     let ends = |f: &Group, b: usize| {
         let g = branch(f, b);
         (
-            *read_f64(&g, "parameter").last().unwrap(),
+            *read_f64(g, "parameter").last().unwrap(),
             rows(f, b, "unknowns").pop().unwrap(),
         )
     };

@@ -116,8 +116,10 @@ pub(crate) fn write_atomically(
     };
     let mut root = Group::root();
     let result = write(&mut root)
-        .and_then(|()| super::schema::describe_file(&mut root))
-        .and_then(|()| store::write(&tmp, &root))
+        .and_then(|()| {
+            super::schema::describe_file(&mut root);
+            store::write(&tmp, &root)
+        })
         .map_err(|e| failed(e.to_string()))
         .and_then(|()| super::seal::seal(&tmp).map_err(|e| failed(format!("sealing: {e}"))));
     if let Err(e) = result {

@@ -584,16 +584,15 @@ pub fn read(path: &Path) -> StoreResult<Group> {
                 StoreError::Unreadable(format!("{shown} is not a readable HDF5 file: {other}"))
             }
         })?;
-        read_group(&file.root(), String::new())
-            .map_err(|e| StoreError::Unreadable(format!("{shown}: {e}")))
+        read_group(&file.root(), "").map_err(|e| StoreError::Unreadable(format!("{shown}: {e}")))
     };
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(parse))
         .unwrap_or_else(|_| Err(StoreError::Damaged(shown.clone())))
 }
 
-fn read_group(g: &hdf5_pure::Group, path: String) -> Result<Group, hdf5_pure::Error> {
+fn read_group(g: &hdf5_pure::Group, path: &str) -> Result<Group, hdf5_pure::Error> {
     let mut out = Group {
-        attrs: read_attrs(g.attrs()?, path.clone()),
+        attrs: read_attrs(g.attrs()?, path.to_owned()),
         ..Group::default()
     };
     for name in g.datasets()? {
@@ -621,7 +620,7 @@ fn read_group(g: &hdf5_pure::Group, path: String) -> Result<Group, hdf5_pure::Er
     }
     for name in g.groups()? {
         let child = format!("{path}/{name}");
-        let sub = read_group(&g.group(&name)?, child)?;
+        let sub = read_group(&g.group(&name)?, &child)?;
         out.groups.insert(name, sub);
     }
     Ok(out)
