@@ -7,6 +7,7 @@
 
 use std::path::Path;
 
+use cosserat::output::store::{Group, StoreError, StoreResult};
 use plotters::prelude::*;
 
 /// One branch as read from a diagram file.
@@ -63,11 +64,11 @@ pub struct DiagramData {
 
 /// The rows of an m×k dataset, or m empty rows when the file has none
 /// (written before measures existed).
-fn measure_rows(g: &hdf5::Group, k: usize, m: usize) -> hdf5::Result<Vec<Vec<f64>>> {
+fn measure_rows(g: &Group, k: usize, m: usize) -> StoreResult<Vec<Vec<f64>>> {
     let Ok(ds) = g.dataset("measures") else {
         return Ok(vec![vec![]; m]);
     };
-    let v = ds.read_raw::<f64>()?;
+    let v = ds.floats()?;
     if k == 0 {
         return Ok(vec![vec![]; m]);
     }
@@ -78,7 +79,7 @@ fn measure_rows(g: &hdf5::Group, k: usize, m: usize) -> hdf5::Result<Vec<Vec<f64
 }
 
 /// Rows of three; a length that is not a multiple of three is an error.
-fn rows3(v: &[f64]) -> hdf5::Result<Vec<[f64; 3]>> {
+fn rows3(v: &[f64]) -> StoreResult<Vec<[f64; 3]>> {
     if !v.len().is_multiple_of(3) {
         return Err("a dataset of 3-vectors has a length that is not a multiple of 3".into());
     }
@@ -86,20 +87,12 @@ fn rows3(v: &[f64]) -> hdf5::Result<Vec<[f64; 3]>> {
 }
 
 /// Reads a diagram written by `cosserat continue`.
-pub fn read_diagram(path: &Path) -> hdf5::Result<DiagramData> {
+pub fn read_diagram(path: &Path) -> StoreResult<DiagramData> {
     let f = cosserat::output::seal::open(path)?;
-    let parameter_name = f
-        .attr("parameter_name")?
-        .read_scalar::<hdf5::types::VarLenUnicode>()?
-        .as_str()
-        .to_string();
+    let parameter_name = f.attrs.text("parameter_name")?.to_owned();
     let root = f.group("branches")?;
     let measure_names: Vec<String> = match root.dataset("measure_names") {
-        Ok(ds) => ds
-            .read_raw::<hdf5::types::VarLenUnicode>()?
-            .iter()
-            .map(|s| s.as_str().to_string())
-            .collect(),
+        Ok(ds) => ds.texts()?.to_vec(),
         Err(_) => vec![],
     };
     let k = measure_names.len();
@@ -110,46 +103,36 @@ pub fn read_diagram(path: &Path) -> hdf5::Result<DiagramData> {
             break;
         };
         // A chained run's stages continue different keys on one axis.
-        if let Ok(a) = g.attr("parameter_name") {
-            let key = a
-                .read_scalar::<hdf5::types::VarLenUnicode>()?
-                .as_str()
-                .to_string();
-            if !keys.contains(&key) {
-                keys.push(key);
+        if let Ok(key) = g.attrs.text("parameter_name") {
+            if !keys.iter().any(|k| k == key) {
+                keys.push(key.to_owned());
             }
         }
-        let read = |name: &str| g.dataset(name).and_then(|d| d.read_raw::<f64>());
+        let read =
+            |name: &str| -> StoreResult<Vec<f64>> { Ok(g.dataset(name)?.floats()?.to_vec()) };
         let shapes_ds = g.dataset("shapes")?;
         let per = shapes_ds.shape().get(1).copied().unwrap_or(0);
-        let shapes = shapes_ds.read_raw::<f64>()?;
+        let shapes = shapes_ds.floats()?;
         let parameter = read("parameter")?;
-        let measures = measure_rows(&g, k, parameter.len())?;
+        let measures = measure_rows(g, k, parameter.len())?;
         branches.push(BranchData {
             measures,
             parameter,
             tip: rows3(&read("tip_position")?)?,
             tip_angle: read("tip_angle")?,
             norm: read("norm")?,
-            stable: g
-                .dataset("stable")?
-                .read_raw::<u64>()?
-                .iter()
-                .map(|s| *s == 1)
-                .collect(),
+            stable: cosserat::output::read_stable(g.dataset("stable")?)?,
             shapes: shapes
                 .chunks((per * 3).max(1))
                 .map(rows3)
-                .collect::<hdf5::Result<_>>()?,
+                .collect::<StoreResult<_>>()?,
         });
     }
     let sp = f.group("special_points")?;
-    let kinds = sp
-        .dataset("kind")?
-        .read_raw::<hdf5::types::VarLenUnicode>()?;
-    let branch = sp.dataset("branch")?.read_raw::<u64>()?;
-    let index = sp.dataset("index")?.read_raw::<u64>()?;
-    let parameter = sp.dataset("parameter")?.read_raw::<f64>()?;
+    let kinds = sp.dataset("kind")?.texts()?;
+    let branch = sp.dataset("branch")?.counts()?;
+    let index = sp.dataset("index")?.counts()?;
+    let parameter = sp.dataset("parameter")?.floats()?;
     let parameter_name = if keys.len() > 1 {
         keys.iter()
             .enumerate()
@@ -159,15 +142,15 @@ pub fn read_diagram(path: &Path) -> hdf5::Result<DiagramData> {
     } else {
         parameter_name
     };
-    let tip = rows3(&sp.dataset("tip_position")?.read_raw::<f64>()?)?;
+    let tip = rows3(sp.dataset("tip_position")?.floats()?)?;
     let n = kinds.len();
-    let special_measures = measure_rows(&sp, k, n)?;
+    let special_measures = measure_rows(sp, k, n)?;
     if [branch.len(), index.len(), parameter.len(), tip.len()] != [n; 4] {
         return Err("the special-point datasets have different lengths".into());
     }
     let specials = (0..n)
         .map(|i| SpecialData {
-            kind: kinds[i].as_str().to_string(),
+            kind: kinds[i].clone(),
             branch: branch[i] as usize,
             index: index[i] as usize,
             parameter: parameter[i],
@@ -181,7 +164,7 @@ pub fn read_diagram(path: &Path) -> hdf5::Result<DiagramData> {
         specials,
         measure_names,
     };
-    data.check().map_err(|e| hdf5::Error::from(e.as_str()))?;
+    data.check().map_err(StoreError::Invalid)?;
     Ok(data)
 }
 

@@ -37,23 +37,14 @@ fn optimize(args: &[&str]) -> std::process::Output {
 }
 
 fn read_reach(path: &std::path::Path) -> (f64, Vec<f64>, u64) {
-    let f = hdf5::File::open(path).unwrap();
-    let reach = f
-        .dataset("optimum/reach")
-        .unwrap()
-        .read_scalar::<f64>()
-        .unwrap();
-    let c = f
-        .dataset("optimum/shape_coefficients")
-        .unwrap()
-        .read_raw::<f64>()
-        .unwrap();
+    let f = common::h5::open(path);
+    let reach = f.dataset("optimum/reach").unwrap().float().unwrap();
+    let c = common::h5::read_f64(&f, "optimum/shape_coefficients");
     let evaluations = f
         .group("optimum")
         .unwrap()
-        .attr("evaluations")
-        .unwrap()
-        .read_scalar::<u64>()
+        .attrs
+        .count("evaluations")
         .unwrap();
     (reach, c, evaluations)
 }
@@ -77,14 +68,13 @@ fn interrupt(
     std::thread::sleep(std::time::Duration::from_millis(wait));
     signal(&child, sig);
     let code = child.wait().unwrap().code();
-    let f = hdf5::File::open(out).unwrap();
+    let f = common::h5::open(out);
     assert_eq!(stop_reason(&f), "interrupted");
     let kept = f
         .group("search")
         .unwrap()
-        .attr("samples_done")
-        .unwrap()
-        .read_scalar::<u64>()
+        .attrs
+        .count("samples_done")
         .unwrap();
     (code, kept)
 }
@@ -171,8 +161,8 @@ fn fig5_file_and_chart() {
     ]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     assert!(std::fs::metadata(&png).unwrap().len() > 10_000);
-    let f = hdf5::File::open(&out).unwrap();
-    let read = |name: &str| f.dataset(name).unwrap().read_raw::<f64>().unwrap();
+    let f = common::h5::open(&out);
+    let read = |name: &str| common::h5::read_f64(&f, name);
     let reach = read("map/reach");
     let b = read("map/curvature_coefficients");
     assert_eq!(b.len(), 4 * reach.len());
@@ -181,7 +171,7 @@ fn fig5_file_and_chart() {
         .min_by(|&i, &j| norms[i].total_cmp(&norms[j]))
         .unwrap();
     let q = f.group("closest_straight").unwrap();
-    let index = q.attr("index").unwrap().read_scalar::<u64>().unwrap() as usize;
+    let index = q.attrs.count("index").unwrap() as usize;
     assert_eq!(index, least);
     let q_reach = read("closest_straight/reach")[0];
     assert!((q_reach - reach[least]).abs() < 1e-12);

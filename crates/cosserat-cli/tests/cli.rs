@@ -6,6 +6,7 @@ use common::problems::shipped;
 use std::path::{Path, PathBuf};
 
 use common::run::{entries, run, stderr};
+use cosserat::output::store::Group;
 
 fn scratch(name: &str) -> PathBuf {
     common::run::scratch("cli", name)
@@ -198,19 +199,14 @@ fn existing_output_needs_force() {
     std::fs::remove_dir_all(dir).unwrap();
 }
 
-fn read_vectors(g: &hdf5::Group, name: &str, n: usize) -> Vec<f64> {
+fn read_vectors(g: &Group, name: &str, n: usize) -> Vec<f64> {
     let ds = g.dataset(name).unwrap();
-    assert_eq!(ds.shape(), vec![n, 3], "{name}");
-    ds.read_raw::<f64>().unwrap()
+    assert_eq!(ds.shape(), [n, 3], "{name}");
+    ds.floats().unwrap().to_vec()
 }
 
-fn string_attr(loc: &hdf5::Location, name: &str) -> String {
-    loc.attr(name)
-        .unwrap()
-        .read_scalar::<hdf5::types::VarLenUnicode>()
-        .unwrap()
-        .as_str()
-        .to_string()
+fn string_attr(loc: &Group, name: &str) -> String {
+    loc.attrs.text(name).unwrap().to_owned()
 }
 
 #[test]
@@ -237,25 +233,25 @@ fn solution_file_follows_the_contract() {
             "`{word}` missing from the report:\n{stdout}"
         );
     }
-    let f = hdf5::File::open(&out).unwrap();
+    let f = common::h5::open(&out);
     assert!(string_attr(&f, "problem").contains("output_points = 51"));
     let g = f.group("solution").unwrap();
-    let s = g.dataset("s").unwrap().read_raw::<f64>().unwrap();
+    let s = common::h5::read_f64(g, "s");
     assert_eq!(s.len(), 51);
     assert_eq!((s[0], s[50]), (0.0, 1.0));
     for name in ["position", "d1", "d2", "d3", "curvature", "moment", "force"] {
-        read_vectors(&g, name, 51);
+        read_vectors(g, name, 51);
     }
-    assert_eq!(string_attr(&g, "model"), "planar");
-    assert_eq!(string_attr(&g, "method"), "shooting");
-    assert!(g.attr("iterations").unwrap().read_scalar::<u64>().unwrap() >= 1);
-    assert!(g.attr("residual").unwrap().read_scalar::<f64>().unwrap() <= 1e-10);
+    assert_eq!(string_attr(g, "model"), "planar");
+    assert_eq!(string_attr(g, "method"), "shooting");
+    assert!(g.attrs.count("iterations").unwrap() >= 1);
+    assert!(g.attrs.float("residual").unwrap() <= 1e-10);
     // The force is the dead tip load everywhere; the moment is B2 κ2.
-    let force = read_vectors(&g, "force", 51);
+    let force = read_vectors(g, "force", 51);
     assert!(force.chunks(3).all(|f| f == [3.0, 0.0, 0.0]));
     let (m, k) = (
-        read_vectors(&g, "moment", 51),
-        read_vectors(&g, "curvature", 51),
+        read_vectors(g, "moment", 51),
+        read_vectors(g, "curvature", 51),
     );
     assert!(m.iter().zip(&k).all(|(m, k)| (m - k).abs() < 1e-15));
     std::fs::remove_dir_all(dir).unwrap();

@@ -35,13 +35,9 @@ fn fixed_shape_writes_the_critical_load() {
     let (ok, stdout, stderr) = stability("timoshenko_ltb", &out);
     assert!(ok, "{stderr}");
     assert!(stdout.contains("γ_crit"), "{stdout}");
-    let f = hdf5::File::open(&out).unwrap();
+    let f = common::h5::open(&out);
     let g = f.group("stability").unwrap();
-    let gamma = g
-        .dataset("critical_load")
-        .unwrap()
-        .read_scalar::<f64>()
-        .unwrap();
+    let gamma = g.dataset("critical_load").unwrap().float().unwrap();
     assert!((gamma - 4.0126).abs() < 1e-4, "{gamma}");
     let oop = g.group("out_of_plane").unwrap();
     let mode = oop.dataset("null_vector").unwrap();
@@ -57,38 +53,27 @@ fn equilibrium_writes_blocks_and_morse_index() {
     let (ok, stdout, stderr) = stability("cantilever_tip_load", &out);
     assert!(ok, "{stderr}");
     assert!(stdout.contains("verdict   stable"), "{stdout}");
-    let f = hdf5::File::open(&out).unwrap();
+    let f = common::h5::open(&out);
     assert!(f.group("solution").is_ok());
     let g = f.group("stability").unwrap();
-    let values = g.dataset("eigenvalues").unwrap().read_raw::<f64>().unwrap();
+    let values = g.dataset("eigenvalues").unwrap().floats().unwrap().to_vec();
     assert_eq!(values.len(), 4);
     assert!(values.windows(2).all(|w| w[0] <= w[1]) && values[0] > 0.0);
     let vectors = g.dataset("eigenvectors").unwrap();
     assert_eq!(vectors.shape()[0], 4);
-    assert_eq!(
-        g.dataset("morse_index")
-            .unwrap()
-            .read_scalar::<u64>()
-            .unwrap(),
-        0
-    );
+    assert_eq!(g.dataset("morse_index").unwrap().count().unwrap(), 0);
     for block in ["in_plane", "out_of_plane"] {
         let b = g.group(block).unwrap();
         assert_eq!(
             b.dataset("eigenvalues")
                 .unwrap()
-                .read_raw::<f64>()
+                .floats()
                 .unwrap()
+                .to_vec()
                 .len(),
             4
         );
-        assert_eq!(
-            b.dataset("morse_index")
-                .unwrap()
-                .read_scalar::<u64>()
-                .unwrap(),
-            0
-        );
+        assert_eq!(b.dataset("morse_index").unwrap().count().unwrap(), 0);
     }
     std::fs::remove_dir_all(dir).unwrap();
 }

@@ -3,6 +3,8 @@
 //! interrupted and resumed giving the file of an uninterrupted one.
 mod common;
 
+use cosserat::output::store::Group;
+
 use std::path::Path;
 
 use common::h5::{read_f64, stop_reason};
@@ -27,21 +29,17 @@ fn cli_writes_the_diagram_contract_and_a_plot() {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let f = hdf5::File::open(&out).unwrap();
-    assert!(f.attr("problem").is_ok());
+    let f = common::h5::open(&out);
+    assert!(f.attrs.has("problem"));
     let b0 = f.group("branches/0").unwrap();
-    let m = read_f64(&b0, "parameter").len();
+    let m = read_f64(b0, "parameter").len();
     assert!(m > 10);
     assert_eq!(b0.dataset("tip_position").unwrap().shape(), vec![m, 3]);
     assert_eq!(b0.dataset("eigenvalues").unwrap().shape()[0], m);
     assert_eq!(b0.dataset("stable").unwrap().shape(), vec![m]);
     assert_eq!(b0.dataset("morse_index").unwrap().shape(), vec![m]);
     let sp = f.group("special_points").unwrap();
-    let kinds = sp
-        .dataset("kind")
-        .unwrap()
-        .read_raw::<hdf5::types::VarLenUnicode>()
-        .unwrap();
+    let kinds = sp.dataset("kind").unwrap().texts().unwrap().to_vec();
     assert!(kinds
         .iter()
         .all(|k| k.as_str() == "fold" || k.as_str() == "branch_point"));
@@ -60,8 +58,8 @@ fn cli_writes_the_diagram_contract_and_a_plot() {
 }
 
 /// The parameter at the points of a diagram's first branch.
-fn first_branch(f: &hdf5::File) -> Vec<f64> {
-    read_f64(&f.group("branches/0").unwrap(), "parameter")
+fn first_branch(f: &Group) -> Vec<f64> {
+    read_f64(f.group("branches/0").unwrap(), "parameter")
 }
 
 /// `cosserat continue` on the Euler column with the arclength step fixed
@@ -86,7 +84,7 @@ fn interrupted_run_keeps_its_points() {
     let mut child = slow_euler(&out, "0.0005", &[]).spawn().unwrap();
     let status = interrupt_after(&mut child, 2600);
     assert_eq!(status.code(), Some(130), "interrupted runs exit with 130");
-    let f = hdf5::File::open(&out).unwrap();
+    let f = common::h5::open(&out);
     assert_eq!(stop_reason(&f), "interrupted");
     let points = first_branch(&f);
     assert!(points.len() > 5, "{} points kept", points.len());
@@ -106,7 +104,7 @@ fn killed_run_leaves_its_last_checkpoint() {
     std::thread::sleep(std::time::Duration::from_millis(3500));
     child.kill().unwrap();
     let _ = child.wait();
-    let f = hdf5::File::open(&out).expect("the checkpoint is a valid HDF5 file");
+    let f = common::h5::open(&out);
     let points = first_branch(&f);
     assert!(points.len() > 5, "{} points kept", points.len());
     assert!(points.windows(2).all(|w| w[1] > w[0]), "points in order");
@@ -121,7 +119,7 @@ fn killed_run_leaves_its_last_checkpoint() {
     let mut child = slow_euler(&out, "0.0005", &["--resume"]).spawn().unwrap();
     let status = interrupt_after(&mut child, 3000);
     assert_eq!(status.code(), Some(130));
-    let f = hdf5::File::open(&out).unwrap();
+    let f = common::h5::open(&out);
     let more = first_branch(&f);
     assert!(
         more.len() > points.len(),
@@ -160,7 +158,7 @@ fn interrupted_run_resumes_to_the_same_diagram() {
     assert!(command(&partial, &["--resume"]).status().unwrap().success());
     assert!(command(&full, &[]).status().unwrap().success());
     for f in [&partial, &full] {
-        assert_eq!(stop_reason(&hdf5::File::open(f).unwrap()), "completed");
+        assert_eq!(stop_reason(&common::h5::open(f)), "completed");
     }
     common::h5::assert_same_datasets(&partial, &full);
     let left = entries(&dir);

@@ -249,12 +249,13 @@ fn a_stored_branch_point_is_followed_in_a_second_parameter() {
     let call = |a: Vec<String>| run(&a.iter().map(String::as_str).collect::<Vec<_>>());
     let o = call(args("special/0", true, Some(set)));
     assert!(o.status.success(), "{}", stderr(&o));
-    let file = hdf5::File::open(&curve).unwrap();
+    let file = common::h5::open(&curve);
     let p = file
         .dataset("curve/parameters")
         .unwrap()
-        .read_raw::<f64>()
-        .unwrap();
+        .floats()
+        .unwrap()
+        .to_vec();
     assert!(p.len() >= 20, "{} values", p.len());
     for row in p.chunks(2) {
         let exact = std::f64::consts::PI.powi(2) / (4.0 * row[1] * row[1]);
@@ -309,16 +310,13 @@ fn a_solve_file_starts_the_continuation() {
     assert!(o.status.success(), "{}", stderr(&o));
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(out.contains("the equilibrium solved by shooting"), "{out}");
-    let (a, b) = (
-        hdf5::File::open(&own).unwrap(),
-        hdf5::File::open(&from).unwrap(),
-    );
+    let (a, b) = (common::h5::open(&own), common::h5::open(&from));
     let mut worst: f64 = 0.0;
     for i in 0..2 {
         let path = format!("branches/{i}");
         let (ga, gb) = (a.group(&path).unwrap(), b.group(&path).unwrap());
         for name in ["parameter", "unknowns"] {
-            let (u, v) = (read_f64(&ga, name), read_f64(&gb, name));
+            let (u, v) = (read_f64(ga, name), read_f64(gb, name));
             assert_eq!(u.len(), v.len(), "branch {i} {name}");
             worst = u
                 .iter()

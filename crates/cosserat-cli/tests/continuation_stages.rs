@@ -5,41 +5,37 @@
 
 mod common;
 
+use cosserat::output::store::Group;
+
 use common::h5::read_f64;
 use common::problems::shipped;
 use common::run::{run, scratch, stderr};
 use cosserat::references::clamped_elastica_load;
-use hdf5::types::VarLenUnicode;
 
 const CHAINED: &str = "compress_then_turn";
 
 /// Branch `b`'s (m × n) dataset `name` as rows.
-fn rows(file: &hdf5::File, b: usize, name: &str) -> Vec<Vec<f64>> {
+fn rows(file: &Group, b: usize, name: &str) -> Vec<Vec<f64>> {
     let ds = file.dataset(&format!("branches/{b}/{name}")).unwrap();
     let width = ds.shape()[1].max(1);
-    let v = ds.read_raw::<f64>().unwrap();
+    let v = ds.floats().unwrap().to_vec();
     v.chunks(width).map(<[f64]>::to_vec).collect()
 }
 
-fn branch(file: &hdf5::File, b: usize) -> hdf5::Group {
+fn branch(file: &Group, b: usize) -> &Group {
     file.group(&format!("branches/{b}")).unwrap()
 }
 
-fn text_attr(g: &hdf5::Group, name: &str) -> String {
-    g.attr(name)
-        .unwrap()
-        .read_scalar::<VarLenUnicode>()
-        .unwrap()
-        .as_str()
-        .to_string()
+fn text_attr(g: &Group, name: &str) -> String {
+    g.attrs.text(name).unwrap().to_owned()
 }
 
 /// The largest difference of two branches' parameters and unknowns, after
 /// checking they have as many points.
-fn largest_difference(a: &hdf5::File, ba: usize, b: &hdf5::File, bb: usize) -> f64 {
+fn largest_difference(a: &Group, ba: usize, b: &Group, bb: usize) -> f64 {
     let (pa, pb) = (
-        read_f64(&branch(a, ba), "parameter"),
-        read_f64(&branch(b, bb), "parameter"),
+        read_f64(branch(a, ba), "parameter"),
+        read_f64(branch(b, bb), "parameter"),
     );
     assert_eq!(pa.len(), pb.len(), "points of branch {ba} and {bb}");
     let (xa, xb) = (rows(a, ba, "unknowns"), rows(b, bb, "unknowns"));
@@ -103,9 +99,9 @@ fn a_chained_run_equals_its_stages_run_one_by_one() {
     assert!(o.status.success(), "{}", stderr(&o));
 
     let (c, a, b) = (
-        hdf5::File::open(&chained).unwrap(),
-        hdf5::File::open(&one).unwrap(),
-        hdf5::File::open(&two).unwrap(),
+        common::h5::open(&chained),
+        common::h5::open(&one),
+        common::h5::open(&two),
     );
     assert_eq!(largest_difference(&c, 0, &a, 0), 0.0, "stage 1");
     let second = largest_difference(&c, 1, &b, 0);
@@ -117,17 +113,17 @@ fn a_chained_run_equals_its_stages_run_one_by_one() {
     );
 
     let (b0, b1) = (branch(&c, 0), branch(&c, 1));
-    assert_eq!(text_attr(&b0, "parameter_name"), "support.position[2]");
-    assert_eq!(text_attr(&b1, "parameter_name"), "support.turn.angle");
-    let stage = |g: &hdf5::Group| g.attr("stage").unwrap().read_scalar::<u64>().unwrap();
-    assert_eq!((stage(&b0), stage(&b1)), (1, 2));
+    assert_eq!(text_attr(b0, "parameter_name"), "support.position[2]");
+    assert_eq!(text_attr(b1, "parameter_name"), "support.turn.angle");
+    let stage = |g: &Group| g.attrs.count("stage").unwrap();
+    assert_eq!((stage(b0), stage(b1)), (1, 2));
     let held = b1.dataset("held_keys").unwrap();
-    let keys = held.read_raw::<VarLenUnicode>().unwrap();
+    let keys = held.texts().unwrap().to_vec();
     assert_eq!(keys.len(), 1);
     assert_eq!(keys[0].as_str(), "support.position[2]");
-    let last = *read_f64(&b0, "parameter").last().unwrap();
-    assert_eq!(read_f64(&b1, "held_values"), [last]);
-    assert!(read_f64(&b0, "held_values").is_empty());
+    let last = *read_f64(b0, "parameter").last().unwrap();
+    assert_eq!(read_f64(b1, "held_values"), [last]);
+    assert!(read_f64(b0, "held_values").is_empty());
 }
 
 /// Stage 1 of the shipped scene is the clamped–clamped elastica: the
@@ -140,17 +136,18 @@ fn the_first_stage_follows_the_clamped_elastica() {
     let out = dir.join("chain.h5");
     let o = run(&["continue", &shipped(CHAINED), "-o", out.to_str().unwrap()]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let f = hdf5::File::open(&out).unwrap();
+    let f = common::h5::open(&out);
     let names: Vec<String> = f
         .dataset("branches/measure_names")
         .unwrap()
-        .read_raw::<VarLenUnicode>()
+        .texts()
         .unwrap()
+        .to_vec()
         .iter()
         .map(|s| s.as_str().to_string())
         .collect();
     assert_eq!(names[0], "force[2]@1");
-    let z = read_f64(&branch(&f, 0), "parameter");
+    let z = read_f64(branch(&f, 0), "parameter");
     let measures = rows(&f, 0, "measures");
     assert!(z.len() > 20);
     for (z, m) in z.iter().zip(&measures) {
@@ -276,7 +273,7 @@ fn what_cannot_be_chained_is_refused_by_stage() {
         stderr(&o)
     );
     // Stage 1 is kept.
-    let f = hdf5::File::open(&out).unwrap();
+    let f = common::h5::open(&out);
     assert!(f.group("branches/0").is_ok() && f.group("branches/1").is_err());
 }
 
@@ -292,10 +289,10 @@ fn a_later_stage_restarts_with_its_held_keys() {
     assert!(o.status.success(), "{}", stderr(&o));
     // The file's own start (stage 1's, −0.95) is outside stage 2's bounds:
     // the point's value, which --from would set, is given for the check.
-    let c = hdf5::File::open(&chained).unwrap();
+    let c = common::h5::open(&chained);
     let start = format!(
         "continuation.start={}",
-        read_f64(&branch(&c, 1), "parameter")[10]
+        read_f64(branch(&c, 1), "parameter")[10]
     );
     let o = run(&[
         "continue",
@@ -320,11 +317,11 @@ fn a_later_stage_restarts_with_its_held_keys() {
         "continuation.max_step=0.1",
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let a = hdf5::File::open(&again).unwrap();
-    let ends = |f: &hdf5::File, b: usize| {
+    let a = common::h5::open(&again);
+    let ends = |f: &Group, b: usize| {
         let g = branch(f, b);
         (
-            *read_f64(&g, "parameter").last().unwrap(),
+            *read_f64(g, "parameter").last().unwrap(),
             rows(f, b, "unknowns").pop().unwrap(),
         )
     };

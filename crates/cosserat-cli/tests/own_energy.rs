@@ -73,8 +73,8 @@ fn a_programs_energy_runs_through_every_command() {
     let mut args = vec!["solve", p, "-o", solution.to_str().unwrap(), "--force"];
     args.extend(roll_up);
     assert_eq!(run(&args), ExitCode::SUCCESS);
-    let file = hdf5::File::open(&solution).unwrap();
-    let curvature = common::h5::read_f64(&file.group("solution").unwrap(), "curvature");
+    let file = common::h5::open(&solution);
+    let curvature = common::h5::read_f64(file.group("solution").unwrap(), "curvature");
     let exact = (0.5f64 * 4.0).asinh() / 0.5;
     for k in curvature.chunks(3) {
         assert!((k[1] - exact).abs() < 1e-9, "κ2 = {} vs {exact}", k[1]);

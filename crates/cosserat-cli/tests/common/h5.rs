@@ -1,45 +1,42 @@
 //! Every dataset of an HDF5 file as text, for comparing two files bit for
 //! bit (floats by their bit patterns), and the few reads the tests of
-//! result files repeat.
+//! result files repeat. Files are read through the library's one HDF5
+//! module (`cosserat::output::store`); h5py reads them independently in
+//! tests/h5py_reader.rs.
 #![allow(dead_code)]
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use hdf5::types::{TypeDescriptor, VarLenUnicode};
+use cosserat::output::store::{self, Group, Values};
+
+/// The whole file at `path` (its seal, if any, not checked).
+pub fn open(path: &Path) -> Group {
+    store::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
 
 /// Dataset path → its contents (floats as hex bit patterns).
 pub fn datasets(path: &Path) -> BTreeMap<String, String> {
-    let file = hdf5::File::open(path).unwrap();
+    let file = open(path);
     let mut out = BTreeMap::new();
-    walk(&file, "", &mut out);
+    walk(&file, &mut out);
     out
 }
 
-fn walk(group: &hdf5::Group, prefix: &str, out: &mut BTreeMap<String, String>) {
-    for name in group.member_names().unwrap() {
-        let full = format!("{prefix}/{name}");
-        if let Ok(g) = group.group(&name) {
-            walk(&g, &full, out);
-            continue;
-        }
-        let ds = group.dataset(&name).unwrap();
-        let text = match ds.dtype().unwrap().to_descriptor().unwrap() {
-            TypeDescriptor::Float(_) => ds
-                .read_raw::<f64>()
-                .unwrap()
+fn walk(group: &Group, out: &mut BTreeMap<String, String>) {
+    for (_, ds) in group.datasets() {
+        let text = match ds.values() {
+            Values::Floats(v) => v
                 .iter()
                 .map(|v| format!("{:016x}", v.to_bits()))
                 .collect::<Vec<_>>()
                 .join(" "),
-            TypeDescriptor::Unsigned(_) => format!("{:?}", ds.read_raw::<u64>().unwrap()),
-            TypeDescriptor::Integer(_) => format!("{:?}", ds.read_raw::<i64>().unwrap()),
-            TypeDescriptor::VarLenUnicode => {
-                format!("{:?}", ds.read_raw::<VarLenUnicode>().unwrap())
-            }
             other => format!("{other:?}"),
         };
-        out.insert(full, format!("{:?} {text}", ds.shape()));
+        out.insert(ds.path().to_owned(), format!("{:?} {text}", ds.shape()));
+    }
+    for (_, g) in group.groups() {
+        walk(g, out);
     }
 }
 
@@ -62,16 +59,19 @@ pub fn assert_same_datasets(a: &Path, b: &Path) {
 }
 
 /// The floats of dataset `name` of `group`.
-pub fn read_f64(group: &hdf5::Group, name: &str) -> Vec<f64> {
-    group.dataset(name).unwrap().read_raw::<f64>().unwrap()
+pub fn read_f64(group: &Group, name: &str) -> Vec<f64> {
+    group.dataset(name).unwrap().floats().unwrap().to_vec()
 }
 
 /// The `stop_reason` attribute of a result file.
-pub fn stop_reason(file: &hdf5::File) -> String {
-    file.attr("stop_reason")
-        .unwrap()
-        .read_scalar::<VarLenUnicode>()
-        .unwrap()
-        .as_str()
-        .to_string()
+pub fn stop_reason(file: &Group) -> String {
+    file.attrs.text("stop_reason").unwrap().to_owned()
+}
+
+/// Rewrites the HDF5 file at `path` after `edit` changed its tree; the
+/// result is unsealed (a file written by another program).
+pub fn rewrite(path: &Path, edit: impl FnOnce(&mut Group)) {
+    let mut file = open(path);
+    edit(&mut file);
+    store::write(path, &file).unwrap();
 }

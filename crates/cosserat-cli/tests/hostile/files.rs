@@ -2,26 +2,40 @@
 //! panic or a crash in the HDF5 library.
 
 use super::*;
+use cosserat::output::store::Values;
 
 /// Replaces dataset `name` of the HDF5 file at `path` by `data` (shape
 /// `[data.len()]`), keeping its type family. The seal is taken off first:
 /// the file stands for one written by another program, which is read
 /// unverified, so the dataset checks themselves are what is tested.
-pub(crate) fn replace_dataset<T: hdf5::H5Type>(path: &Path, name: &str, data: &[T]) {
+pub(crate) fn replace_dataset<T: Column>(path: &Path, name: &str, data: &[T]) {
     let bytes = std::fs::read(path).unwrap();
     assert_eq!(
         &bytes[bytes.len() - 24..bytes.len() - 8],
         b"cosserat-seal-v1"
     );
     std::fs::write(path, &bytes[..bytes.len() - 24]).unwrap();
-    let f = hdf5::File::open_rw(path).unwrap();
-    f.unlink(name).unwrap();
-    f.new_dataset::<T>()
-        .shape([data.len()])
-        .create(name)
-        .unwrap()
-        .write_raw(data)
-        .unwrap();
+    common::h5::rewrite(path, |f| {
+        assert!(f.remove(name), "{name}");
+        f.put(name, &[data.len()], T::values(data)).unwrap();
+    });
+}
+
+/// The element types a damaged dataset is written with.
+pub(crate) trait Column: Copy {
+    fn values(data: &[Self]) -> Values;
+}
+
+impl Column for f64 {
+    fn values(data: &[Self]) -> Values {
+        Values::Floats(data.to_vec())
+    }
+}
+
+impl Column for u64 {
+    fn values(data: &[Self]) -> Values {
+        Values::Counts(data.to_vec())
+    }
 }
 
 /// Files whose datasets contradict each other (a special point on a branch

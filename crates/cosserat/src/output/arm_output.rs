@@ -23,8 +23,8 @@
 //! optimum on an actuator limit — and the values there are the optima
 //! polished from it), the attribute `mesh` (`resolved`, `refined`: searched again on a finer mesh
 //! because the search's did not resolve it, `unresolved`), and
-//! `rejected_designs` (k×3: elements, R̂ there, R̂ on 4× the elements) of
-//! the designs given up on the way.
+//! `rejected_elements` (k: the mesh of each design given up on the way)
+//! and `rejected_reach` (k×2: R̂ there, R̂ on 4× the elements).
 //!
 //! With a reach map (the Fig. 5 data set): `/map/reach` (n),
 //! `/map/load_factor` (n), `/map/shape_coefficients` (n×M),
@@ -44,31 +44,21 @@
 use crate::continuation::RunState;
 use std::path::Path;
 
-use super::hdf5_output::{array, string_attr, write_atomically, OutputError};
+use super::hdf5_output::{write_atomically, OutputError};
+use super::store::{Group, StoreError, StoreResult};
 use crate::study::arm::{
     ArmOptimum, ClosestStraight, ReachMap, Resolution, SearchProgress, StraightArm,
 };
 
-fn scalar(g: &hdf5::Group, name: &str, v: f64) -> hdf5::Result<()> {
-    g.new_dataset::<f64>().create(name)?.write_scalar(&v)
-}
-
-fn points(g: &hdf5::Group, name: &str, v: &[[f64; 3]]) -> hdf5::Result<()> {
+fn points(g: &mut Group, name: &str, v: &[[f64; 3]]) -> StoreResult<()> {
     let flat: Vec<f64> = v.iter().flatten().copied().collect();
-    g.new_dataset::<f64>()
-        .shape([v.len(), 3])
-        .create(name)?
-        .write_raw(&flat)
+    g.floats(name, &[v.len(), 3], &flat)
 }
 
-fn rows(g: &hdf5::Group, name: &str, v: &[Vec<f64>]) -> hdf5::Result<()> {
+fn rows(g: &mut Group, name: &str, v: &[Vec<f64>]) -> StoreResult<()> {
     let width = v.first().map_or(0, std::vec::Vec::len);
     let flat: Vec<f64> = v.iter().flatten().copied().collect();
-    array(g, name, &[v.len(), width], &flat)
-}
-
-fn count(g: &hdf5::Location, name: &str, v: usize) -> hdf5::Result<()> {
-    g.new_attr::<u64>().create(name)?.write_scalar(&(v as u64))
+    g.floats(name, &[v.len(), width], &flat)
 }
 
 fn stop_reason(interrupted: bool) -> &'static str {
@@ -126,102 +116,105 @@ pub fn write_arm_study(
     study: &ArmStudy,
     force: bool,
 ) -> Result<(), OutputError> {
-    write_atomically(path, force, |file| {
-        string_attr(file, "problem", problem)?;
-        string_attr(file, "stop_reason", study.stop_reason.name())?;
-        let g = file.create_group("optimum")?;
-        write_design(&g, study.optimum)?;
-        scalar(&g, "gamma_crit", study.optimum.critical_load)?;
-        count(&g, "evaluations", study.optimum.evaluations)?;
+    write_atomically(path, force, |root| {
+        root.attrs.set_text("problem", problem);
+        root.attrs.set_text("stop_reason", study.stop_reason.name());
+        let g = root.create_group("optimum");
+        write_design(g, study.optimum)?;
+        g.float("gamma_crit", study.optimum.critical_load)?;
+        g.attrs
+            .set_count("evaluations", study.optimum.evaluations as u64);
         if let Some(s) = study.straight {
-            let g = file.create_group("straight")?;
-            scalar(&g, "reach", s.reach)?;
-            scalar(&g, "gamma_crit", s.gamma)?;
-            scalar(&g, "clamp_angle", s.clamp_angle)?;
-            points(&g, "loaded_shape", &s.loaded_shape)?;
-            string_attr(&g, "stop_reason", stop_reason(s.interrupted))?;
-            string_attr(&g, "limit", s.limit.name())?;
+            let g = root.create_group("straight");
+            g.float("reach", s.reach)?;
+            g.float("gamma_crit", s.gamma)?;
+            g.float("clamp_angle", s.clamp_angle)?;
+            points(g, "loaded_shape", &s.loaded_shape)?;
+            g.attrs.set_text("stop_reason", stop_reason(s.interrupted));
+            g.attrs.set_text("limit", s.limit.name());
         }
         if let Some(m) = study.map {
-            let g = file.create_group("map")?;
-            array(&g, "reach", &[m.reach.len()], &m.reach)?;
-            array(&g, "load_factor", &[m.gamma.len()], &m.gamma)?;
-            rows(&g, "shape_coefficients", &m.shape_coefficients)?;
-            rows(&g, "curvature_coefficients", &m.curvature_coefficients)?;
-            count(&g, "samples", m.samples)?;
-            string_attr(&g, "stop_reason", stop_reason(m.interrupted))?;
+            let g = root.create_group("map");
+            g.floats("reach", &[m.reach.len()], &m.reach)?;
+            g.floats("load_factor", &[m.gamma.len()], &m.gamma)?;
+            rows(g, "shape_coefficients", &m.shape_coefficients)?;
+            rows(g, "curvature_coefficients", &m.curvature_coefficients)?;
+            g.attrs.set_count("samples", m.samples as u64);
+            g.attrs.set_text("stop_reason", stop_reason(m.interrupted));
         }
         for (name, q) in [
             ("closest_straight", study.closest),
             ("least_curvature", study.least_curvature),
         ] {
             if let Some(q) = q {
-                let g = file.create_group(name)?;
-                write_design(&g, &q.optimum)?;
-                count(&g, "index", q.index)?;
-                scalar(&g, "curvature_norm", q.curvature_norm)?;
+                let g = root.create_group(name);
+                write_design(g, &q.optimum)?;
+                g.attrs.set_count("index", q.index as u64);
+                g.float("curvature_norm", q.curvature_norm)?;
             }
         }
         if let Some(p) = study.progress {
-            write_progress(file, p)?;
+            write_progress(root, p)?;
         }
         Ok(())
     })
 }
 
-fn write_design(g: &hdf5::Group, o: &ArmOptimum) -> hdf5::Result<()> {
-    scalar(g, "reach", o.design.reach)?;
+fn write_design(g: &mut Group, o: &ArmOptimum) -> StoreResult<()> {
+    g.float("reach", o.design.reach)?;
     if let Some(r) = &o.resolution {
         write_resolution(g, r)?;
     }
-    scalar(g, "load_factor", o.design.gamma)?;
+    g.float("load_factor", o.design.gamma)?;
     let c = &o.design.shape_coefficients;
-    array(g, "shape_coefficients", &[c.len()], c)?;
+    g.floats("shape_coefficients", &[c.len()], c)?;
     let b = &o.curvature_coefficients;
-    array(g, "curvature_coefficients", &[b.len()], b)?;
+    g.floats("curvature_coefficients", &[b.len()], b)?;
     points(g, "loaded_shape", &o.loaded_shape)?;
     points(g, "unloaded_shape", &o.unloaded_shape)?;
     let k = &o.intrinsic_curvature;
-    array(g, "intrinsic_curvature", &[k.len()], k)
+    g.floats("intrinsic_curvature", &[k.len()], k)
 }
 
 /// The discretization check of a design (`optimize::Resolution`).
-fn write_resolution(g: &hdf5::Group, r: &Resolution) -> hdf5::Result<()> {
+fn write_resolution(g: &mut Group, r: &Resolution) -> StoreResult<()> {
     let s = &r.study;
-    let elements: Vec<f64> = s.elements.iter().map(|n| *n as f64).collect();
-    array(g, "mesh_elements", &[3], &elements)?;
-    array(g, "reach_meshes", &[3], &s.reach)?;
-    scalar(g, "reach_fine", s.reach[2])?;
-    scalar(g, "reach_error", s.error().unwrap_or(f64::NAN))?;
-    scalar(g, "reach_order", s.order().unwrap_or(f64::NAN))?;
-    count(g, "elements", s.elements[0])?;
-    string_attr(g, "mesh", r.verdict.name())?;
+    let elements: Vec<u64> = s.elements.iter().map(|n| *n as u64).collect();
+    g.counts("mesh_elements", &elements)?;
+    g.floats("reach_meshes", &[3], &s.reach)?;
+    g.float("reach_fine", s.reach[2])?;
+    g.float("reach_error", s.error().unwrap_or(f64::NAN))?;
+    g.float("reach_order", s.order().unwrap_or(f64::NAN))?;
+    g.attrs.set_count("elements", s.elements[0] as u64);
+    g.attrs.set_text("mesh", r.verdict.name());
     let values = if s.local_optima {
         "local_optima"
     } else {
         "design"
     };
-    string_attr(g, "mesh_values", values)?;
-    let rejected: Vec<Vec<f64>> = r
-        .rejected
-        .iter()
-        .map(|(n, coarse, fine)| vec![*n as f64, *coarse, *fine])
-        .collect();
-    if !rejected.is_empty() {
-        rows(g, "rejected_designs", &rejected)?;
+    g.attrs.set_text("mesh_values", values);
+    if !r.rejected.is_empty() {
+        let elements: Vec<u64> = r.rejected.iter().map(|(n, _, _)| *n as u64).collect();
+        g.counts("rejected_elements", &elements)?;
+        let reach: Vec<Vec<f64>> = r
+            .rejected
+            .iter()
+            .map(|(_, coarse, fine)| vec![*coarse, *fine])
+            .collect();
+        rows(g, "rejected_reach", &reach)?;
     }
     Ok(())
 }
 
-fn write_progress(file: &hdf5::File, p: &SearchProgress) -> hdf5::Result<()> {
-    let g = file.create_group("search")?;
-    count(&g, "samples_done", p.samples_done)?;
-    count(&g, "polishes_done", p.polishes_done)?;
-    count(&g, "evaluations", p.evaluations)?;
+fn write_progress(root: &mut Group, p: &SearchProgress) -> StoreResult<()> {
+    let g = root.create_group("search");
+    g.attrs.set_count("samples_done", p.samples_done as u64);
+    g.attrs.set_count("polishes_done", p.polishes_done as u64);
+    g.attrs.set_count("evaluations", p.evaluations as u64);
     let reach: Vec<f64> = p.leaders.iter().map(|l| l.0).collect();
-    array(&g, "leader_reach", &[reach.len()], &reach)?;
+    g.floats("leader_reach", &[reach.len()], &reach)?;
     let pts: Vec<Vec<f64>> = p.leaders.iter().map(|l| l.1.clone()).collect();
-    rows(&g, "leader_points", &pts)
+    rows(g, "leader_points", &pts)
 }
 
 /// What an interrupted optimize run kept: the problem text, the stop
@@ -240,38 +233,31 @@ pub struct SavedSearch {
 }
 
 /// Reads what [`write_arm_study`] kept of a search.
-pub fn read_search(path: &Path) -> hdf5::Result<SavedSearch> {
-    use hdf5::types::VarLenUnicode;
+pub fn read_search(path: &Path) -> StoreResult<SavedSearch> {
     let file = super::seal::open(path)?;
-    let text = |name: &str| -> hdf5::Result<String> {
-        Ok(file
-            .attr(name)?
-            .read_scalar::<VarLenUnicode>()?
-            .as_str()
-            .to_owned())
-    };
     let g = file.group("search")?;
-    let n =
-        |name: &str| -> hdf5::Result<usize> { Ok(g.attr(name)?.read_scalar::<u64>()? as usize) };
-    let reach = g.dataset("leader_reach")?.read_raw::<f64>()?;
-    let flat = g.dataset("leader_points")?.read_raw::<f64>()?;
+    let n = |name: &str| -> StoreResult<usize> { Ok(g.attrs.count(name)? as usize) };
+    let reach = g.dataset("leader_reach")?.floats()?;
+    let flat = g.dataset("leader_points")?.floats()?;
     let width = if reach.is_empty() {
         0
     } else {
         flat.len() / reach.len()
     };
+    if width * reach.len() != flat.len() {
+        return Err("leader_points does not have one row per leader".into());
+    }
     let leaders = reach
         .iter()
         .enumerate()
         .map(|(i, r)| (*r, flat[i * width..(i + 1) * width].to_vec()))
         .collect();
     Ok(SavedSearch {
-        problem: text("problem")?,
+        problem: file.attrs.text("problem")?.to_owned(),
         stop_reason: {
-            let name = text("stop_reason")?;
-            RunState::from_name(&name).ok_or_else(|| {
-                hdf5::Error::from(format!("unknown stop_reason `{name}`").as_str())
-            })?
+            let name = file.attrs.text("stop_reason")?;
+            RunState::from_name(name)
+                .ok_or_else(|| StoreError::from(format!("unknown stop_reason `{name}`")))?
         },
         progress: SearchProgress {
             samples_done: n("samples_done")?,
@@ -282,6 +268,7 @@ pub fn read_search(path: &Path) -> hdf5::Result<SavedSearch> {
         },
         best: file
             .dataset("optimum/shape_coefficients")?
-            .read_raw::<f64>()?,
+            .floats()?
+            .to_vec(),
     })
 }

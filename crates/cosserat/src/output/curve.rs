@@ -9,7 +9,7 @@
 
 use std::path::Path;
 
-use super::hdf5_output::{array, string_attr, write_atomically, OutputError};
+use super::hdf5_output::{set_generator, write_atomically, OutputError};
 use crate::continuation::{SingularCurve, SpecialKind};
 
 fn rows(
@@ -28,38 +28,32 @@ pub fn write_curve(
     curve: &SingularCurve,
     force: bool,
 ) -> Result<(), OutputError> {
-    write_atomically(path, force, |file| {
-        string_attr(file, "problem", problem)?;
-        string_attr(file, "parameter_names", &curve.keys.join(","))?;
-        string_attr(file, "kind", kind.name())?;
-        string_attr(file, "ends", &curve.ends.join(";"))?;
-        string_attr(
-            file,
-            "generator",
-            concat!("cosserat ", env!("CARGO_PKG_VERSION")),
-        )?;
-        let g = file.create_group("curve")?;
+    write_atomically(path, force, |root| {
+        root.attrs.set_text("problem", problem);
+        root.attrs
+            .set_text("parameter_names", &curve.keys.join(","));
+        root.attrs.set_text("kind", kind.name());
+        root.attrs.set_text("ends", &curve.ends.join(";"));
+        set_generator(root);
+        let g = root.create_group("curve");
         let m = curve.points.len();
         let (_, p) = rows(curve, |c| c.parameters.to_vec());
-        array(&g, "parameters", &[m, 2], &p)?;
+        g.floats("parameters", &[m, 2], &p)?;
         let (n, x) = rows(curve, |c| c.unknowns.clone());
-        array(&g, "unknowns", &[m, n], &x)?;
+        g.floats("unknowns", &[m, n], &x)?;
         let (k, t) = rows(curve, |c| c.tangent.clone());
-        array(&g, "tangent", &[m, k], &t)?;
+        g.floats("tangent", &[m, k], &t)?;
         let (nv, v) = rows(curve, |c| c.null_vector.clone());
-        array(&g, "null_vector", &[m, nv], &v)?;
+        g.floats("null_vector", &[m, nv], &v)?;
         let s: Vec<f64> = curve.points.iter().map(|c| c.singularity).collect();
-        array(&g, "singularity", &[m], &s)?;
+        g.floats("singularity", &[m], &s)?;
         let after: Vec<u64> = curve.cusps.iter().map(|c| c.after as u64).collect();
-        g.new_dataset::<u64>()
-            .shape([after.len()])
-            .create("cusps")?
-            .write_raw(&after)?;
+        g.counts("cusps", &after)?;
         let at: Vec<f64> = curve
             .cusps
             .iter()
             .flat_map(|c| c.point.parameters)
             .collect();
-        array(&g, "cusp_parameters", &[curve.cusps.len(), 2], &at)
+        g.floats("cusp_parameters", &[curve.cusps.len(), 2], &at)
     })
 }

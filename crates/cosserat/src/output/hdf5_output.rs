@@ -1,4 +1,4 @@
-//! Equilibria as HDF5 files (through the HDF5 C library, hdf5-metno).
+//! Equilibria as HDF5 files (built as a [`store`] tree).
 //!
 //! Layout (a contract, see README.md): group `/solution` with datasets `s`
 //! (n), `position`, `d1`, `d2`, `d3`, `curvature`, `moment` (body), `force`
@@ -14,9 +14,9 @@
 
 use std::path::Path;
 
-use hdf5::types::VarLenUnicode;
-
 use nalgebra::Vector3;
+
+use super::store::{self, Group, StoreError, StoreResult};
 
 use crate::bvp::Equilibrium;
 use crate::equations::RodSample;
@@ -31,7 +31,7 @@ pub enum OutputError {
     /// The target cannot be replaced (not a regular file, an input).
     #[error("{0}")]
     Unusable(String),
-    /// The HDF5 library reported an error.
+    /// The HDF5 file could not be built or written.
     #[error("writing {path}: {message}")]
     Hdf5 {
         /// The file being written.
@@ -65,9 +65,9 @@ pub fn write_equilibrium(
     problem: &str,
     force: bool,
 ) -> Result<(), OutputError> {
-    write_atomically(path, force, |file| {
-        root_attributes(file, problem)?;
-        write_solution(file, eq)
+    write_atomically(path, force, |root| {
+        root_attributes(root, problem);
+        write_solution(root, eq)
     })
 }
 
@@ -79,14 +79,14 @@ pub fn write_stability(
     result: &StabilityResult,
     force: bool,
 ) -> Result<(), OutputError> {
-    write_atomically(path, force, |file| {
-        root_attributes(file, problem)?;
+    write_atomically(path, force, |root| {
+        root_attributes(root, problem);
         match result {
             StabilityResult::Equilibrium(eq, stability) => {
-                write_solution(file, eq)?;
-                write_spectrum(file, stability)
+                write_solution(root, eq)?;
+                write_spectrum(root, stability)
             }
-            StabilityResult::FixedShape(critical) => write_critical_load(file, critical),
+            StabilityResult::FixedShape(critical) => write_critical_load(root, critical),
         }
     })
 }
@@ -100,31 +100,28 @@ pub enum StabilityResult {
     FixedShape(CriticalLoad),
 }
 
-/// Runs `write` on a temporary file next to `path` and renames it into
-/// place; removes the temporary on any failure.
+/// Builds the file's tree with `write`, describes it ([`super::schema`]),
+/// writes it to a temporary file next to `path`, seals it and renames it
+/// into place; removes the temporary on any failure.
 pub(crate) fn write_atomically(
     path: &Path,
     force: bool,
-    write: impl FnOnce(&hdf5::File) -> hdf5::Result<()>,
+    write: impl FnOnce(&mut Group) -> StoreResult<()>,
 ) -> Result<(), OutputError> {
     check_target(path, force)?;
     let tmp = super::target::temporary_path(path);
-    let result = hdf5::File::create(&tmp)
-        .and_then(|file| {
-            write(&file)?;
-            super::schema::describe_file(&file)?;
-            file.flush()
+    let failed = |message: String| OutputError::Hdf5 {
+        path: path.display().to_string(),
+        message,
+    };
+    let mut root = Group::root();
+    let result = write(&mut root)
+        .and_then(|()| {
+            super::schema::describe_file(&mut root);
+            store::write(&tmp, &root)
         })
-        .map_err(|e| OutputError::Hdf5 {
-            path: path.display().to_string(),
-            message: e.to_string(),
-        });
-    let result = result.and_then(|()| {
-        super::seal::seal(&tmp).map_err(|e| OutputError::Hdf5 {
-            path: path.display().to_string(),
-            message: format!("sealing: {e}"),
-        })
-    });
+        .map_err(|e| failed(e.to_string()))
+        .and_then(|()| super::seal::seal(&tmp).map_err(|e| failed(format!("sealing: {e}"))));
     if let Err(e) = result {
         let _ = std::fs::remove_file(&tmp);
         return Err(e);
@@ -142,111 +139,78 @@ pub(crate) fn write_atomically(
     })
 }
 
-pub(crate) fn text(s: &str) -> hdf5::Result<VarLenUnicode> {
-    s.parse::<VarLenUnicode>()
-        .map_err(|e| hdf5::Error::from(e.to_string().as_str()))
+/// The root attribute naming the program that wrote a file.
+pub(crate) fn set_generator(root: &mut Group) {
+    root.attrs
+        .set_text("generator", concat!("cosserat ", env!("CARGO_PKG_VERSION")));
 }
 
-pub(crate) fn string_attr(loc: &hdf5::Location, name: &str, value: &str) -> hdf5::Result<()> {
-    loc.new_attr::<VarLenUnicode>()
-        .create(name)?
-        .write_scalar(&text(value)?)
-}
-
-fn f64_attr(loc: &hdf5::Location, name: &str, value: f64) -> hdf5::Result<()> {
-    loc.new_attr::<f64>().create(name)?.write_scalar(&value)
-}
-
-fn usize_attr(loc: &hdf5::Location, name: &str, value: usize) -> hdf5::Result<()> {
-    loc.new_attr::<u64>()
-        .create(name)?
-        .write_scalar(&(value as u64))
-}
-
+/// Samples' vectors as an n×3 dataset.
 fn vectors(
-    group: &hdf5::Group,
+    group: &mut Group,
     name: &str,
     samples: &[RodSample],
     f: impl Fn(&RodSample) -> nalgebra::Vector3<f64>,
-) -> hdf5::Result<()> {
+) -> StoreResult<()> {
     let data: Vec<f64> = samples
         .iter()
         .flat_map(|p| f(p).as_slice().to_vec())
         .collect();
-    group
-        .new_dataset::<f64>()
-        .shape([samples.len(), 3])
-        .create(name)?
-        .write_raw(&data)
+    group.floats(name, &[samples.len(), 3], &data)
 }
 
-fn root_attributes(file: &hdf5::File, problem: &str) -> hdf5::Result<()> {
-    string_attr(file, "problem", problem)?;
-    string_attr(
-        file,
-        "generator",
-        concat!("cosserat ", env!("CARGO_PKG_VERSION")),
-    )
+fn root_attributes(root: &mut Group, problem: &str) {
+    root.attrs.set_text("problem", problem);
+    set_generator(root);
 }
 
-pub(crate) fn array(
-    group: &hdf5::Group,
-    name: &str,
-    shape: &[usize],
-    data: &[f64],
-) -> hdf5::Result<()> {
-    group
-        .new_dataset::<f64>()
-        .shape(shape)
-        .create(name)?
-        .write_raw(data)
-}
-
-fn write_solution(file: &hdf5::File, eq: &Equilibrium) -> hdf5::Result<()> {
-    let g = file.create_group("solution")?;
+fn write_solution(root: &mut Group, eq: &Equilibrium) -> StoreResult<()> {
+    let g = root.create_group("solution");
     let s: Vec<f64> = eq.samples.iter().map(|p| p.s).collect();
-    array(&g, "s", &[s.len()], &s)?;
-    vectors(&g, "position", &eq.samples, |p| p.position)?;
+    g.floats("s", &[s.len()], &s)?;
+    vectors(g, "position", &eq.samples, |p| p.position)?;
     for (i, name) in ["d1", "d2", "d3"].iter().enumerate() {
-        vectors(&g, name, &eq.samples, |p| p.directors[i])?;
+        vectors(g, name, &eq.samples, |p| p.directors[i])?;
     }
-    vectors(&g, "curvature", &eq.samples, |p| p.curvature)?;
-    vectors(&g, "moment", &eq.samples, |p| p.moment)?;
-    vectors(&g, "force", &eq.samples, |p| p.force)?;
+    vectors(g, "curvature", &eq.samples, |p| p.curvature)?;
+    vectors(g, "moment", &eq.samples, |p| p.moment)?;
+    vectors(g, "force", &eq.samples, |p| p.force)?;
     let h = &eq.residual_history;
-    array(&g, "residual_history", &[h.len()], h)?;
-    array(&g, "unknowns", &[eq.unknowns.len()], &eq.unknowns)?;
-    usize_attr(&g, "segments", eq.method.segments())?;
-    string_attr(&g, "model", eq.model.level.name())?;
-    string_attr(&g, "model_reason", &eq.model.reason)?;
-    string_attr(&g, "method", eq.method.name())?;
-    usize_attr(&g, "iterations", eq.iterations)?;
-    f64_attr(&g, "residual", eq.residual)?;
-    string_attr(&g, "converged", "true")?;
-    usize_attr(&g, "load_steps", eq.load_steps)?;
-    f64_attr(&g, "director_drift", eq.director_drift)?;
-    f64_attr(&g, "wall_time", eq.wall_time)?;
-    usize_attr(&g, "integration_steps", eq.integration.accepted)
+    g.floats("residual_history", &[h.len()], h)?;
+    g.floats("unknowns", &[eq.unknowns.len()], &eq.unknowns)?;
+    let a = &mut g.attrs;
+    a.set_count("segments", eq.method.segments() as u64);
+    a.set_text("model", eq.model.level.name());
+    a.set_text("model_reason", &eq.model.reason);
+    a.set_text("method", eq.method.name());
+    a.set_count("iterations", eq.iterations as u64);
+    a.set_float("residual", eq.residual);
+    a.set_text("converged", "true");
+    a.set_count("load_steps", eq.load_steps as u64);
+    a.set_float("director_drift", eq.director_drift);
+    a.set_float("wall_time", eq.wall_time);
+    a.set_count("integration_steps", eq.integration.accepted as u64);
+    Ok(())
 }
 
 /// Modes as (count × nodes × 3).
 fn modes(
-    group: &hdf5::Group,
+    group: &mut Group,
     name: &str,
     modes: &[&Vec<Vector3<f64>>],
     nodes: usize,
-) -> hdf5::Result<()> {
+) -> StoreResult<()> {
     let data: Vec<f64> = modes
         .iter()
         .flat_map(|m| m.iter().flat_map(|w| w.as_slice().to_vec()))
         .collect();
-    array(group, name, &[modes.len(), nodes, 3], &data)
+    group.floats(name, &[modes.len(), nodes, 3], &data)
 }
 
-fn write_spectrum(file: &hdf5::File, st: &Stability) -> hdf5::Result<()> {
-    let g = file.create_group("stability")?;
+fn write_spectrum(root: &mut Group, st: &Stability) -> StoreResult<()> {
+    let g = root.create_group("stability");
     let n = st.nodes.len();
-    array(&g, "nodes", &[n], &st.nodes)?;
+    g.floats("nodes", &[n], &st.nodes)?;
     let mut all: Vec<(f64, &Vec<Vector3<f64>>)> = st
         .blocks
         .iter()
@@ -255,48 +219,39 @@ fn write_spectrum(file: &hdf5::File, st: &Stability) -> hdf5::Result<()> {
     all.sort_by(|a, b| a.0.total_cmp(&b.0));
     all.truncate(st.blocks.first().map_or(0, |b| b.eigenvalues.len()));
     let values: Vec<f64> = all.iter().map(|a| a.0).collect();
-    array(&g, "eigenvalues", &[values.len()], &values)?;
+    g.floats("eigenvalues", &[values.len()], &values)?;
     modes(
-        &g,
+        g,
         "eigenvectors",
         &all.iter().map(|a| a.1).collect::<Vec<_>>(),
         n,
     )?;
-    usize_attr(&g, "morse_index", st.morse_index)?;
-    g.new_dataset::<u64>()
-        .create("morse_index")?
-        .write_scalar(&(st.morse_index as u64))?;
-    string_attr(&g, "verdict", if st.stable { "stable" } else { "unstable" })?;
+    g.attrs.set_count("morse_index", st.morse_index as u64);
+    g.count("morse_index", st.morse_index as u64)?;
+    g.attrs
+        .set_text("verdict", if st.stable { "stable" } else { "unstable" });
     for b in st.blocks.iter().filter(|b| b.block != Block::Full) {
-        let sub = g.create_group(b.block.name())?;
-        array(&sub, "eigenvalues", &[b.eigenvalues.len()], &b.eigenvalues)?;
-        modes(&sub, "eigenvectors", &b.modes.iter().collect::<Vec<_>>(), n)?;
-        sub.new_dataset::<u64>()
-            .create("morse_index")?
-            .write_scalar(&(b.morse_index as u64))?;
+        let sub = g.create_group(b.block.name());
+        sub.floats("eigenvalues", &[b.eigenvalues.len()], &b.eigenvalues)?;
+        modes(sub, "eigenvectors", &b.modes.iter().collect::<Vec<_>>(), n)?;
+        sub.count("morse_index", b.morse_index as u64)?;
     }
     Ok(())
 }
 
-fn write_critical_load(file: &hdf5::File, c: &CriticalLoad) -> hdf5::Result<()> {
-    let g = file.create_group("stability")?;
+fn write_critical_load(root: &mut Group, c: &CriticalLoad) -> StoreResult<()> {
+    let g = root.create_group("stability");
     let n = c.nodes.len();
-    array(&g, "nodes", &[n], &c.nodes)?;
-    g.new_dataset::<f64>()
-        .create("critical_load")?
-        // None: stable under any load, so the critical load is +∞ (the
-        // value, not a placeholder).
-        .write_scalar(&c.gamma.unwrap_or(f64::INFINITY))?;
-    g.new_dataset::<f64>()
-        .create("load_factor")?
-        .write_scalar(&c.load_factor.unwrap_or(f64::INFINITY))?;
+    g.floats("nodes", &[n], &c.nodes)?;
+    // None: stable under any load, so the critical load is +∞ (the value,
+    // not a placeholder).
+    g.float("critical_load", c.gamma.unwrap_or(f64::INFINITY))?;
+    g.float("load_factor", c.load_factor.unwrap_or(f64::INFINITY))?;
     for (block, factor, mode) in &c.blocks {
-        let sub = g.create_group(block.name())?;
-        sub.new_dataset::<f64>()
-            .create("load_factor")?
-            .write_scalar(&factor.unwrap_or(f64::INFINITY))?;
+        let sub = g.create_group(block.name());
+        sub.float("load_factor", factor.unwrap_or(f64::INFINITY))?;
         if !mode.is_empty() {
-            modes(&sub, "null_vector", &[mode], n)?;
+            modes(sub, "null_vector", &[mode], n)?;
         }
     }
     Ok(())
@@ -319,30 +274,24 @@ pub struct SolvedUnknowns {
 /// `cosserat stability` on an equilibrium) wrote, its seal checked; an
 /// error names what is missing (a file of another kind, or one written
 /// before solve files kept their unknowns).
-pub fn read_solved(path: &Path) -> hdf5::Result<SolvedUnknowns> {
+pub fn read_solved(path: &Path) -> StoreResult<SolvedUnknowns> {
     let f = super::seal::open(path)?;
     let g = f
         .group("solution")
-        .map_err(|_| hdf5::Error::from("it has no /solution group"))?;
+        .map_err(|_| StoreError::from("it has no /solution group"))?;
     let unknowns = g
         .dataset("unknowns")
         .map_err(|_| {
-            hdf5::Error::from(
+            StoreError::from(
                 "its /solution has no unknowns (written before solve files kept them): solve again",
             )
         })?
-        .read_raw::<f64>()?;
-    let read = |loc: &hdf5::Location, name: &str| -> hdf5::Result<String> {
-        Ok(loc
-            .attr(name)?
-            .read_scalar::<VarLenUnicode>()?
-            .as_str()
-            .to_string())
-    };
+        .floats()?
+        .to_vec();
     Ok(SolvedUnknowns {
-        problem: read(&f, "problem")?,
-        model: read(&g, "model")?,
-        method: read(&g, "method")?,
+        problem: f.attrs.text("problem")?.to_owned(),
+        model: g.attrs.text("model")?.to_owned(),
+        method: g.attrs.text("method")?.to_owned(),
         unknowns,
     })
 }

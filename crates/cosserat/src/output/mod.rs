@@ -1,6 +1,6 @@
 //! Results out: HDF5 files of equilibria, stability, bifurcation diagrams,
-//! arm studies and sweeps (feature `hdf5`: the HDF5 C library through
-//! hdf5-metno), written atomically to outputs claimed by [`target`] and
+//! arm studies and sweeps (feature `hdf5`: pure Rust through hdf5-pure,
+//! behind the one module [`store`]), written atomically to outputs claimed by [`target`] and
 //! sealed with a checksum ([`seal`]) that is verified before a file is read
 //! back. Writers read results; they never build or compute them. No stage
 //! imports this module.
@@ -17,6 +17,8 @@ mod hdf5_output;
 pub mod schema;
 pub mod seal;
 #[cfg(feature = "hdf5")]
+pub mod store;
+#[cfg(feature = "hdf5")]
 mod sweep_output;
 pub mod target;
 
@@ -25,11 +27,13 @@ pub use arm_output::{read_search, write_arm, write_arm_study, ArmStudy, SavedSea
 #[cfg(feature = "hdf5")]
 pub use curve::write_curve;
 #[cfg(feature = "hdf5")]
-pub use diagram::{read_saved, write_diagram, write_stages};
+pub use diagram::{read_saved, read_stable, write_diagram, write_stages};
 #[cfg(feature = "hdf5")]
 pub use hdf5_output::{
     check_target, read_solved, write_equilibrium, write_stability, OutputError, SolvedUnknowns,
     StabilityResult,
 };
+#[cfg(feature = "hdf5")]
+pub use store::{StoreError, StoreResult};
 #[cfg(feature = "hdf5")]
 pub use sweep_output::{read_sweep, write_sweep, SweepHeader};

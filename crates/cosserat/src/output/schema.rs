@@ -6,10 +6,10 @@
 //! this table does not know gets the description "undescribed" — the
 //! tests read every file the commands write and refuse any such dataset.
 
-use hdf5::types::VarLenUnicode;
+use super::store::Group;
 
 /// The version of the layout described by docs/hdf5-schema.md.
-pub const SCHEMA_VERSION: &str = "1";
+pub const SCHEMA_VERSION: &str = "2";
 
 /// The description given to a dataset the table does not know.
 pub const UNDESCRIBED: &str = "undescribed";
@@ -46,13 +46,13 @@ fn entry(parent: &str, name: &str) -> (&'static str, &'static str) {
         (_, "shapes") => ("m", "centreline at equally spaced points"),
         (_, "unknowns") => ("", "discrete unknowns of the continued discretization"),
         (_, "tangent") => ("", "unit tangent of the branch in (unknowns, parameter)"),
-        (_, "stable") => ("", "1 where stable (Morse index 0 and conservative loads), else 0"),
+        (_, "stable") => ("", "`stable` (Morse index 0 and conservative loads) or `unstable`"),
         (_, "held_keys") => ("", "keys held at the values of earlier stages"),
         (_, "held_values") => ("as each key", "values of the held keys"),
         ("special_points", "kind") => ("", "fold or branch point"),
         ("special_points", "branch" | "index") => ("", "branch and point index of the special point"),
         ("special_points", "block") => ("", "the Hessian block whose eigenvalue crosses zero"),
-        ("special_points", "symmetry_breaking") => ("", "1 where the mode breaks the branch's symmetry"),
+        ("special_points", "symmetry_breaking") => ("", "`breaking` where the mode breaks the branch's symmetry, else `preserving`"),
         ("special_points", "singularity") => ("1", "size of the singularity (test function, its bound)"),
         ("special_points", "multiplicity") => ("", "eigenvalues crossing zero together"),
         ("special_points", "location") => ("", "augmented (minimally augmented system) or bracketed (regula falsi)"),
@@ -69,7 +69,10 @@ fn entry(parent: &str, name: &str) -> (&'static str, &'static str) {
         (_, "loaded_shape" | "unloaded_shape") => ("m", "centreline of the design, loaded or unloaded"),
         (_, "reach" | "reach_fine") => ("1", "reach per rod length L"),
         (_, "reach_error") => ("1", "estimated mesh error of the reach"),
-        (_, "reach_meshes" | "mesh_elements") => ("", "meshes of the convergence study"),
+        (_, "mesh_elements") => ("", "elements of the meshes of the convergence study"),
+        (_, "reach_meshes") => ("1", "reach per rod length on each mesh of the convergence study"),
+        (_, "rejected_elements") => ("", "elements of the mesh of each design given up"),
+        (_, "rejected_reach") => ("1", "reach per rod length of each design given up: on its mesh, on 4× its elements"),
         (_, "reach_order") => ("1", "measured order of the mesh convergence"),
         (_, "clamp_angle") => ("rad", "clamp angle of the straight arm"),
         (_, "leader_points") => ("1", "the best samples' coefficients"),
@@ -94,36 +97,20 @@ fn entry(parent: &str, name: &str) -> (&'static str, &'static str) {
     }
 }
 
-/// Attaches `units` and `description` to every dataset of `group` and its
-/// subgroups.
-fn describe(group: &hdf5::Group, parent: &str) -> hdf5::Result<()> {
-    for name in group.member_names()? {
-        if let Ok(sub) = group.group(&name) {
-            describe(&sub, &name)?;
-            continue;
-        }
-        let ds = group.dataset(&name)?;
-        let (units, description) = entry(parent, &name);
-        for (key, value) in [("units", units), ("description", description)] {
-            let v: VarLenUnicode = value
-                .parse()
-                .map_err(|e| hdf5::Error::from(format!("{e}")))?;
-            ds.new_attr::<VarLenUnicode>()
-                .create(key)?
-                .write_scalar(&v)?;
-        }
-    }
-    Ok(())
+/// Whether a sweep result column (`family_0/evaluations`) holds a count:
+/// stored as integers, not floats (docs/hdf5-schema.md, "Types").
+pub fn is_count_column(name: &str) -> bool {
+    let last = name.rsplit('/').next().unwrap_or(name);
+    matches!(last, "iterations" | "elements" | "evaluations")
 }
 
-/// Describes every dataset of a file just written and stamps the schema
-/// version on its root.
-pub(crate) fn describe_file(file: &hdf5::File) -> hdf5::Result<()> {
-    describe(file, "")?;
-    let v: VarLenUnicode = SCHEMA_VERSION
-        .parse()
-        .map_err(|e| hdf5::Error::from(format!("{e}")))?;
-    file.new_attr::<VarLenUnicode>()
-        .create("schema_version")?
-        .write_scalar(&v)
+/// Describes every dataset of a file's tree and stamps the schema version
+/// on its root.
+pub(crate) fn describe_file(root: &mut Group) {
+    root.each_dataset_mut("", &mut |parent, name, ds| {
+        let (units, description) = entry(parent, name);
+        ds.attrs.set_text("units", units);
+        ds.attrs.set_text("description", description);
+    });
+    root.attrs.set_text("schema_version", SCHEMA_VERSION);
 }

@@ -1,8 +1,9 @@
 //! A checksum sealed onto every result file this crate writes, checked
-//! before a file is handed back to the HDF5 library (`--resume`, `merge`,
-//! `plot`): the HDF5 C library trusts the bytes it reads, and a damaged
-//! file can make it read out of bounds or ask for an impossible
-//! allocation. A damaged file is refused by name instead.
+//! before a file is handed back to the HDF5 reader (`--resume`, `merge`,
+//! `plot`): a damaged file is refused by name, before its bytes are
+//! parsed, instead of being read as whatever the damage made of it (the
+//! HDF5 C library, used before hdf5-pure, read out of bounds or asked for
+//! impossible allocations on such files).
 //!
 //! The seal is 24 bytes appended after the HDF5 data: the magic
 //! `cosserat-seal-v1` and the FNV-1a 64-bit hash of every byte before it
@@ -89,9 +90,9 @@ pub fn check(path: &Path) -> Result<Seal, String> {
     }
 }
 
-/// Opens a result file for reading after checking its seal.
+/// Reads a result file whole after checking its seal.
 #[cfg(feature = "hdf5")]
-pub fn open(path: &Path) -> hdf5::Result<hdf5::File> {
-    check(path).map_err(|e| hdf5::Error::from(e.as_str()))?;
-    hdf5::File::open(path)
+pub fn open(path: &Path) -> Result<super::store::Group, super::store::StoreError> {
+    check(path).map_err(super::store::StoreError::Unreadable)?;
+    super::store::read(path)
 }

@@ -8,11 +8,12 @@
 //!   `/grid/shape`;
 //! - `/points/index` (n, flat row-major grid index, last axis fastest),
 //!   `/points/parameters` (n×k), and every result column under
-//!   `/points/<name>` (n, or n×w; NaN where a value does not exist),
-//!   labels as strings; `/points` attributes `columns` and `labels` list
+//!   `/points/<name>` (n, or n×w; NaN where a value does not exist; a
+//!   count column — [`super::schema::is_count_column`] — as i64, −1 where
+//!   it does not exist), labels as strings; `/points` attributes `columns` and `labels` list
 //!   the names, one per line;
 //! - `/maps/<name>`: every one-value column on the full grid (the grid's
-//!   shape, NaN where not computed) — e.g. `/maps/family_0/reach`, ready
+//!   shape, NaN — or −1 for a count — where not computed) — e.g. `/maps/family_0/reach`, ready
 //!   for a contour plot in h5py.
 //!
 //! Written atomically (temporary file, then rename), so a checkpoint is
@@ -22,9 +23,9 @@ use crate::continuation::RunState;
 use std::collections::BTreeSet;
 use std::path::Path;
 
-use hdf5::types::VarLenUnicode;
-
-use super::hdf5_output::{array, string_attr, text, write_atomically, OutputError};
+use super::hdf5_output::{set_generator, write_atomically, OutputError};
+use super::schema::is_count_column;
+use super::store::{Dataset, Group, StoreError, StoreResult, Values};
 use crate::study::sweep::grid_index;
 use crate::study::sweep::Record;
 
@@ -54,26 +55,45 @@ impl SweepHeader {
     }
 }
 
-fn strings(g: &hdf5::Group, name: &str, data: &[String]) -> hdf5::Result<()> {
-    let values: Vec<VarLenUnicode> = data.iter().map(|s| text(s)).collect::<hdf5::Result<_>>()?;
-    g.new_dataset::<VarLenUnicode>()
-        .shape([values.len()])
-        .create(name)?
-        .write_raw(&values)
+/// A numeric column as stored: floats, or for a count column i64 with −1
+/// where the value does not exist (NaN in the record). A count that is
+/// not a whole number ≥ 0 is refused, never rounded.
+fn column(name: &str, data: Vec<f64>) -> StoreResult<Values> {
+    if !is_count_column(name) {
+        return Ok(Values::Floats(data));
+    }
+    data.iter()
+        .map(|&v| {
+            if v.is_nan() {
+                Ok(-1)
+            } else if v >= 0.0 && v.fract() == 0.0 && v < 9.0e15 {
+                Ok(v as i64)
+            } else {
+                Err(StoreError::from(format!(
+                    "column {name}: {v} is not a count"
+                )))
+            }
+        })
+        .collect::<StoreResult<Vec<i64>>>()
+        .map(Values::Signed)
 }
 
-/// The group at `path` below `root`, created as needed; and the last name.
-fn parent<'a>(root: &hdf5::Group, path: &'a str) -> hdf5::Result<(hdf5::Group, &'a str)> {
-    let mut g = root.clone();
-    let mut parts: Vec<&str> = path.split('/').collect();
-    let last = parts.pop().unwrap_or_default();
-    for p in parts {
-        g = match g.group(p) {
-            Ok(sub) => sub,
-            Err(_) => g.create_group(p)?,
-        };
+/// A stored numeric column back as the record's floats (−1 of a count
+/// column: NaN, the value does not exist).
+fn column_values(d: &Dataset) -> StoreResult<Vec<f64>> {
+    match d.values() {
+        Values::Floats(v) => Ok(v.clone()),
+        Values::Signed(v) => Ok(v
+            .iter()
+            .map(|&x| if x < 0 { f64::NAN } else { x as f64 })
+            .collect()),
+        other => Err(format!(
+            "dataset {} is {}, not a column",
+            d.path(),
+            other.type_name()
+        )
+        .into()),
     }
-    Ok((g, last))
 }
 
 /// Writes `records` (sorted by index) under `header`, atomically.
@@ -83,41 +103,32 @@ pub fn write_sweep(
     records: &[Record],
     force: bool,
 ) -> Result<(), OutputError> {
-    write_atomically(path, force, |file| {
+    write_atomically(path, force, |root| {
         for (name, value) in [
-            ("problem", &header.problem),
-            ("kind", &header.kind),
-            ("shard", &header.shard),
-            ("stop_reason", &header.stop_reason.name().to_string()),
-            (
-                "generator",
-                &concat!("cosserat ", env!("CARGO_PKG_VERSION")).to_string(),
-            ),
+            ("problem", header.problem.as_str()),
+            ("kind", header.kind.as_str()),
+            ("shard", header.shard.as_str()),
+            ("stop_reason", header.stop_reason.name()),
         ] {
-            string_attr(file, name, value)?;
+            root.attrs.set_text(name, value);
         }
-        for (name, v) in [("points", header.points()), ("members", header.members)] {
-            file.new_attr::<u64>()
-                .create(name)?
-                .write_scalar(&(v as u64))?;
-        }
-        write_grid(file, header)?;
-        write_points(file, header, records)?;
-        write_maps(file, header, records)
+        set_generator(root);
+        root.attrs.set_count("points", header.points() as u64);
+        root.attrs.set_count("members", header.members as u64);
+        write_grid(root, header)?;
+        write_points(root, header, records)?;
+        write_maps(root, header, records)
     })
 }
 
-fn write_grid(file: &hdf5::File, header: &SweepHeader) -> hdf5::Result<()> {
-    let g = file.create_group("grid")?;
-    strings(&g, "keys", &header.keys)?;
+fn write_grid(root: &mut Group, header: &SweepHeader) -> StoreResult<()> {
+    let g = root.create_group("grid");
+    g.texts("keys", &header.keys)?;
     for (j, values) in header.axes.iter().enumerate() {
-        array(&g, &format!("axis_{j}"), &[values.len()], values)?;
+        g.floats(&format!("axis_{j}"), &[values.len()], values)?;
     }
     let shape: Vec<u64> = header.axes.iter().map(|a| a.len() as u64).collect();
-    g.new_dataset::<u64>()
-        .shape([shape.len()])
-        .create("shape")?
-        .write_raw(&shape)
+    g.counts("shape", &shape)
 }
 
 /// The axis values at flat index `i` on the grid of `axes`.
@@ -130,20 +141,17 @@ fn parameters(axes: &[Vec<f64>], i: usize) -> Vec<f64> {
         .collect()
 }
 
-fn write_points(file: &hdf5::File, header: &SweepHeader, records: &[Record]) -> hdf5::Result<()> {
-    let g = file.create_group("points")?;
+fn write_points(root: &mut Group, header: &SweepHeader, records: &[Record]) -> StoreResult<()> {
+    let g = root.create_group("points");
     let n = records.len();
     let index: Vec<u64> = records.iter().map(|r| r.index as u64).collect();
-    g.new_dataset::<u64>()
-        .shape([n])
-        .create("index")?
-        .write_raw(&index)?;
+    g.counts("index", &index)?;
     let k = header.axes.len();
     let params: Vec<f64> = records
         .iter()
         .flat_map(|r| parameters(&header.axes, r.index))
         .collect();
-    array(&g, "parameters", &[n, k], &params)?;
+    g.floats("parameters", &[n, k], &params)?;
     let columns: BTreeSet<&String> = records.iter().flat_map(|r| r.numbers.keys()).collect();
     for name in &columns {
         let width = records
@@ -157,9 +165,8 @@ fn write_points(file: &hdf5::File, header: &SweepHeader, records: &[Record]) -> 
                 data[row * width + j] = *v;
             }
         }
-        let (parent, last) = parent(&g, name)?;
         let shape: Vec<usize> = if width == 1 { vec![n] } else { vec![n, width] };
-        array(&parent, last, &shape, &data)?;
+        g.put(name, &shape, column(name, data)?)?;
     }
     let labels: BTreeSet<&String> = records.iter().flat_map(|r| r.labels.keys()).collect();
     for name in &labels {
@@ -167,16 +174,16 @@ fn write_points(file: &hdf5::File, header: &SweepHeader, records: &[Record]) -> 
             .iter()
             .map(|r| r.labels.get(*name).cloned().unwrap_or_default())
             .collect();
-        let (parent, last) = parent(&g, name)?;
-        strings(&parent, last, &values)?;
+        g.texts(name, &values)?;
     }
     let list = |s: &BTreeSet<&String>| s.iter().map(|x| x.as_str()).collect::<Vec<_>>().join("\n");
-    string_attr(&g, "columns", &list(&columns))?;
-    string_attr(&g, "labels", &list(&labels))
+    g.attrs.set_text("columns", &list(&columns));
+    g.attrs.set_text("labels", &list(&labels));
+    Ok(())
 }
 
-fn write_maps(file: &hdf5::File, header: &SweepHeader, records: &[Record]) -> hdf5::Result<()> {
-    let g = file.create_group("maps")?;
+fn write_maps(root: &mut Group, header: &SweepHeader, records: &[Record]) -> StoreResult<()> {
+    let g = root.create_group("maps");
     let shape: Vec<usize> = header.axes.iter().map(Vec::len).collect();
     let columns: BTreeSet<&String> = records
         .iter()
@@ -194,49 +201,35 @@ fn write_maps(file: &hdf5::File, header: &SweepHeader, records: &[Record]) -> hd
                 data[r.index] = v[0];
             }
         }
-        let (parent, last) = parent(&g, name)?;
-        array(&parent, last, &shape, &data)?;
+        g.put(name, &shape, column(name, data)?)?;
     }
     Ok(())
 }
 
-fn read_string(loc: &hdf5::Location, name: &str) -> hdf5::Result<String> {
-    Ok(loc
-        .attr(name)?
-        .read_scalar::<VarLenUnicode>()?
-        .as_str()
-        .to_string())
-}
-
 /// Reads a sweep file: its header and records.
-pub fn read_sweep(path: &Path) -> hdf5::Result<(SweepHeader, Vec<Record>)> {
+pub fn read_sweep(path: &Path) -> StoreResult<(SweepHeader, Vec<Record>)> {
     let f = super::seal::open(path)?;
     let grid = f.group("grid")?;
-    let keys: Vec<String> = grid
-        .dataset("keys")?
-        .read_raw::<VarLenUnicode>()?
-        .iter()
-        .map(|s| s.as_str().to_string())
-        .collect();
+    let keys = grid.dataset("keys")?.texts()?.to_vec();
     let axes = (0..keys.len())
-        .map(|j| grid.dataset(&format!("axis_{j}"))?.read_raw::<f64>())
-        .collect::<hdf5::Result<Vec<_>>>()?;
+        .map(|j| Ok(grid.dataset(&format!("axis_{j}"))?.floats()?.to_vec()))
+        .collect::<StoreResult<Vec<_>>>()?;
+    let text = |name: &str| -> StoreResult<String> { Ok(f.attrs.text(name)?.to_owned()) };
     let header = SweepHeader {
-        problem: read_string(&f, "problem")?,
-        kind: read_string(&f, "kind")?,
-        shard: read_string(&f, "shard")?,
+        problem: text("problem")?,
+        kind: text("kind")?,
+        shard: text("shard")?,
         stop_reason: {
-            let name = read_string(&f, "stop_reason")?;
-            RunState::from_name(&name).ok_or_else(|| {
-                hdf5::Error::from(format!("unknown stop_reason `{name}`").as_str())
-            })?
+            let name = text("stop_reason")?;
+            RunState::from_name(&name)
+                .ok_or_else(|| StoreError::from(format!("unknown stop_reason `{name}`")))?
         },
         keys,
         axes,
-        members: f.attr("members")?.read_scalar::<u64>()? as usize,
+        members: f.attrs.count("members")? as usize,
     };
     let g = f.group("points")?;
-    let index = g.dataset("index")?.read_raw::<u64>()?;
+    let index = g.dataset("index")?.counts()?;
     let points: usize = header.axes.iter().map(Vec::len).product();
     let mut seen = std::collections::BTreeSet::new();
     if index
@@ -246,8 +239,9 @@ pub fn read_sweep(path: &Path) -> hdf5::Result<(SweepHeader, Vec<Record>)> {
         return Err("a point index is outside the grid or repeated".into());
     }
     let mut records: Vec<Record> = index.iter().map(|i| Record::new(*i as usize)).collect();
-    let names = |attr: &str| -> hdf5::Result<Vec<String>> {
-        Ok(read_string(&g, attr)?
+    let names = |attr: &str| -> StoreResult<Vec<String>> {
+        Ok(g.attrs
+            .text(attr)?
             .lines()
             .filter(|l| !l.is_empty())
             .map(String::from)
@@ -256,24 +250,22 @@ pub fn read_sweep(path: &Path) -> hdf5::Result<(SweepHeader, Vec<Record>)> {
     for name in names("columns")? {
         let d = g.dataset(&name)?;
         let width = d.shape().get(1).copied().unwrap_or(1);
-        let data = d.read_raw::<f64>()?;
+        let data = column_values(d)?;
         if data.len() != width.max(1) * records.len() {
-            return Err(format!("column {name}: not one row per point")
-                .as_str()
-                .into());
+            return Err(format!("column {name}: not one row per point").into());
         }
         for (r, row) in records.iter_mut().zip(data.chunks(width.max(1))) {
             r.set(&name, row.to_vec());
         }
     }
     for name in names("labels")? {
-        let data = g.dataset(&name)?.read_raw::<VarLenUnicode>()?;
+        let data = g.dataset(&name)?.texts()?;
         if data.len() != records.len() {
-            return Err(format!("label {name}: not one per point").as_str().into());
+            return Err(format!("label {name}: not one per point").into());
         }
         for (r, v) in records.iter_mut().zip(data) {
-            if !v.as_str().is_empty() {
-                r.label(&name, v.as_str());
+            if !v.is_empty() {
+                r.label(&name, v);
             }
         }
     }
