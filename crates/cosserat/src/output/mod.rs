@@ -19,6 +19,8 @@ pub mod seal;
 #[cfg(feature = "hdf5")]
 mod sweep_output;
 pub mod target;
+pub mod vtk;
+pub mod xdmf;
 
 #[cfg(feature = "hdf5")]
 pub use arm_output::{read_search, write_arm, write_arm_study, ArmStudy, SavedSearch};
