@@ -5,7 +5,8 @@
 //! HDF5 datasets as h5py reads them (tests/export/read_back.py): positions
 //! and fields equal to the stored values, directors orthonormal, s over
 //! [0, L] with L from the problem file, one time step per stored point,
-//! timesteps equal to the stored parameters along a monotone branch.
+//! timesteps equal to the stored parameters along a monotone branch, an
+//! arm study's designs equal to its stored centrelines.
 //! Where ParaView's Python (`pvpython`, or `pvbatch`) is on PATH, ParaView
 //! opens each file too and counts its time steps.
 //!
@@ -125,6 +126,9 @@ fn an_equilibrium_exports_with_every_field() {
     ok(&dir, &["solve", &problem, "-o", "direct.vtp"]);
     ok(&dir, &["export", "c.h5", "--format", "vtk", "-o", "c.vtp"]);
     ok(&dir, &["export", "c.h5", "--format", "xdmf"]);
+    // A stability file holds the same equilibrium with its spectrum.
+    ok(&dir, &["stability", &problem, "-o", "st.h5"]);
+    ok(&dir, &["export", "st.h5", "--format", "vtk"]);
     // The cantilever's length from its problem file.
     let length = 1.0;
     assert!(std::fs::read_to_string(&problem)
@@ -134,6 +138,7 @@ fn an_equilibrium_exports_with_every_field() {
         read_back(&dir, "vtp", "c.vtp", "c.h5", length, None);
         read_back(&dir, "vtp", "direct.vtp", "c.h5", length, None);
         read_back(&dir, "xmf", "c.xmf2", "c.h5", length, None);
+        read_back(&dir, "vtp", "st.vtp", "st.h5", length, None);
     }
     paraview_steps(&dir, "c.vtp", 0);
     paraview_steps(&dir, "c.xmf2", 1);
@@ -248,6 +253,9 @@ fn an_arm_study_exports_its_designs() {
     let out = ok(&dir, &["export", "a.h5", "--format", "vtk"]);
     assert!(out.contains("optimum loaded, optimum unloaded"), "{out}");
     ok(&dir, &["export", "a.h5", "--format", "xdmf"]);
+    if python_ready() {
+        read_back(&dir, "pvd", "a.pvd", "a.h5", 0.0, None);
+    }
     paraview_steps(&dir, "a.pvd", 2);
     paraview_steps(&dir, "a.xmf2", 2);
     std::fs::remove_dir_all(&dir).unwrap();
