@@ -139,6 +139,13 @@ fn timeline(file: &ShapeFile, branch: Option<usize>) -> Result<Timeline<'_>, Str
             ),
         });
     };
+    Ok(branch_timeline(file, b))
+}
+
+/// The points of branch `b`: in the order and at the values of the
+/// parameter where it is strictly monotone along the branch, else by
+/// index.
+fn branch_timeline(file: &ShapeFile, b: usize) -> Timeline<'_> {
     let mut frames: Vec<&Frame> = file.frames.iter().filter(|f| f.branch == Some(b)).collect();
     let name = file.branches[b]
         .parameter_name
@@ -152,17 +159,17 @@ fn timeline(file: &ShapeFile, branch: Option<usize>) -> Result<Timeline<'_>, Str
             frames.reverse();
         }
         let times = frames.iter().filter_map(|f| f.parameter).collect();
-        return Ok(Timeline {
+        return Timeline {
             frames,
             times,
             note: format!("the continuation parameter {name} (monotone along branch {b})"),
-        });
+        };
     }
-    Ok(Timeline {
+    Timeline {
         times: (0..frames.len()).map(|i| i as f64).collect(),
         frames,
         note: format!("point index along branch {b} ({name} is not monotone along it)"),
-    })
+    }
 }
 
 /// The arc length s of each diagram frame's equally spaced points, where
