@@ -353,7 +353,13 @@ pub(crate) fn problem_case(
     let wants_output = verb != Verb::CheckEnergy
         && (matches!(verb, Verb::Continue | Verb::Sweep) || rng.chance(0.7));
     if wants_output {
-        let (out, more, writable) = output(rng, 0.3, "h5", "out.h5");
+        // `solve -o NAME.vtp` writes VTK PolyData instead of HDF5.
+        let ext = if verb == Verb::Solve && rng.chance(0.3) {
+            "vtp"
+        } else {
+            "h5"
+        };
+        let (out, more, writable) = output(rng, 0.3, ext, &format!("out.{ext}"));
         if rng.chance(0.1) {
             // The input itself as the output.
             args.extend(["-o".into(), "p.toml".into()]);
