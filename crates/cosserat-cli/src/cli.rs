@@ -29,7 +29,8 @@ pub enum Command {
     Solve {
         /// The problem file (TOML).
         problem: PathBuf,
-        /// Write the solution to this HDF5 file.
+        /// Write the solution to this HDF5 file (or, named *.vtp, as a
+        /// VTK polyline for ParaView).
         #[arg(short, long)]
         output: Option<PathBuf>,
         /// Override the solver method: "shooting", "multiple-shooting" or "collocation".
@@ -169,6 +170,11 @@ pub enum Command {
         #[arg(long)]
         force: bool,
     },
+    /// Export the rod shapes of a result file for ParaView: an
+    /// equilibrium as one polyline with its fields, a diagram as one time
+    /// step per continuation point (VTK .pvd of .vtp files, or XDMF
+    /// referring into the HDF5 file).
+    Export(crate::export_command::ExportArgs),
     /// Draw a bifurcation diagram file.
     Plot {
         /// The HDF5 diagram from `cosserat continue`.

@@ -16,6 +16,7 @@
 //! | `optimize` | [`optimize_command`] | `study::arm::ArmProblem` → `ArmOptimum`, its reach map and loading / control paths | the study (HDF5), its chart by [`arm_chart`] (Fig. 5) |
 //! | `sweep`, `merge` | [`sweep_command`] | `study::sweep::Sweep` → `study::sweep::run` over `ArmJob` or `SolveJob` | checkpointed records (HDF5), merged shards, charts by [`sweep_figure`] and [`sweep_chart`] (Figs. 6, 7) |
 //! | `validate` | [`validate`] | every case of validation/*.toml with every method, against `cosserat::references` | a Markdown report |
+//! | `export` | [`export_command`] (reads through [`shape_file`]) | none: the shapes a result file holds | VTK (.vtp, .pvd) or XDMF (.xmf) for ParaView |
 //! | `bench` | [`mod@bench`] | `bvp::solve` for every method and order | a work-precision chart and CSV |
 //!
 //! Every command first reads its problem (`cosserat::input::Problem`, the only
@@ -38,9 +39,11 @@ pub mod continue_command;
 pub mod curve_command;
 pub mod energies;
 pub mod exit;
+pub mod export_command;
 pub mod optimize_command;
 pub mod plot;
 pub mod progress;
+pub mod shape_file;
 pub mod signals;
 pub mod solve_command;
 pub mod stored_start;
@@ -163,6 +166,7 @@ pub fn run(cli: Cli) -> ExitCode {
             plot,
             force,
         } => sweep_command::run_merge(&inputs, &output, plot.as_deref(), force),
+        Command::Export(args) => export_command::run_export(&args),
         Command::Plot {
             diagram,
             output,

@@ -210,12 +210,31 @@ pub fn run_solve(path: &Path, output: Option<&Path>, set: &[String], force: bool
         );
     }
     if let Some(out) = output {
-        if let Err(e) = write_equilibrium(out, &eq, &problem.text, true) {
+        let written = if is_vtp(out) {
+            write_polyline(out, &eq)
+        } else {
+            write_equilibrium(out, &eq, &problem.text, true).map_err(|e| e.to_string())
+        };
+        if let Err(e) = written {
             return fail(OUTPUT, e);
         }
         println!("written   {}", out.display());
     }
     ExitCode::SUCCESS
+}
+
+/// `-o NAME.vtp`: the equilibrium as VTK PolyData for ParaView, not HDF5.
+fn is_vtp(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("vtp"))
+}
+
+/// Writes the equilibrium as a VTK polyline with its fields, atomically.
+fn write_polyline(path: &Path, eq: &Equilibrium) -> Result<(), String> {
+    use cosserat::output::vtk::{polydata, Polyline};
+    let rod = Polyline::from_samples(&eq.samples).map_err(|e| e.to_string())?;
+    let text = polydata(&rod);
+    cosserat::output::target::replace_atomically(path, |tmp| std::fs::write(tmp, &text))
 }
 
 /// The stability verdict of a solved equilibrium (conservative loads), on a

@@ -1,5 +1,5 @@
 //! The hostile-input harness: the built `cosserat` binary, every command
-//! (`solve`, `stability`, `continue`, `optimize`, `sweep`, `plot`,
+//! (`solve`, `stability`, `continue`, `optimize`, `sweep`, `plot`, `export`,
 //! `merge`), run on mutated problem files (numeric extremes, wrong types,
 //! wrong lengths, deleted and duplicated keys and tables, truncated files,
 //! byte noise, oversized files, extreme `--set` values) and hostile paths

@@ -16,10 +16,11 @@ pub(crate) enum Verb {
     Plot,
     Merge,
     CheckEnergy,
+    Export,
 }
 
 impl Verb {
-    pub(crate) const ALL: [Verb; 8] = [
+    pub(crate) const ALL: [Verb; 9] = [
         Verb::Solve,
         Verb::Stability,
         Verb::Continue,
@@ -28,6 +29,7 @@ impl Verb {
         Verb::Plot,
         Verb::Merge,
         Verb::CheckEnergy,
+        Verb::Export,
     ];
     pub(crate) fn name(self) -> &'static str {
         match self {
@@ -39,6 +41,7 @@ impl Verb {
             Verb::Plot => "plot",
             Verb::Merge => "merge",
             Verb::CheckEnergy => "check-energy",
+            Verb::Export => "export",
         }
     }
     /// The table a problem needs for this command.
@@ -291,6 +294,7 @@ pub(crate) fn case(id: usize, seed: u64, seeds: &[(String, String)], fx: &Fixtur
     match verb {
         Verb::Plot => plot_case(id, &mut rng, fx),
         Verb::Merge => merge_case(id, &mut rng, fx),
+        Verb::Export => export_case(id, &mut rng, fx),
         _ => problem_case(id, verb, &mut rng, seeds),
     }
 }
@@ -349,7 +353,13 @@ pub(crate) fn problem_case(
     let wants_output = verb != Verb::CheckEnergy
         && (matches!(verb, Verb::Continue | Verb::Sweep) || rng.chance(0.7));
     if wants_output {
-        let (out, more, writable) = output(rng, 0.3, "h5", "out.h5");
+        // `solve -o NAME.vtp` writes VTK PolyData instead of HDF5.
+        let ext = if verb == Verb::Solve && rng.chance(0.3) {
+            "vtp"
+        } else {
+            "h5"
+        };
+        let (out, more, writable) = output(rng, 0.3, ext, &format!("out.{ext}"));
         if rng.chance(0.1) {
             // The input itself as the output.
             args.extend(["-o".into(), "p.toml".into()]);
@@ -446,6 +456,43 @@ pub(crate) fn merge_case(id: usize, rng: &mut Rng, fx: &Fixtures) -> Case {
     Case {
         id,
         what,
+        prepared,
+        args,
+        outputs,
+    }
+}
+
+/// `export`: the diagram intact or damaged, or a sweep shard (no shape),
+/// as VTK (a `.pvd` and its `.vtp` files, or a `.vtp` the diagram's many
+/// shapes cannot go to) or XDMF, to hostile paths.
+pub(crate) fn export_case(id: usize, rng: &mut Rng, fx: &Fixtures) -> Case {
+    let (bytes, how) = match rng.below(4) {
+        0 => (fx.shards[0].clone(), "a sweep shard".to_string()),
+        1 => damaged(rng, &fx.diagram),
+        _ => (fx.diagram.clone(), "intact".to_string()),
+    };
+    let mut prepared = vec![Prepared::File("d.h5".into(), bytes)];
+    let (format, ext) = *rng.pick(&[("vtk", "pvd"), ("vtk", "vtp"), ("xdmf", "xmf2")]);
+    let (out, more, writable) = output(rng, 0.4, ext, &format!("out.{ext}"));
+    prepared.extend(more);
+    let mut args: Vec<String> = ["export", "d.h5", "--format", format, "-o", &out]
+        .map(String::from)
+        .to_vec();
+    if rng.chance(0.3) {
+        args.extend(["--branch".into(), rng.pick(&["0", "1", "7"]).to_string()]);
+    }
+    if rng.chance(0.3) {
+        args.push("--force".into());
+    }
+    let mut outputs = if writable { vec![out.clone()] } else { vec![] };
+    if writable && ext == "pvd" {
+        // The collection's shapes beside it: OUT_0000.vtp, ...
+        let stem = out.strip_suffix(".pvd").unwrap_or(&out);
+        outputs.extend((0..1000).map(|k| format!("{stem}_{k:04}.vtp")));
+    }
+    Case {
+        id,
+        what: format!("export ({how}) {}", args[2..].join(" ")),
         prepared,
         args,
         outputs,

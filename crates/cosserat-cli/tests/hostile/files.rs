@@ -66,6 +66,21 @@ fn inconsistent_result_files_are_named_errors() {
             vec!["plot", "d.h5", "-o", "f.png"],
         ),
         (
+            "d.h5",
+            Box::new(|p: &Path| replace_dataset(p, "branches/0/stable", &[1u64])),
+            vec!["export", "d.h5", "--format", "vtk"],
+        ),
+        (
+            "d.h5",
+            Box::new(|p: &Path| replace_dataset(p, "branches/0/shapes", &[1.0f64, 2.0, 3.0, 4.0])),
+            vec!["export", "d.h5", "--format", "xdmf"],
+        ),
+        (
+            "d.h5",
+            Box::new(|p: &Path| replace_dataset(p, "branches/0/parameter", &[f64::NAN])),
+            vec!["export", "d.h5", "--format", "vtk"],
+        ),
+        (
             "s.h5",
             Box::new(|p: &Path| replace_dataset(p, "points/index", &[1_000_000u64, 1])),
             vec!["merge", "s.h5", "-o", "m.h5"],
@@ -113,6 +128,7 @@ fn damaged_sealed_files_are_refused_before_hdf5_reads_them() {
     for (k, (bytes, args)) in [
         (&fx.diagram, vec!["plot", "x.h5", "-o", "f.png"]),
         (&fx.shards[0], vec!["merge", "x.h5", "-o", "m.h5"]),
+        (&fx.diagram, vec!["export", "x.h5", "--format", "xdmf"]),
     ]
     .into_iter()
     .enumerate()

@@ -21,6 +21,8 @@ pub mod store;
 #[cfg(feature = "hdf5")]
 mod sweep_output;
 pub mod target;
+pub mod vtk;
+pub mod xdmf;
 
 #[cfg(feature = "hdf5")]
 pub use arm_output::{read_search, write_arm, write_arm_study, ArmStudy, SavedSearch};
