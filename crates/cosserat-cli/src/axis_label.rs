@@ -95,8 +95,8 @@ impl Dimension {
             Dimension::Curvature => ("1/m", format!("{symbol} L")),
             Dimension::Force => ("N", format!("{symbol} L²/B₂")),
             Dimension::ForcePerLength => ("N/m", format!("{symbol} L³/B₂")),
-            Dimension::Couple => ("N·m", format!("{symbol} L/B₂")),
-            Dimension::Energy => ("N·m", format!("{symbol} L/B₂")),
+            // A couple and an energy share N·m and the group L/B₂.
+            Dimension::Couple | Dimension::Energy => ("N·m", format!("{symbol} L/B₂")),
             Dimension::Stiffness => ("N·m²", format!("{symbol}/B₂")),
             Dimension::Quartic => ("N·m⁴", format!("{symbol}/(B₂ L²)")),
         };

@@ -405,7 +405,7 @@ pub fn read_points(csv: &Path) -> Result<Vec<Point>, String> {
     let text = std::fs::read_to_string(csv).map_err(|e| e.to_string())?;
     let mut lines = text.lines().enumerate();
     match lines.next() {
-        Some((_, h)) if h == "scene,method,parameter,tip_error,time_s,newton_steps,mesh_size" => {}
+        Some((_, "scene,method,parameter,tip_error,time_s,newton_steps,mesh_size")) => {}
         _ => return Err("line 1: not a work_precision.csv header".into()),
     }
     let names: Vec<&'static str> = scenes().iter().map(|s| s.name).collect();

@@ -403,7 +403,7 @@ pub enum Glyph {
 impl Glyph {
     /// Draws the glyph in the 24 × 14 box at (x, y) of `area`.
     fn draw<DB: DrawingBackend>(
-        &self,
+        self,
         area: &DrawingArea<DB, Shift>,
         (x, y): (i32, i32),
     ) -> Result<(), Failure>
@@ -411,7 +411,7 @@ impl Glyph {
         DB::ErrorType: 'static,
     {
         let mid = (x + 12, y + 7);
-        match *self {
+        match self {
             Glyph::Line(c, stroke) => {
                 let style = c.stroke_width(3);
                 let segments: Vec<(i32, i32)> = match stroke {
@@ -566,7 +566,6 @@ where
         .margin_right(8)
         .y_label_area_size(0)
         .right_y_label_area_size(58)
-        .x_label_area_size(if top > 0 { 0 } else { 0 })
         .build_cartesian_2d(0.0..1.0, lo..hi)?;
     let span = hi - lo;
     chart
@@ -577,11 +576,12 @@ where
         .y_label_formatter(&|v| tick(*v, span))
         .label_style(("sans-serif", TEXT_FONT))
         .draw()?;
-    let steps = 96;
+    let steps: i32 = 96;
     chart.draw_series((0..steps).map(|k| {
-        let a = lo + span * k as f64 / steps as f64;
-        let b = lo + span * (k + 1) as f64 / steps as f64;
-        let t = (k as f64 + 0.5) / steps as f64;
+        let n = f64::from(steps);
+        let a = lo + span * f64::from(k) / n;
+        let b = lo + span * f64::from(k + 1) / n;
+        let t = (f64::from(k) + 0.5) / n;
         Rectangle::new([(0.0, a), (1.0, b)], shade(t).filled())
     }))?;
     frame(chart.plotting_area())?;

@@ -300,8 +300,7 @@ impl Figure for Envelopes<'_> {
         ];
         let names = self.panels.iter().find(|p| p.1.len() == curves);
         for (k, (label, _)) in names
-            .map(|p| p.1.as_slice())
-            .unwrap_or(&[])
+            .map_or(&[][..], |p| p.1.as_slice())
             .iter()
             .enumerate()
         {
@@ -315,11 +314,11 @@ impl Figure for Envelopes<'_> {
     }
 }
 
-fn build<'a, DB: DrawingBackend>(
-    area: &'a DrawingArea<DB, Shift>,
+fn build<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
     z: (f64, f64),
     h: (f64, f64),
-) -> Result<ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>, Failure>
+) -> Result<ChartContext<'_, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>, Failure>
 where
     DB::ErrorType: 'static,
 {

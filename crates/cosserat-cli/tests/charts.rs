@@ -317,7 +317,7 @@ fn crowded_diagram(height: f64) -> DiagramData {
     let shape = |k: usize| -> Vec<[f64; 3]> {
         (0..=20)
             .map(|i| {
-                let s = i as f64 / 20.0;
+                let s = f64::from(i) / 20.0;
                 [
                     -height * (std::f64::consts::PI * s).sin() * k as f64 / m as f64,
                     0.0,
@@ -414,7 +414,7 @@ fn header(keys: &[&str], axes: Vec<Vec<f64>>) -> SweepHeader {
         kind: "arm".into(),
         shard: "merged".into(),
         stop_reason: RunState::Completed,
-        keys: keys.iter().map(|k| k.to_string()).collect(),
+        keys: keys.iter().map(ToString::to_string).collect(),
         members: axes.iter().map(Vec::len).product(),
         axes,
     }
