@@ -126,8 +126,13 @@ pub fn tick(v: f64, span: f64) -> String {
         .map(|m| m * decade)
         .find(|s| *s >= rough * (1.0 - 1e-9))
         .unwrap_or(10.0 * decade);
-    if v != 0.0 && (v.abs() >= 1e5 || step < 1e-4) {
-        return format!("{v:.2e}");
+    if v.abs() >= 1e5 || step < 1e-4 {
+        // Zero among scientific ticks is a plain 0.
+        return if v.abs() < 1e-3 * step {
+            "0".into()
+        } else {
+            format!("{v:.2e}")
+        };
     }
     let decimals = (-step.log10() - 1e-9).ceil().clamp(0.0, 6.0) as usize;
     let s = format!("{v:.decimals$}");
@@ -672,5 +677,6 @@ mod tests {
         assert_eq!(tick(-0.0, 1.0), "0.0");
         assert_eq!(tick(0.0012, 0.005), "0.0012");
         assert_eq!(tick(3e-6, 1e-5), "3.00e-6");
+        assert_eq!(tick(0.0, 1e-5), "0");
     }
 }

@@ -299,11 +299,7 @@ impl Figure for Envelopes<'_> {
             LegendEntry::new(Glyph::Dot(RED), "μ ≈ 1.81, eq. (4)"),
         ];
         let names = self.panels.iter().find(|p| p.1.len() == curves);
-        for (k, (label, _)) in names
-            .map_or(&[][..], |p| p.1.as_slice())
-            .iter()
-            .enumerate()
-        {
+        for (k, (label, _)) in names.map_or(&[][..], |p| p.1.as_slice()).iter().enumerate() {
             entries.push(LegendEntry::new(
                 Glyph::Line(colour(k), Stroke::Solid),
                 label.clone(),

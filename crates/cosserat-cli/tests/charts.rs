@@ -262,7 +262,7 @@ fn continuation_chart_of_the_euler_column() {
         "--plot",
         svg.to_str().unwrap(),
         "--set",
-        "continuation.bounds=[0,6]",
+        "continuation.bounds=[0,4]",
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let o = run(&["plot", h5.to_str().unwrap(), "-o", png.to_str().unwrap()]);
