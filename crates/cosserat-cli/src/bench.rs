@@ -399,7 +399,7 @@ fn draw_work_precision(dir: &Path, points: &[Point]) -> Result<(), Box<dyn std::
     Ok(())
 }
 
-/// The points of a work_precision.csv as [`work_precision`] writes it;
+/// The points of a work_precision.csv as `cosserat bench work-precision` writes it;
 /// Err names the line and what is wrong.
 pub fn read_points(csv: &Path) -> Result<Vec<Point>, String> {
     let text = std::fs::read_to_string(csv).map_err(|e| e.to_string())?;

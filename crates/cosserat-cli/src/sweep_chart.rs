@@ -21,8 +21,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use crate::chart_style::{
-    colour, colour_bar, equal_aspect, frame, legend, line, render, tick, Failure, Figure, Glyph,
-    LegendEntry, Stroke, AXIS_FONT, TEXT_FONT, TITLE_FONT,
+    colour, colour_bar, equal_aspect, frame, legend, line, padded, render, tick, Failure, Figure,
+    Glyph, LegendEntry, Stroke, AXIS_FONT, TEXT_FONT, TITLE_FONT,
 };
 use cosserat::study::sweep::contour::{GridField, PowerFit};
 
@@ -158,9 +158,16 @@ where
     DB::ErrorType: 'static,
 {
     let f = &panel.field;
-    let (x0, x1) = (f.x[0], f.x[f.x.len() - 1]);
-    let (y0, y1) = (f.y[0], f.y[f.y.len() - 1]);
-    let (x1, y1) = (x1.max(x0 + 1e-9), y1.max(y0 + 1e-9));
+    // An axis of one value gets a padded range, never a zero-width one.
+    let range = |v: &[f64]| {
+        let (a, b) = (v[0], v[v.len() - 1]);
+        if b > a {
+            (a, b)
+        } else {
+            padded(v.iter().copied())
+        }
+    };
+    let ((x0, x1), (y0, y1)) = (range(f.x), range(f.y));
     let mut chart = ChartBuilder::on(area)
         .caption(&panel.title, ("sans-serif", TITLE_FONT))
         .margin(12)
