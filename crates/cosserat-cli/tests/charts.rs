@@ -567,3 +567,106 @@ fn work_precision_chart_redrawn_from_its_csv() {
     assert!(stderr(&o).contains("not a work_precision.csv header"));
     std::fs::remove_dir_all(d).unwrap();
 }
+
+/// An arm design of reach `reach` whose loaded shape is a quarter circle
+/// bent down to the tip and whose unloaded shape rises.
+fn arm_design(reach: f64, c: [f64; 3], b: [f64; 2]) -> cosserat::study::arm::ArmOptimum {
+    use cosserat::study::arm::{ArmDesign, ArmOptimum, ArmScene};
+    let arc = |sign: f64| -> Vec<[f64; 3]> {
+        (0..=40)
+            .map(|i| {
+                let t = std::f64::consts::FRAC_PI_2 * f64::from(i) / 40.0;
+                [sign * reach * (1.0 - t.cos()), 0.0, reach * t.sin()]
+            })
+            .collect()
+    };
+    ArmOptimum {
+        design: ArmDesign {
+            reach,
+            gamma: 4.0,
+            shape_coefficients: vec![0.0, c[0], c[1], c[2]],
+        },
+        curvature_coefficients: b.to_vec(),
+        loaded_shape: arc(0.3),
+        unloaded_shape: arc(-0.5),
+        intrinsic_curvature: vec![],
+        evaluations: 1,
+        critical_load: 4.0,
+        scene: ArmScene::default(),
+        resolution: None,
+    }
+}
+
+/// The Fig. 5 chart: two reach maps, each with its colour bar; P and Q
+/// tagged apart; the shapes to scale with their legends above them.
+#[test]
+fn arm_chart_has_colour_bars_and_shapes_to_scale() {
+    use cosserat::study::arm::{ClosestStraight, ReachMap};
+    use cosserat_cli::arm_chart::{draw_arm, ArmChart};
+    let d = dir("arm");
+    let p = arm_design(1.9, [0.5, 0.2, 0.0], [-2.0, 2.8]);
+    let q = ClosestStraight {
+        index: 3,
+        curvature_norm: 1.4,
+        optimum: arm_design(1.85, [0.52, 0.21, 0.0], [-1.9, 2.7]),
+    };
+    let n = 300;
+    let u = |k: usize, m: usize| ((k * m) % 997) as f64 / 997.0;
+    let map = ReachMap {
+        shape_coefficients: (0..n)
+            .map(|k| vec![0.0, 8.0 * u(k, 31) - 4.0, 4.0 * u(k, 17) - 2.0, 0.0])
+            .collect(),
+        curvature_coefficients: (0..n)
+            .map(|k| vec![6.0 * u(k, 13) - 4.0, 8.0 * u(k, 29) - 2.0])
+            .collect(),
+        reach: (0..n).map(|k| 1.0 + u(k, 7)).collect(),
+        gamma: vec![4.0; n],
+        samples: n,
+        interrupted: false,
+    };
+    let chart = ArmChart {
+        optimum: &p,
+        map: Some(&map),
+        closest: Some(&q),
+        straight: None,
+    };
+    let (svg, png) = (d.join("arm.svg"), d.join("arm.png"));
+    draw_arm(&chart, &svg).unwrap();
+    draw_arm(&chart, &png).unwrap();
+    assert_png(&png);
+    let text = read(&svg);
+    assert_problem_terms(&text);
+    assert_legends_outside(&text);
+    assert_tags_apart(&text);
+    let words: Vec<String> = texts(&text).into_iter().map(|t| t.text).collect();
+    for label in [
+        "loaded-shape coefficient c₂",
+        "R √(F/B₂)",
+        "P loaded",
+        "tip force F",
+    ] {
+        assert!(words.iter().any(|w| w == label), "`{label}` in {words:?}");
+    }
+    let mut columns: BTreeMap<(i64, i64), usize> = BTreeMap::new();
+    for (tag, _) in elements(&text, "rect") {
+        if attr(tag, "stroke") == Some("none") && attr(tag, "fill") != Some("#FFFFFF") {
+            *columns
+                .entry((number(tag, "x") as i64, number(tag, "width") as i64))
+                .or_default() += 1;
+        }
+    }
+    assert_eq!(
+        columns.values().filter(|n| **n >= 90).count(),
+        2,
+        "two colour bars"
+    );
+    let shapes: Vec<SvgRect> = frames(&text)
+        .into_iter()
+        .filter(|f| f.y > 600.0 && f.w > 100.0)
+        .collect();
+    assert_eq!(shapes.len(), 2);
+    for f in &shapes {
+        assert_to_scale(&text, f);
+    }
+    std::fs::remove_dir_all(d).unwrap();
+}
