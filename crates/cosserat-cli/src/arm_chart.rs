@@ -7,13 +7,23 @@
 //!    'P' marks the optimum R*, 'Q' the sample closest to a straight rod
 //!    (least Σb²). c) the optimum's loaded (solid) and unloaded (dashed)
 //!    shapes; d) Q's shapes and the loaded shape of the true straight
-//!    optimum R̂0. Shapes are in the reach's units, height −x against z.
+//!    optimum R̂0. Shapes are in the reach's units, height −x against z,
+//!    to scale, the load drawn at the tip (or the weight at mid-length).
+//!    The reach of the dots is read on a colour bar beside each map; the
+//!    shapes' legend sits above them.
 
 use std::fmt::Write as _;
 use std::path::Path;
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
+
+use crate::chart_style::{
+    self, colour, colour_bar, draw_tags, equal_aspect, frame, legend, line, padded, render, tick,
+    Chart2d, Failure, Figure, Glyph, LegendEntry, PixelBox, Stroke, Tag, AXIS_FONT, TEXT_FONT,
+    TITLE_FONT,
+};
+use cosserat::study::arm::ArmWeight;
 
 use cosserat::study::arm::{ArmOptimum, ClosestStraight, ReachMap, StraightArm};
 
@@ -31,13 +41,10 @@ pub struct ArmChart<'a> {
 }
 
 type Area<'b, DB> = DrawingArea<DB, Shift>;
-type Failure = Box<dyn std::error::Error>;
 
 /// Draws the chart to `out` (.png or .svg), atomically: to a temporary
 /// file beside it (same extension, so the format is kept), then renamed.
 pub fn draw_arm(chart: &ArmChart, out: &Path) -> Result<(), Failure> {
-    crate::plot::register_font();
-    let size = (1400, 1100);
     let extension = out
         .extension()
         .map(|e| e.to_string_lossy().to_lowercase())
@@ -47,11 +54,7 @@ pub fn draw_arm(chart: &ArmChart, out: &Path) -> Result<(), Failure> {
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
     let tmp = out.with_file_name(format!(".{stem}.{}.tmp.{extension}", std::process::id()));
-    let drawn = if extension == "svg" {
-        panels(&SVGBackend::new(&tmp, size).into_drawing_area(), chart)
-    } else {
-        panels(&BitMapBackend::new(&tmp, size).into_drawing_area(), chart)
-    };
+    let drawn = render(chart, &tmp);
     let renamed = drawn.and_then(|()| std::fs::rename(&tmp, out).map_err(Failure::from));
     if renamed.is_err() {
         let _ = std::fs::remove_file(&tmp);
@@ -59,72 +62,93 @@ pub fn draw_arm(chart: &ArmChart, out: &Path) -> Result<(), Failure> {
     renamed
 }
 
-fn panels<DB: DrawingBackend>(root: &Area<DB>, chart: &ArmChart) -> Result<(), Failure>
-where
-    DB::ErrorType: 'static,
-{
-    root.fill(&WHITE)?;
-    let areas = root.split_evenly((2, 2));
-    let p = chart.optimum;
-    let q = chart.closest.map(|q| &q.optimum);
-    let coefficient = |i: usize| move |o: &ArmOptimum| o.design.shape_coefficients[i];
-    let curvature = |i: usize| move |o: &ArmOptimum| o.curvature_coefficients[i];
-    if p.design.shape_coefficients.len() >= 3 {
-        let map = chart.map.map(|m| (&m.shape_coefficients, &m.reach));
-        let marks = (coefficient(1), coefficient(2));
-        scatter(
-            &areas[0],
-            "a) reach R over the loaded shape",
-            ("c2", "c3"),
-            map,
-            (1, 2),
-            p,
-            q,
-            &marks,
-        )?;
+/// The unit of the reach (docs/problem-files.md, `[arm]`).
+fn reach_unit(o: &ArmOptimum) -> &'static str {
+    match o.scene.weight {
+        ArmWeight::Alone => "(q/B₂)^(1/3)",
+        ArmWeight::Weightless | ArmWeight::WithTipLoad(_) => "√(F/B₂)",
     }
-    if p.curvature_coefficients.len() >= 2 {
-        let map = chart.map.map(|m| (&m.curvature_coefficients, &m.reach));
-        let marks = (curvature(0), curvature(1));
-        scatter(
-            &areas[1],
-            "b) reach R over the intrinsic curvature",
-            ("b1", "b2"),
-            map,
-            (0, 1),
-            p,
-            q,
-            &marks,
-        )?;
-    }
-    let title = format!(
-        "c) P: R* = {:.4} (solid loaded, dashed unloaded)",
-        p.design.reach
-    );
-    let mut shapes = vec![(&p.loaded_shape, 0, false), (&p.unloaded_shape, 0, true)];
-    shapes_panel(&areas[2], &title, &shapes)?;
-    shapes.clear();
-    let mut title = String::from("d)");
-    if let Some(q) = q {
-        write!(title, " Q: R = {:.4}", q.design.reach).expect("writing to a String cannot fail");
-        shapes.push((&q.loaded_shape, 1, false));
-        shapes.push((&q.unloaded_shape, 1, true));
-    }
-    if let Some(s) = chart.straight {
-        write!(title, "; true straight optimum R0 = {:.4} (green)", s.reach)
-            .expect("writing to a String cannot fail");
-        shapes.push((&s.loaded_shape, 2, false));
-    }
-    shapes_panel(&areas[3], &title, &shapes)?;
-    root.present()?;
-    Ok(())
 }
 
-const COLORS: [RGBColor; 3] = [
-    RGBColor(0, 114, 178),
-    RGBColor(213, 94, 0),
-    RGBColor(0, 158, 115),
-];
+impl Figure for ArmChart<'_> {
+    fn size(&self) -> (u32, u32) {
+        (1500, 1200)
+    }
+
+    fn draw_on<DB: DrawingBackend>(&self, root: &Area<DB>) -> Result<(), Failure>
+    where
+        DB::ErrorType: 'static,
+    {
+        let areas = root.split_evenly((2, 2));
+        let p = self.optimum;
+        let q = self.closest.map(|q| &q.optimum);
+        let unit = reach_unit(p);
+        let coefficient = |i: usize| move |o: &ArmOptimum| o.design.shape_coefficients[i];
+        let curvature = |i: usize| move |o: &ArmOptimum| o.curvature_coefficients[i];
+        if p.design.shape_coefficients.len() >= 3 {
+            let map = self.map.map(|m| (&m.shape_coefficients, &m.reach));
+            let marks = (coefficient(1), coefficient(2));
+            scatter(
+                &areas[0],
+                "a) reach of the sampled designs over the loaded shape",
+                ("loaded-shape coefficient c₂", "loaded-shape coefficient c₃"),
+                unit,
+                map,
+                (1, 2),
+                (p, q),
+                &marks,
+            )?;
+        }
+        if p.curvature_coefficients.len() >= 2 {
+            let map = self.map.map(|m| (&m.curvature_coefficients, &m.reach));
+            let marks = (curvature(0), curvature(1));
+            scatter(
+                &areas[1],
+                "b) the same designs over the intrinsic curvature",
+                ("κ⁰₂ Taylor coefficient b₁", "κ⁰₂ Taylor coefficient b₂"),
+                unit,
+                map,
+                (0, 1),
+                (p, q),
+                &marks,
+            )?;
+        }
+        let title = format!("c) P, the optimum: R* = {:.4} {unit}", p.design.reach);
+        let shapes = vec![
+            Shape::new(&p.loaded_shape, 0, Stroke::Solid, "P loaded"),
+            Shape::new(&p.unloaded_shape, 0, Stroke::Dashed, "P unloaded"),
+        ];
+        shapes_panel(&areas[2], &title, &shapes, p)?;
+        let mut shapes = vec![];
+        let mut title = String::from("d)");
+        if let Some(q) = q {
+            write!(title, " Q: R = {:.4}", q.design.reach)
+                .expect("writing to a String cannot fail");
+            shapes.push(Shape::new(&q.loaded_shape, 1, Stroke::Solid, "Q loaded"));
+            shapes.push(Shape::new(
+                &q.unloaded_shape,
+                1,
+                Stroke::Dashed,
+                "Q unloaded",
+            ));
+        }
+        if let Some(s) = self.straight {
+            let sep = if q.is_some() { ";" } else { "" };
+            write!(title, "{sep} straight optimum R0 = {:.4}", s.reach)
+                .expect("writing to a String cannot fail");
+            shapes.push(Shape::new(
+                &s.loaded_shape,
+                2,
+                Stroke::Solid,
+                "R0 loaded (κ⁰ = 0)",
+            ));
+        }
+        if !shapes.is_empty() {
+            shapes_panel(&areas[3], &title, &shapes, p)?;
+        }
+        Ok(())
+    }
+}
 
 /// Low reach dark blue, high reach yellow.
 fn heat(t: f64) -> RGBColor {
@@ -133,28 +157,17 @@ fn heat(t: f64) -> RGBColor {
     RGBColor(mix(40.0, 250.0), mix(30.0, 210.0), mix(120.0, 30.0))
 }
 
-fn span(values: impl Iterator<Item = f64>) -> (f64, f64) {
-    let (lo, hi) = values
-        .filter(|v| v.is_finite())
-        .fold((f64::MAX, f64::MIN), |(a, b), v| (a.min(v), b.max(v)));
-    if lo > hi {
-        return (-1.0, 1.0);
-    }
-    let pad = 0.05 * (hi - lo).max(1e-9);
-    (lo - pad, hi + pad)
-}
-
-/// The sampled designs as dots coloured by R̂ (highest drawn last), with
-/// P and Q marked.
+/// The sampled designs as dots coloured by R̂ (highest drawn last, a
+/// colour bar beside), with P and Q marked and tagged apart.
 #[allow(clippy::too_many_arguments)]
 fn scatter<DB: DrawingBackend>(
     area: &Area<DB>,
     title: &str,
     axes: (&str, &str),
+    unit: &str,
     map: Option<(&Vec<Vec<f64>>, &Vec<f64>)>,
     columns: (usize, usize),
-    p: &ArmOptimum,
-    q: Option<&ArmOptimum>,
+    (p, q): (&ArmOptimum, Option<&ArmOptimum>),
     mark: &(impl Fn(&ArmOptimum) -> f64, impl Fn(&ArmOptimum) -> f64),
 ) -> Result<(), Failure>
 where
@@ -165,6 +178,7 @@ where
             rows.iter()
                 .zip(reach)
                 .map(|(r, v)| (r[columns.0], r[columns.1], *v))
+                .filter(|d| d.2.is_finite())
                 .collect()
         })
         .unwrap_or_default();
@@ -172,70 +186,167 @@ where
     let marks: Vec<(&str, f64, f64)> = std::iter::once(("P", mark.0(p), mark.1(p)))
         .chain(q.map(|q| ("Q", mark.0(q), mark.1(q))))
         .collect();
-    let xs = span(dots.iter().map(|d| d.0).chain(marks.iter().map(|m| m.1)));
-    let ys = span(dots.iter().map(|d| d.1).chain(marks.iter().map(|m| m.2)));
-    let (lo, hi) = dots
-        .iter()
-        .fold((f64::MAX, f64::MIN), |(a, b), d| (a.min(d.2), b.max(d.2)));
-    let mut chart = ChartBuilder::on(area)
-        .caption(
-            format!("{title} ({lo:.2} dark … {hi:.2} light)"),
-            ("sans-serif", 18),
-        )
+    let xs = padded(dots.iter().map(|d| d.0).chain(marks.iter().map(|m| m.1)));
+    let ys = padded(dots.iter().map(|d| d.1).chain(marks.iter().map(|m| m.2)));
+    let (plot, bar) = area.split_horizontally(area.dim_in_pixel().0 - 110);
+    let mut chart = ChartBuilder::on(&plot)
+        .caption(title, ("sans-serif", TITLE_FONT))
         .margin(15)
-        .x_label_area_size(40)
-        .y_label_area_size(55)
+        .x_label_area_size(50)
+        .y_label_area_size(70)
         .build_cartesian_2d(xs.0..xs.1, ys.0..ys.1)?;
+    let (xspan, yspan) = (xs.1 - xs.0, ys.1 - ys.0);
     chart
         .configure_mesh()
         .x_desc(axes.0)
         .y_desc(axes.1)
-        .label_style(("sans-serif", 14))
+        .x_label_formatter(&|v| tick(*v, xspan))
+        .y_label_formatter(&|v| tick(*v, yspan))
+        .label_style(("sans-serif", TEXT_FONT))
+        .axis_desc_style(("sans-serif", AXIS_FONT))
+        .light_line_style(WHITE)
+        .bold_line_style(BLACK.mix(0.12))
         .draw()?;
-    let width = (hi - lo).max(1e-12);
+    let range = padded(dots.iter().map(|d| d.2));
+    let range = if dots.len() > 1 {
+        (dots[0].2, dots[dots.len() - 1].2)
+    } else {
+        range
+    };
+    let width = (range.1 - range.0).max(1e-12);
     chart.draw_series(
         dots.iter()
-            .map(|d| Circle::new((d.0, d.1), 3, heat((d.2 - lo) / width).filled())),
+            .map(|d| Circle::new((d.0, d.1), 3, heat((d.2 - range.0) / width).filled())),
     )?;
-    for (name, x, y) in marks {
-        let element = EmptyElement::at((x, y))
-            + Circle::new((0, 0), 7, BLACK.stroke_width(2))
-            + Text::new(name, (9, -20), ("sans-serif", 18));
-        chart.draw_series(std::iter::once(element))?;
+    frame(chart.plotting_area())?;
+    let tags: Vec<Tag> = marks
+        .iter()
+        .map(|(name, x, y)| Tag {
+            text: (*name).to_string(),
+            at: (*x, *y),
+            glyph: Some(Glyph::Ring(BLACK)),
+        })
+        .collect();
+    draw_tags(&mut chart, &tags, &[])?;
+    if !dots.is_empty() {
+        colour_bar(&bar, range, &heat, &format!("R {unit}"), 75)?;
     }
     Ok(())
 }
 
-/// Rod shapes, height −x against z.
+/// A rod shape to draw.
+struct Shape<'a> {
+    points: &'a [[f64; 3]],
+    colour: usize,
+    stroke: Stroke,
+    label: &'static str,
+}
+
+impl<'a> Shape<'a> {
+    fn new(
+        points: &'a [[f64; 3]],
+        colour: usize,
+        stroke: Stroke,
+        label: &'static str,
+    ) -> Shape<'a> {
+        Shape {
+            points,
+            colour,
+            stroke,
+            label,
+        }
+    }
+
+    fn loaded(&self) -> bool {
+        self.label.contains("loaded") && !self.label.contains("unloaded")
+    }
+}
+
+/// Length of a load arrow (pixels): a direction, not a magnitude.
+const ARROW: f64 = 42.0;
+/// The colour of load arrows.
+const LOAD: RGBColor = RGBColor(200, 0, 0);
+
+/// Rod shapes, height −x against z, to scale, with the load on the loaded
+/// shapes and the legend above.
 fn shapes_panel<DB: DrawingBackend>(
     area: &Area<DB>,
     title: &str,
-    shapes: &[(&Vec<[f64; 3]>, usize, bool)],
+    shapes: &[Shape],
+    p: &ArmOptimum,
 ) -> Result<(), Failure>
 where
     DB::ErrorType: 'static,
 {
-    let zs = span(shapes.iter().flat_map(|s| s.0.iter().map(|r| r[2])));
-    let hs = span(shapes.iter().flat_map(|s| s.0.iter().map(|r| -r[0])));
-    let mut chart = ChartBuilder::on(area)
-        .caption(title, ("sans-serif", 18))
-        .margin(15)
-        .x_label_area_size(40)
-        .y_label_area_size(55)
-        .build_cartesian_2d(zs.0..zs.1, hs.0..hs.1)?;
+    let inner = area.titled(title, ("sans-serif", TITLE_FONT))?;
+    let (top, plot) = inner.split_vertically(60);
+    let loads = p.scene.loads();
+    let (at_tip, force) = if loads.tip_force.norm() > 0.0 {
+        (true, loads.tip_force)
+    } else {
+        (false, loads.distributed_force)
+    };
+    let mut entries: Vec<LegendEntry> = shapes
+        .iter()
+        .map(|s| LegendEntry::new(Glyph::Line(colour(s.colour), s.stroke), s.label))
+        .collect();
+    let (dz, dh) = (force[2], -force[0]);
+    let size = dz.hypot(dh);
+    if size > 0.0 {
+        let text = if at_tip {
+            "tip force F"
+        } else {
+            "weight q (at mid-length)"
+        };
+        entries.push(LegendEntry::new(Glyph::Arrow(LOAD), text));
+    }
+    legend(&top.margin(4, 0, 70, 0), &entries, 3)?;
+    let zs = padded(shapes.iter().flat_map(|s| s.points.iter().map(|r| r[2])));
+    let hs = padded(shapes.iter().flat_map(|s| s.points.iter().map(|r| -r[0])));
+    let build = |zs: (f64, f64), hs: (f64, f64)| {
+        ChartBuilder::on(&plot)
+            .margin(15)
+            .x_label_area_size(50)
+            .y_label_area_size(70)
+            .build_cartesian_2d(zs.0..zs.1, hs.0..hs.1)
+    };
+    let pixels = build(zs, hs)?.plotting_area().dim_in_pixel();
+    let (zs, hs) = equal_aspect(zs, hs, pixels);
+    let room = (ARROW + 12.0) * (zs.1 - zs.0) / f64::from(pixels.0.max(1));
+    let (zs, hs) = equal_aspect(
+        (zs.0 - room, zs.1 + room),
+        (hs.0 - room, hs.1 + room),
+        pixels,
+    );
+    let mut chart: Chart2d<DB> = build(zs, hs)?;
+    let (zspan, hspan) = (zs.1 - zs.0, hs.1 - hs.0);
     chart
         .configure_mesh()
-        .x_desc("z")
-        .y_desc("−x (height)")
-        .label_style(("sans-serif", 14))
+        .x_desc(format!("z {}", reach_unit(p)))
+        .y_desc(format!("height −x {}", reach_unit(p)))
+        .x_label_formatter(&|v| tick(*v, zspan))
+        .y_label_formatter(&|v| tick(*v, hspan))
+        .label_style(("sans-serif", TEXT_FONT))
+        .axis_desc_style(("sans-serif", AXIS_FONT))
+        .light_line_style(WHITE)
+        .bold_line_style(BLACK.mix(0.12))
         .draw()?;
-    for (shape, color, dashed) in shapes {
-        let style = COLORS[*color % COLORS.len()].stroke_width(2);
-        let pts: Vec<(f64, f64)> = shape.iter().map(|r| (r[2], -r[0])).collect();
-        if *dashed {
-            chart.draw_series(DashedLineSeries::new(pts, 8, 6, style))?;
-        } else {
-            chart.draw_series(LineSeries::new(pts, style))?;
+    for s in shapes {
+        let pts: Vec<(f64, f64)> = s.points.iter().map(|r| (r[2], -r[0])).collect();
+        line(&mut chart, pts, colour(s.colour), s.stroke, 2)?;
+    }
+    frame(chart.plotting_area())?;
+    if size > 0.0 {
+        let (bx, by) = plot.get_base_pixel();
+        for s in shapes.iter().filter(|s| s.loaded() && !s.points.is_empty()) {
+            let r = if at_tip {
+                s.points[s.points.len() - 1]
+            } else {
+                s.points[s.points.len() / 2]
+            };
+            let from = chart.backend_coord(&(r[2], -r[0]));
+            let d = ((dz / size * ARROW) as i32, (-dh / size * ARROW) as i32);
+            let _: PixelBox = chart_style::arrow(&plot, (from.0 - bx, from.1 - by), d, LOAD)?;
         }
     }
     Ok(())

@@ -38,6 +38,11 @@ pub enum BenchCommand {
         /// Directory for work_precision.csv, .png and .svg.
         #[arg(short, long, default_value = "work-precision")]
         output: PathBuf,
+        /// Draw the chart of a stored measurement (a work_precision.csv)
+        /// into the output directory instead of measuring again: the
+        /// timings stay those of the machine that measured them.
+        #[arg(long, value_name = "CSV")]
+        redraw: Option<PathBuf>,
     },
     /// Wall time of a problem's whole `[continuation]` diagram (median, min,
     /// max after one warm-up run) with the diagram's branches and special
@@ -57,7 +62,20 @@ pub enum BenchCommand {
 /// Runs a benchmark; the exit code of the command.
 pub fn run(command: BenchCommand) -> ExitCode {
     match command {
-        BenchCommand::WorkPrecision { output } => match work_precision(&output) {
+        BenchCommand::WorkPrecision {
+            output,
+            redraw: Some(csv),
+        } => match read_points(&csv) {
+            Ok(points) => match draw_work_precision(&output, &points) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => crate::exit::fail(crate::exit::OUTPUT, e),
+            },
+            Err(e) => crate::exit::fail(crate::exit::BAD_INPUT, format!("{}: {e}", csv.display())),
+        },
+        BenchCommand::WorkPrecision {
+            output,
+            redraw: None,
+        } => match work_precision(&output) {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => {
                 eprintln!("error: {e}");
@@ -365,101 +383,151 @@ fn work_precision(dir: &Path) -> Result<(), Box<dyn std::error::Error>> {
         .expect("writing to a String cannot fail");
     }
     std::fs::write(dir.join("work_precision.csv"), csv)?;
-    crate::plot::register_font();
+    draw_work_precision(dir, &points)?;
+    println!("written   {}", dir.join("work_precision.csv").display());
+    Ok(())
+}
+
+/// Draws `points` to work_precision.png and .svg in `dir`.
+fn draw_work_precision(dir: &Path, points: &[Point]) -> Result<(), Box<dyn std::error::Error>> {
     let png = dir.join("work_precision.png");
     let svg = dir.join("work_precision.svg");
-    chart(
-        &BitMapBackend::new(&png, (1800, 620)).into_drawing_area(),
-        &points,
-    )?;
-    chart(
-        &SVGBackend::new(&svg, (1800, 620)).into_drawing_area(),
-        &points,
-    )?;
-    println!(
-        "written   {}, {}, {}",
-        dir.join("work_precision.csv").display(),
-        png.display(),
-        svg.display()
-    );
+    let chart = WorkPrecision { points };
+    crate::chart_style::render(&chart, &png)?;
+    crate::chart_style::render(&chart, &svg)?;
+    println!("written   {}, {}", png.display(), svg.display());
     Ok(())
+}
+
+/// The points of a work_precision.csv as `cosserat bench work-precision` writes it;
+/// Err names the line and what is wrong.
+pub fn read_points(csv: &Path) -> Result<Vec<Point>, String> {
+    let text = std::fs::read_to_string(csv).map_err(|e| e.to_string())?;
+    let mut lines = text.lines().enumerate();
+    match lines.next() {
+        Some((_, "scene,method,parameter,tip_error,time_s,newton_steps,mesh_size")) => {}
+        _ => return Err("line 1: not a work_precision.csv header".into()),
+    }
+    let names: Vec<&'static str> = scenes().iter().map(|s| s.name).collect();
+    lines
+        .filter(|(_, l)| !l.trim().is_empty())
+        .map(|(i, l)| {
+            let bad = |what: &str| format!("line {}: {what}", i + 1);
+            let f: Vec<&str> = l.split(',').collect();
+            let [scene, method, parameter, error, time, steps, mesh] = f[..] else {
+                return Err(bad("not 7 fields"));
+            };
+            let number = |v: &str| {
+                v.parse::<f64>()
+                    .ok()
+                    .filter(|x| x.is_finite())
+                    .ok_or_else(|| bad(&format!("`{v}` is not a finite number")))
+            };
+            let count = |v: &str| {
+                v.parse::<usize>()
+                    .map_err(|_| bad(&format!("`{v}` is not a count")))
+            };
+            Ok(Point {
+                scene: names
+                    .iter()
+                    .find(|n| **n == scene)
+                    .ok_or_else(|| bad(&format!("unknown scene `{scene}`")))?,
+                method: method.to_string(),
+                parameter: number(parameter)?,
+                error: number(error)?,
+                time: number(time)?,
+                newton_steps: count(steps)?,
+                mesh: count(mesh)?,
+            })
+        })
+        .collect()
 }
 
 const FLOOR: f64 = 1e-16;
 
-fn chart<DB: DrawingBackend>(
-    root: &DrawingArea<DB, plotters::coord::Shift>,
-    points: &[Point],
-) -> Result<(), Box<dyn std::error::Error>>
-where
-    DB::ErrorType: 'static,
-{
-    root.fill(&WHITE)?;
-    let names: Vec<&str> = scenes().iter().map(|s| s.name).collect();
-    let panels = root.split_evenly((1, names.len()));
-    let mut methods: Vec<String> = points.iter().map(|p| p.method.clone()).collect();
-    methods.dedup();
-    let mut order: Vec<String> = Vec::new();
-    for m in methods {
-        if !order.contains(&m) {
-            order.push(m);
-        }
+/// The work-precision chart: one panel per scene, error against time on
+/// log axes, one colour per method; the legend in a strip above the
+/// panels (never over the data).
+struct WorkPrecision<'a> {
+    points: &'a [Point],
+}
+
+impl crate::chart_style::Figure for WorkPrecision<'_> {
+    fn size(&self) -> (u32, u32) {
+        (1800, 680)
     }
-    let colors = [
-        RGBColor(0, 114, 178),
-        RGBColor(230, 159, 0),
-        RGBColor(0, 158, 115),
-        RGBColor(204, 121, 167),
-    ];
-    for (panel, name) in panels.iter().zip(&names) {
-        let mine: Vec<&Point> = points.iter().filter(|p| p.scene == *name).collect();
-        let (tmin, tmax) = mine.iter().fold((f64::MAX, f64::MIN), |(a, b), p| {
-            (a.min(p.time), b.max(p.time))
-        });
-        let mut c = ChartBuilder::on(panel)
-            .caption(*name, ("sans-serif", 26))
-            .margin(12)
-            .x_label_area_size(50)
-            .y_label_area_size(80)
-            .build_cartesian_2d(
-                (tmin / 1.5..tmax * 1.5).log_scale(),
-                (FLOOR..1.0).log_scale(),
-            )?;
-        c.configure_mesh()
-            .x_desc("wall time per equilibrium (s)")
-            .y_desc("tip error")
-            .x_label_formatter(&|v| format!("{v:.0e}"))
-            .y_label_formatter(&|v| format!("{v:.0e}"))
-            .label_style(("sans-serif", 16))
-            .axis_desc_style(("sans-serif", 18))
-            .draw()?;
-        for (i, m) in order.iter().enumerate() {
-            let color = colors[i % colors.len()];
-            let series: Vec<(f64, f64)> = mine
-                .iter()
-                .filter(|p| &p.method == m)
-                .map(|p| (p.time, p.error.clamp(FLOOR, 1.0)))
-                .collect();
-            c.draw_series(LineSeries::new(series.clone(), color.stroke_width(2)))?
-                .label(m.as_str())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(3))
-                });
-            c.draw_series(
-                series
+
+    fn draw_on<DB: DrawingBackend>(
+        &self,
+        root: &DrawingArea<DB, plotters::coord::Shift>,
+    ) -> Result<(), Box<dyn std::error::Error>>
+    where
+        DB::ErrorType: 'static,
+    {
+        use crate::chart_style::{colour, frame, legend, Glyph, LegendEntry, Stroke};
+        let points = self.points;
+        let names: Vec<&str> = scenes().iter().map(|s| s.name).collect();
+        let mut order: Vec<String> = Vec::new();
+        for p in points {
+            if !order.contains(&p.method) {
+                order.push(p.method.clone());
+            }
+        }
+        let (top, body) = root.split_vertically(56);
+        let entries: Vec<LegendEntry> = order
+            .iter()
+            .enumerate()
+            .map(|(i, m)| LegendEntry::new(Glyph::Line(colour(i), Stroke::Solid), m.clone()))
+            .collect();
+        legend(&top.margin(10, 0, 90, 0), &entries, entries.len())?;
+        let panels = body.split_evenly((1, names.len()));
+        for (panel, name) in panels.iter().zip(&names) {
+            let mine: Vec<&Point> = points.iter().filter(|p| p.scene == *name).collect();
+            let (tmin, tmax) = mine.iter().fold((f64::MAX, f64::MIN), |(a, b), p| {
+                (a.min(p.time), b.max(p.time))
+            });
+            let (tmin, tmax) = if tmin <= tmax {
+                (tmin, tmax)
+            } else {
+                (1e-6, 1.0)
+            };
+            let mut c = ChartBuilder::on(panel)
+                .caption(*name, ("sans-serif", 24))
+                .margin(12)
+                .x_label_area_size(50)
+                .y_label_area_size(80)
+                .build_cartesian_2d(
+                    (tmin / 1.5..tmax * 1.5).log_scale(),
+                    (FLOOR..1.0).log_scale(),
+                )?;
+            c.configure_mesh()
+                .x_desc("wall time per equilibrium (s)")
+                .y_desc("tip error, max-norm of Δr(L)")
+                .x_label_formatter(&|v| format!("{v:.0e}"))
+                .y_label_formatter(&|v| format!("{v:.0e}"))
+                .label_style(("sans-serif", 16))
+                .axis_desc_style(("sans-serif", 18))
+                .light_line_style(WHITE)
+                .bold_line_style(BLACK.mix(0.12))
+                .draw()?;
+            for (i, m) in order.iter().enumerate() {
+                let color = colour(i);
+                let series: Vec<(f64, f64)> = mine
                     .iter()
-                    .map(|&(x, y)| Circle::new((x, y), 4, color.filled())),
-            )?;
+                    .filter(|p| &p.method == m)
+                    .map(|p| (p.time, p.error.clamp(FLOOR, 1.0)))
+                    .collect();
+                c.draw_series(LineSeries::new(series.clone(), color.stroke_width(2)))?;
+                c.draw_series(
+                    series
+                        .iter()
+                        .map(|&(x, y)| Circle::new((x, y), 4, color.filled())),
+                )?;
+            }
+            frame(c.plotting_area())?;
         }
-        c.configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .label_font(("sans-serif", 16))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()?;
+        Ok(())
     }
-    root.present()?;
-    Ok(())
 }
 
 /// Tip (x, z) of the unit cantilever under a tip force perpendicular to the

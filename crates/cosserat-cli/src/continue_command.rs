@@ -5,7 +5,7 @@ use std::path::Path;
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
-use crate::plot::{draw, read_diagram};
+use crate::plot::{draw, problem_view, read_diagram};
 use crate::progress::Meter;
 use crate::stored_start::{solved_start, stored_start, Start, StoredStart};
 use cosserat::continuation::{
@@ -351,7 +351,9 @@ pub fn run_plot(diagram: &Path, measure: &str, output: &Path, force: bool) -> Ex
     if let Err(e) = known_measure(&data, measure) {
         return fail(BAD_INPUT, format!("--measure: {e}"));
     }
-    match replace_atomically(output, |tmp| draw(&data, measure, tmp)) {
+    match replace_atomically(output, |tmp| {
+        draw(&data, &problem_view(diagram, &data), measure, tmp)
+    }) {
         Ok(()) => {
             println!("plotted   {}", output.display());
             ExitCode::SUCCESS
@@ -429,7 +431,9 @@ fn known_measure(data: &crate::plot::DiagramData, measure: &str) -> Result<(), S
 pub fn plot_file(input: &Path, measure: &str, out: &Path) -> Result<(), String> {
     let data = read_diagram(input).map_err(|e| format!("{}: {e}", input.display()))?;
     known_measure(&data, measure)?;
-    replace_atomically(out, |tmp| draw(&data, measure, tmp))?;
+    replace_atomically(out, |tmp| {
+        draw(&data, &problem_view(input, &data), measure, tmp)
+    })?;
     println!("plotted   {}", out.display());
     Ok(())
 }

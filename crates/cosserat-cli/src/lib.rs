@@ -32,8 +32,10 @@
 #![warn(missing_docs)]
 
 pub mod arm_chart;
+pub mod axis_label;
 pub mod bench;
 pub mod chain;
+pub mod chart_style;
 pub mod cli;
 pub mod continue_command;
 pub mod curve_command;

@@ -8,7 +8,14 @@
 use std::path::Path;
 
 use cosserat::output::store::{Group, StoreError, StoreResult};
+use plotters::coord::Shift;
 use plotters::prelude::*;
+
+use crate::axis_label::{measure_label, parameter_label, Scale};
+use crate::chart_style::{
+    self, colour, draw_tags, equal_aspect, frame, legend, line, padded, render, tick, Failure,
+    Figure, Glyph, LegendEntry, PixelBox, Stroke, Tag, AXIS_FONT, TEXT_FONT, TITLE_FONT,
+};
 
 /// One branch as read from a diagram file.
 #[derive(Debug, Clone, Default)]
@@ -228,203 +235,517 @@ pub fn register_font() {
     let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
 }
 
-/// Draws the diagram to `out` (.png or .svg).
+// ---------------------------------------------------------------------
+// Drawing (everything below works on the data read above).
+// ---------------------------------------------------------------------
+
+/// How the tip force of a diagram's problem changes with the parameter.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum LoadRule {
+    /// The problem's own tip force at every point.
+    Fixed([f64; 3]),
+    /// The problem's tip force times the parameter (`load_scale`,
+    /// `control_scale`).
+    Scaled([f64; 3]),
+    /// The problem's tip force with component `i` the parameter.
+    Component([f64; 3], usize),
+    /// Not known (a chained run that changes a load): no arrow is drawn.
+    Unknown,
+}
+
+impl LoadRule {
+    /// The tip force at parameter `p`.
+    fn at(self, p: f64) -> Option<[f64; 3]> {
+        match self {
+            LoadRule::Fixed(f) => Some(f),
+            LoadRule::Scaled(f) => Some(f.map(|v| v * p)),
+            LoadRule::Component(mut f, i) => {
+                f[i] = p;
+                Some(f)
+            }
+            LoadRule::Unknown => None,
+        }
+    }
+}
+
+/// What a diagram's chart needs to know of its problem: how to read its
+/// numbers (axis labels) and the tip load to draw on the shapes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ProblemView {
+    scale: Scale,
+    load: LoadRule,
+}
+
+impl ProblemView {
+    /// A problem not known: documented units, no load arrows.
+    pub fn unknown() -> ProblemView {
+        ProblemView {
+            scale: Scale::Dimensional,
+            load: LoadRule::Unknown,
+        }
+    }
+
+    /// The view of the effective problem text `text` of a diagram whose
+    /// parameter name is `parameter_name` (a key, or a chained run's
+    /// `stage 1: KEY | …`).
+    pub fn of_problem(text: &str, parameter_name: &str) -> ProblemView {
+        let keys: Vec<&str> = parameter_name
+            .split(" | ")
+            .map(|p| p.split_once(": ").map_or(p, |(_, k)| k))
+            .collect();
+        let scale = Scale::of_problem(text, &keys);
+        let force = toml::from_str::<toml::Table>(text).ok().and_then(|t| {
+            let f = t.get("loads")?.get("tip_force")?.as_array()?;
+            let v: Vec<f64> = f
+                .iter()
+                .map(|x| x.as_float().or_else(|| x.as_integer().map(|i| i as f64)))
+                .collect::<Option<_>>()?;
+            <[f64; 3]>::try_from(v).ok()
+        });
+        let force = force.unwrap_or([0.0; 3]);
+        let load = match keys.as_slice() {
+            ["load_scale" | "control_scale"] => LoadRule::Scaled(force),
+            [key] => match key.strip_prefix("loads.tip_force[") {
+                Some("0]") => LoadRule::Component(force, 0),
+                Some("1]") => LoadRule::Component(force, 1),
+                Some("2]") => LoadRule::Component(force, 2),
+                Some(_) => LoadRule::Unknown,
+                None => LoadRule::Fixed(force),
+            },
+            _ if keys
+                .iter()
+                .any(|k| k.starts_with("loads.") || k.ends_with("_scale")) =>
+            {
+                LoadRule::Unknown
+            }
+            _ => LoadRule::Fixed(force),
+        };
+        ProblemView { scale, load }
+    }
+}
+
+/// The problem view of a diagram file, from the problem text the file
+/// keeps. (Reads the file through the library's `read_saved`, not with
+/// HDF5 calls of its own; a file it cannot read gives
+/// [`ProblemView::unknown`].)
+pub fn problem_view(path: &Path, data: &DiagramData) -> ProblemView {
+    match cosserat::output::read_saved(path) {
+        Ok((text, _)) => ProblemView::of_problem(&text, &data.parameter_name),
+        Err(_) => ProblemView::unknown(),
+    }
+}
+
+/// Draws the diagram to `out` (.png or .svg): the parameter against
+/// `measure` (stable solid, unstable dashed, special points marked by
+/// kind), a legend beside it, and the rod shapes at the special points and
+/// branch ends, to scale, with the tip load.
 pub fn draw(
     data: &DiagramData,
+    view: &ProblemView,
     measure: &str,
     out: &Path,
 ) -> Result<(), Box<dyn std::error::Error>> {
-    register_font();
-    let svg = out
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("svg"));
-    if svg {
-        panels(
-            &SVGBackend::new(out, (1400, 600)).into_drawing_area(),
+    render(
+        &DiagramChart {
             data,
+            view,
             measure,
-        )
-    } else {
-        panels(
-            &BitMapBackend::new(out, (1400, 600)).into_drawing_area(),
-            data,
-            measure,
-        )
-    }
+        },
+        out,
+    )
 }
 
-const COLORS: [RGBColor; 6] = [
-    RGBColor(0, 114, 178),
-    RGBColor(213, 94, 0),
-    RGBColor(0, 158, 115),
-    RGBColor(204, 121, 167),
-    RGBColor(230, 159, 0),
-    RGBColor(86, 180, 233),
-];
-
-fn bounds(values: impl Iterator<Item = f64>) -> (f64, f64) {
-    let (lo, hi) = values
-        .filter(|v| v.is_finite())
-        .fold((f64::MAX, f64::MIN), |(a, b), v| (a.min(v), b.max(v)));
-    if lo > hi {
-        return (0.0, 1.0);
-    }
-    let pad = 0.05 * (hi - lo).max(1e-9);
-    (lo - pad, hi + pad)
+/// A diagram file's chart.
+struct DiagramChart<'a> {
+    data: &'a DiagramData,
+    view: &'a ProblemView,
+    measure: &'a str,
 }
 
-fn label(s: &SpecialData, counts: &mut [usize; 2]) -> String {
-    let (tag, slot) = if s.kind == "fold" {
-        ("F", 0)
-    } else {
-        ("BP", 1)
-    };
-    counts[slot] += 1;
-    format!("{tag}{}", counts[slot])
+/// The kind of a special point.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum SpecialKind {
+    Fold,
+    BranchPoint,
+    /// A kind this chart does not know (shown by its own name).
+    Other,
 }
 
-fn panels<DB: DrawingBackend>(
-    root: &DrawingArea<DB, plotters::coord::Shift>,
-    data: &DiagramData,
-    measure: &str,
-) -> Result<(), Box<dyn std::error::Error>>
-where
-    DB::ErrorType: 'static,
-{
-    root.fill(&WHITE)?;
-    let (left, right) = root.split_horizontally(820);
-    diagram_panel(&left, data, measure)?;
-    shapes_panel(&right, data)?;
-    root.present()?;
-    Ok(())
-}
-
-fn diagram_panel<DB: DrawingBackend>(
-    area: &DrawingArea<DB, plotters::coord::Shift>,
-    data: &DiagramData,
-    measure: &str,
-) -> Result<(), Box<dyn std::error::Error>>
-where
-    DB::ErrorType: 'static,
-{
-    let named = data.measure_names.iter().position(|n| n == measure);
-    let value = |b: &BranchData, i: usize| match named {
-        Some(k) => b.measures[i][k],
-        None => measure_value(measure, &b.tip[i], b.tip_angle[i], b.norm[i]),
-    };
-    let xs = bounds(
-        data.branches
-            .iter()
-            .flat_map(|b| b.parameter.iter().copied()),
-    );
-    let ys = bounds(
-        data.branches
-            .iter()
-            .flat_map(|b| (0..b.parameter.len()).map(move |i| value(b, i))),
-    );
-    let mut chart = ChartBuilder::on(area)
-        .caption(
-            "bifurcation diagram (solid: stable, dashed: unstable)",
-            ("sans-serif", 20),
-        )
-        .margin(15)
-        .x_label_area_size(45)
-        .y_label_area_size(65)
-        .build_cartesian_2d(xs.0..xs.1, ys.0..ys.1)?;
-    chart
-        .configure_mesh()
-        .x_desc(data.parameter_name.as_str())
-        .y_desc(measure)
-        .label_style(("sans-serif", 15))
-        .draw()?;
-    for (bi, b) in data.branches.iter().enumerate() {
-        let color = COLORS[bi % COLORS.len()];
-        let mut start = 0;
-        while start + 1 < b.parameter.len() {
-            let stable = b.stable[start + 1];
-            let mut end = start + 1;
-            while end + 1 < b.parameter.len() && b.stable[end + 1] == stable {
-                end += 1;
-            }
-            let pts: Vec<(f64, f64)> = (start..=end)
-                .map(|i| (b.parameter[i], value(b, i)))
-                .collect();
-            let style = color.stroke_width(2);
-            if stable {
-                chart.draw_series(LineSeries::new(pts, style))?;
-            } else {
-                chart.draw_series(DashedLineSeries::new(pts, 8, 6, style))?;
-            }
-            start = end;
+impl SpecialKind {
+    fn of(kind: &str) -> SpecialKind {
+        match kind {
+            "fold" => SpecialKind::Fold,
+            "branch_point" => SpecialKind::BranchPoint,
+            _ => SpecialKind::Other,
         }
     }
-    let mut counts = [0, 0];
-    for s in &data.specials {
-        let b = &data.branches[s.branch];
-        let i = s.index.min(b.parameter.len().saturating_sub(1));
-        let y = match named {
-            Some(k) => s.measures[k],
-            None => measure_value(
-                measure,
-                &s.tip,
-                b.tip_angle.get(i).copied().unwrap_or(0.0),
-                b.norm.get(i).copied().unwrap_or(0.0),
-            ),
+
+    fn tag(self) -> &'static str {
+        match self {
+            SpecialKind::Fold => "F",
+            SpecialKind::BranchPoint => "BP",
+            SpecialKind::Other => "S",
+        }
+    }
+
+    fn glyph(self) -> Glyph {
+        match self {
+            SpecialKind::Fold => Glyph::Dot(BLACK),
+            SpecialKind::BranchPoint => Glyph::Square(BLACK),
+            SpecialKind::Other => Glyph::Ring(BLACK),
+        }
+    }
+}
+
+/// A marked point of the diagram: a special point or a branch end, with
+/// its tag ("F1", "BP2", "E3") and where its shape is.
+struct Mark {
+    tag: String,
+    glyph: Glyph,
+    parameter: f64,
+    value: f64,
+    branch: usize,
+    index: usize,
+}
+
+/// How many branches the legend lists by colour.
+const LEGEND_BRANCHES: usize = 8;
+
+impl DiagramChart<'_> {
+    /// The measure of branch `b`'s point `i`.
+    fn value(&self, b: &BranchData, i: usize) -> f64 {
+        match self
+            .data
+            .measure_names
+            .iter()
+            .position(|n| n == self.measure)
+        {
+            Some(k) => b.measures[i][k],
+            None => measure_value(self.measure, &b.tip[i], b.tip_angle[i], b.norm[i]),
+        }
+    }
+
+    /// The special points (numbered per kind) and the branch ends.
+    fn marks(&self) -> Vec<Mark> {
+        let mut counts = [0usize; 3];
+        let named = self
+            .data
+            .measure_names
+            .iter()
+            .position(|n| n == self.measure);
+        let mut marks: Vec<Mark> = self
+            .data
+            .specials
+            .iter()
+            .map(|s| {
+                let kind = SpecialKind::of(&s.kind);
+                counts[kind as usize] += 1;
+                let b = &self.data.branches[s.branch];
+                let i = s.index.min(b.parameter.len().saturating_sub(1));
+                let value = match named {
+                    Some(k) => s.measures[k],
+                    None => measure_value(
+                        self.measure,
+                        &s.tip,
+                        b.tip_angle.get(i).copied().unwrap_or(0.0),
+                        b.norm.get(i).copied().unwrap_or(0.0),
+                    ),
+                };
+                Mark {
+                    tag: format!("{}{}", kind.tag(), counts[kind as usize]),
+                    glyph: kind.glyph(),
+                    parameter: s.parameter,
+                    value,
+                    branch: s.branch,
+                    index: s.index,
+                }
+            })
+            .collect();
+        for (bi, b) in self.data.branches.iter().enumerate() {
+            if let Some(last) = b.parameter.len().checked_sub(1) {
+                marks.push(Mark {
+                    tag: format!("E{}", bi + 1),
+                    glyph: Glyph::Ring(colour(bi)),
+                    parameter: b.parameter[last],
+                    value: self.value(b, last),
+                    branch: bi,
+                    index: last,
+                });
+            }
+        }
+        marks
+    }
+
+    fn legend_entries(&self, marks: &[Mark], arrow: bool) -> Vec<LegendEntry> {
+        let flags = || {
+            self.data
+                .branches
+                .iter()
+                .flat_map(|b| b.stable.iter().skip(1))
         };
-        let name = label(s, &mut counts);
-        let marker = (s.parameter, y);
-        let element = EmptyElement::at(marker)
-            + Circle::new((0, 0), 6, BLACK.filled())
-            + Text::new(name, (8, -22), ("sans-serif", 16));
-        chart.draw_series(std::iter::once(element))?;
+        let mut entries = vec![];
+        if flags().any(|s| *s) {
+            entries.push(LegendEntry::new(
+                Glyph::Line(BLACK, Stroke::Solid),
+                "stable",
+            ));
+        }
+        if flags().any(|s| !*s) {
+            entries.push(LegendEntry::new(
+                Glyph::Line(BLACK, Stroke::Dashed),
+                "unstable",
+            ));
+        }
+        for (kind, text) in [
+            (SpecialKind::Fold, "fold F"),
+            (SpecialKind::BranchPoint, "branch point BP"),
+            (SpecialKind::Other, "special point S"),
+        ] {
+            if marks
+                .iter()
+                .any(|m| m.tag.starts_with(kind.tag()) && m.glyph == kind.glyph())
+            {
+                entries.push(LegendEntry::new(kind.glyph(), text));
+            }
+        }
+        entries.push(LegendEntry::new(Glyph::Ring(BLACK), "branch end E"));
+        let n = self.data.branches.len();
+        for bi in 0..n.min(LEGEND_BRANCHES) {
+            entries.push(LegendEntry::new(
+                Glyph::Line(colour(bi), Stroke::Solid),
+                format!("branch {}", bi + 1),
+            ));
+        }
+        if n > LEGEND_BRANCHES {
+            entries.push(LegendEntry::new(
+                Glyph::Line(colour(LEGEND_BRANCHES), Stroke::Dotted),
+                format!("… {n} branches in all"),
+            ));
+        }
+        if arrow {
+            entries.push(LegendEntry::new(Glyph::Arrow(LOAD), "tip force F"));
+        }
+        entries
     }
-    Ok(())
 }
 
-fn shapes_panel<DB: DrawingBackend>(
-    area: &DrawingArea<DB, plotters::coord::Shift>,
-    data: &DiagramData,
-) -> Result<(), Box<dyn std::error::Error>>
-where
-    DB::ErrorType: 'static,
-{
-    // The shapes at the special points' neighbours and the branch ends.
-    let mut picks: Vec<(usize, usize)> =
-        data.specials.iter().map(|s| (s.branch, s.index)).collect();
-    for (bi, b) in data.branches.iter().enumerate() {
-        if !b.shapes.is_empty() {
-            picks.push((bi, b.shapes.len() - 1));
+/// The colour of load arrows.
+const LOAD: RGBColor = RGBColor(200, 0, 0);
+
+impl Figure for DiagramChart<'_> {
+    fn size(&self) -> (u32, u32) {
+        (1560, 640)
+    }
+
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), Failure>
+    where
+        DB::ErrorType: 'static,
+    {
+        let (left, rest) = root.split_horizontally(800);
+        let (middle, right) = rest.split_horizontally(230);
+        let marks = self.marks();
+        self.diagram_panel(&left, &marks)?;
+        let arrow = self.shapes_panel(&right, &marks)?;
+        let entries = self.legend_entries(&marks, arrow);
+        legend(&middle.margin(60, 0, 4, 4), &entries, 1)?;
+        Ok(())
+    }
+}
+
+impl DiagramChart<'_> {
+    fn diagram_panel<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        marks: &[Mark],
+    ) -> Result<(), Failure>
+    where
+        DB::ErrorType: 'static,
+    {
+        let data = self.data;
+        let scale = self.view.scale;
+        let xs = padded(
+            data.branches
+                .iter()
+                .flat_map(|b| b.parameter.iter().copied()),
+        );
+        let ys = padded(
+            data.branches
+                .iter()
+                .flat_map(|b| (0..b.parameter.len()).map(move |i| self.value(b, i)))
+                .chain(marks.iter().map(|m| m.value)),
+        );
+        let mut chart = ChartBuilder::on(area)
+            .caption("bifurcation diagram", ("sans-serif", TITLE_FONT))
+            .margin(15)
+            .x_label_area_size(50)
+            .y_label_area_size(80)
+            .build_cartesian_2d(xs.0..xs.1, ys.0..ys.1)?;
+        let (xspan, yspan) = (xs.1 - xs.0, ys.1 - ys.0);
+        chart
+            .configure_mesh()
+            .x_desc(parameter_label(&data.parameter_name, scale))
+            .y_desc(measure_label(self.measure, scale))
+            .x_label_formatter(&|v| tick(*v, xspan))
+            .y_label_formatter(&|v| tick(*v, yspan))
+            .label_style(("sans-serif", TEXT_FONT))
+            .axis_desc_style(("sans-serif", AXIS_FONT))
+            .light_line_style(WHITE)
+            .bold_line_style(BLACK.mix(0.12))
+            .draw()?;
+        for (bi, b) in data.branches.iter().enumerate() {
+            let mut start = 0;
+            while start + 1 < b.parameter.len() {
+                let stable = b.stable[start + 1];
+                let mut end = start + 1;
+                while end + 1 < b.parameter.len() && b.stable[end + 1] == stable {
+                    end += 1;
+                }
+                let pts: Vec<(f64, f64)> = (start..=end)
+                    .map(|i| (b.parameter[i], self.value(b, i)))
+                    .collect();
+                let stroke = if stable {
+                    Stroke::Solid
+                } else {
+                    Stroke::Dashed
+                };
+                line(&mut chart, pts, colour(bi), stroke, 2)?;
+                start = end;
+            }
+        }
+        frame(chart.plotting_area())?;
+        let tags: Vec<Tag> = marks
+            .iter()
+            .map(|m| Tag {
+                text: m.tag.clone(),
+                at: (m.parameter, m.value),
+                glyph: Some(m.glyph),
+            })
+            .collect();
+        draw_tags(&mut chart, &tags, &[])
+    }
+
+    /// The shapes at the marks, to scale, tagged at their tips, with the
+    /// tip load as an arrow; whether an arrow was drawn.
+    fn shapes_panel<DB: DrawingBackend>(
+        &self,
+        area: &DrawingArea<DB, Shift>,
+        marks: &[Mark],
+    ) -> Result<bool, Failure>
+    where
+        DB::ErrorType: 'static,
+    {
+        let data = self.data;
+        let shown: Vec<(&Mark, &Vec<[f64; 3]>)> = marks
+            .iter()
+            .filter_map(|m| {
+                let b = data.branches.get(m.branch)?;
+                Some((m, b.shapes.get(m.index)?))
+            })
+            .filter(|(_, s)| !s.is_empty())
+            .collect();
+        let zs = padded(shown.iter().flat_map(|(_, s)| s.iter().map(|r| r[2])));
+        let hs = padded(shown.iter().flat_map(|(_, s)| s.iter().map(|r| -r[0])));
+        let (x_unit, h_unit) = match self.view.scale {
+            Scale::Nondimensional => ("z/L", "height −x/L"),
+            Scale::Dimensional => ("z (m)", "height −x (m)"),
+        };
+        let inner = area.titled("rod shapes (to scale)", ("sans-serif", TITLE_FONT))?;
+        // Built twice: first to learn the plotting area's pixels, then
+        // with the ranges of equal aspect (building draws nothing).
+        let build = |zs: (f64, f64), hs: (f64, f64)| {
+            ChartBuilder::on(&inner)
+                .margin(15)
+                .x_label_area_size(50)
+                .y_label_area_size(70)
+                .build_cartesian_2d(zs.0..zs.1, hs.0..hs.1)
+        };
+        let pixels = build(zs, hs)?.plotting_area().dim_in_pixel();
+        let (zs, hs) = equal_aspect(zs, hs, pixels);
+        // Room for the load arrows at the tips.
+        let (zs, hs) = if self.view.load == LoadRule::Unknown {
+            (zs, hs)
+        } else {
+            let room = (ARROW + 12.0) * (zs.1 - zs.0) / f64::from(pixels.0.max(1));
+            equal_aspect(
+                (zs.0 - room, zs.1 + room),
+                (hs.0 - room, hs.1 + room),
+                pixels,
+            )
+        };
+        let mut chart = build(zs, hs)?;
+        let (zspan, hspan) = (zs.1 - zs.0, hs.1 - hs.0);
+        chart
+            .configure_mesh()
+            .x_desc(x_unit)
+            .y_desc(h_unit)
+            .x_label_formatter(&|v| tick(*v, zspan))
+            .y_label_formatter(&|v| tick(*v, hspan))
+            .label_style(("sans-serif", TEXT_FONT))
+            .axis_desc_style(("sans-serif", AXIS_FONT))
+            .light_line_style(WHITE)
+            .bold_line_style(BLACK.mix(0.12))
+            .draw()?;
+        for (m, s) in &shown {
+            let pts = s.iter().map(|r| (r[2], -r[0])).collect();
+            line(&mut chart, pts, colour(m.branch), Stroke::Solid, 2)?;
+        }
+        frame(chart.plotting_area())?;
+        let (bx, by) = area.get_base_pixel();
+        let mut arrows = vec![];
+        for (m, s) in &shown {
+            let Some(f) = self.view.load.at(m.parameter) else {
+                continue;
+            };
+            // In the picture's plane: z to the right, height (−x) up.
+            let (dz, dh) = (f[2], -f[0]);
+            let size = dz.hypot(dh);
+            if size <= 1e-9 * f.iter().fold(0.0f64, |a, v| a.max(v.abs())) || size == 0.0 {
+                continue;
+            }
+            let tip = s[s.len() - 1];
+            let from = chart.backend_coord(&(tip[2], -tip[0]));
+            let d = ((dz / size * ARROW) as i32, (-dh / size * ARROW) as i32);
+            let b = chart_style::arrow(area, (from.0 - bx, from.1 - by), d, LOAD)?;
+            arrows.push(PixelBox {
+                x: b.x + bx,
+                y: b.y + by,
+                ..b
+            });
+        }
+        draw_tags(&mut chart, &shape_tags(&shown), &arrows)?;
+        Ok(!arrows.is_empty())
+    }
+}
+
+/// Length of a load arrow (pixels): a direction, not a magnitude.
+const ARROW: f64 = 42.0;
+
+/// One tag per distinct shape at its tip: marks whose shapes coincide
+/// (the two sides of one branch point, a trivial branch's end) share it.
+fn shape_tags(shown: &[(&Mark, &Vec<[f64; 3]>)]) -> Vec<Tag> {
+    let mut groups: Vec<(Vec<&str>, &Vec<[f64; 3]>)> = vec![];
+    for (m, s) in shown {
+        let same = |g: &&mut (Vec<&str>, &Vec<[f64; 3]>)| {
+            g.1.len() == s.len()
+                && g.1
+                    .iter()
+                    .zip(s.iter())
+                    .all(|(a, b)| (0..3).all(|k| (a[k] - b[k]).abs() <= 1e-9))
+        };
+        match groups.iter_mut().find(|g| same(g)) {
+            Some(g) => g.0.push(&m.tag),
+            None => groups.push((vec![&m.tag], s)),
         }
     }
-    let shapes: Vec<(usize, &Vec<[f64; 3]>)> = picks
-        .iter()
-        .filter_map(|&(b, i)| {
-            data.branches
-                .get(b)
-                .and_then(|br| br.shapes.get(i))
-                .map(|s| (b, s))
+    groups
+        .into_iter()
+        .map(|(tags, s)| {
+            let t = s[s.len() - 1];
+            Tag {
+                text: tags.join(", "),
+                at: (t[2], -t[0]),
+                glyph: None,
+            }
         })
-        .collect();
-    let zs = bounds(shapes.iter().flat_map(|(_, s)| s.iter().map(|r| r[2])));
-    let hs = bounds(shapes.iter().flat_map(|(_, s)| s.iter().map(|r| -r[0])));
-    let mut chart = ChartBuilder::on(area)
-        .caption("rod shapes (height −x against z)", ("sans-serif", 20))
-        .margin(15)
-        .x_label_area_size(45)
-        .y_label_area_size(55)
-        .build_cartesian_2d(zs.0..zs.1, hs.0..hs.1)?;
-    chart
-        .configure_mesh()
-        .x_desc("z")
-        .y_desc("−x")
-        .label_style(("sans-serif", 15))
-        .draw()?;
-    for (b, s) in shapes {
-        let color = COLORS[b % COLORS.len()];
-        chart.draw_series(LineSeries::new(
-            s.iter().map(|r| (r[2], -r[0])),
-            color.stroke_width(2),
-        ))?;
-    }
-    Ok(())
+        .collect()
 }

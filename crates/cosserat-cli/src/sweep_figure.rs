@@ -8,7 +8,8 @@
 
 use std::path::Path;
 
-use crate::sweep_chart::{contour_maps, envelopes, Envelope, MapPanel};
+use crate::axis_label::{key_label, Scale};
+use crate::sweep_chart::{contour_maps, envelopes, Envelope, EnvelopeLabels, MapLabels, MapPanel};
 use cosserat::output::SweepHeader;
 use cosserat::study::sweep::contour::{fit_power_law, GridField, PowerFit};
 use cosserat::study::sweep::Record;
@@ -80,34 +81,72 @@ pub fn draw(out: &Path, header: &SweepHeader, records: &[Record]) -> Result<(), 
     result.map_err(|e| format!("{}: {e}", out.display()))
 }
 
+/// The scale of a sweep's problem and the unit its reaches are given in
+/// (docs/problem-files.md, `[arm]`): √(B₂/F) with a tip load, (B₂/q)^(1/3)
+/// with the arm's weight alone.
+fn reach_unit(header: &SweepHeader) -> (Scale, &'static str) {
+    let keys: Vec<&str> = header.keys.iter().map(String::as_str).collect();
+    let scale = Scale::of_problem(&header.problem, &keys);
+    let weight_alone = toml::from_str::<toml::Table>(&header.problem)
+        .ok()
+        .and_then(|t| {
+            let f = t.get("loads")?.get("tip_force")?.as_array()?.clone();
+            Some(
+                f.iter()
+                    .all(|v| v.as_float().or(v.as_integer().map(|i| i as f64)) == Some(0.0)),
+            )
+        })
+        .unwrap_or(false);
+    let unit = if weight_alone {
+        "(q/B₂)^(1/3)"
+    } else {
+        "√(F/B₂)"
+    };
+    (scale, unit)
+}
+
+/// A grid value as a short number (0.25, 16, 0.667).
+fn short(v: f64) -> String {
+    let s = format!("{v:.3}");
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
 fn map_chart(
     out: &Path,
     header: &SweepHeader,
     records: &[Record],
 ) -> Result<(), Box<dyn std::error::Error>> {
-    let families: Vec<usize> = (0..2)
+    let (scale, unit) = reach_unit(header);
+    let with_values: Vec<usize> = (0..2)
         .filter(|f| {
             records
                 .iter()
                 .any(|r| r.number(&format!("family_{f}/reach")).is_some())
         })
         .collect();
-    let maps: Vec<Vec<f64>> = families
+    let maps: Vec<(usize, Vec<f64>)> = with_values
         .iter()
-        .map(|f| family_map(header, records, *f))
+        .map(|f| (*f, family_map(header, records, *f)))
         .collect();
-    let fit = reach_fit(header, records, 0);
-    let panels: Vec<MapPanel> = families
+    // A family without a single optimum of its own gets a note, not an
+    // empty panel.
+    let (drawn, empty): (Vec<_>, Vec<_>) = maps
         .iter()
-        .zip(&maps)
+        .partition(|(_, z)| z.iter().any(|v| v.is_finite()));
+    let drawn = if drawn.is_empty() {
+        maps.iter().take(1).collect()
+    } else {
+        drawn
+    };
+    let fit = reach_fit(header, records, 0);
+    let (x, y) = (
+        key_label(&header.keys[0], scale),
+        key_label(&header.keys[1], scale),
+    );
+    let panels: Vec<MapPanel> = drawn
+        .iter()
         .map(|(f, z)| MapPanel {
-            title: match (f, &fit) {
-                (0, Some(fit)) => format!("R*, family 0 (dashed: (61), ι = {:.3})", fit.iota),
-                _ if z.iter().all(|v| v.is_nan()) => {
-                    format!("R*, family {f}: no distinct optimum found")
-                }
-                _ => format!("R*, family {f}"),
-            },
+            title: format!("R*, family {f}"),
             field: GridField {
                 x: &header.axes[0],
                 y: &header.axes[1],
@@ -116,12 +155,28 @@ fn map_chart(
             fit: if *f == 0 { fit.as_ref() } else { None },
         })
         .collect();
-    contour_maps(out, &header.keys[0], &header.keys[1], &panels)
+    let labels = MapLabels {
+        fit: fit.as_ref().map(|fit| {
+            format!(
+                "eq. (61) on family 0: {y} = Ω ({x})^(−ι), one ι = {:.3} for all contours",
+                fit.iota
+            )
+        }),
+        notes: empty
+            .iter()
+            .map(|(f, _)| format!("family {f}: no distinct optimum at any grid point (no panel)"))
+            .collect(),
+        value: format!("R* {unit}"),
+        x,
+        y,
+    };
+    contour_maps(out, &labels, &panels)
 }
 
 /// Tip points (ẑ, height) = R (cos α, sin α) along α, one curve per value
 /// of the other axes.
 fn curves(header: &SweepHeader, records: &[Record], a: usize, column: &str) -> Vec<Envelope> {
+    let (scale, _) = reach_unit(header);
     let mut out: Vec<(Vec<usize>, Envelope)> = vec![];
     for r in records {
         let Some(reach) = r.number(column).filter(|v| v.is_finite()) else {
@@ -137,7 +192,13 @@ fn curves(header: &SweepHeader, records: &[Record], a: usize, column: &str) -> V
         } else {
             let label = (0..idx.len())
                 .filter(|&j| j != a)
-                .map(|j| format!("{} = {:.3}", header.keys[j], header.axes[j][idx[j]]))
+                .map(|j| {
+                    format!(
+                        "{} = {}",
+                        key_label(&header.keys[j], scale),
+                        short(header.axes[j][idx[j]])
+                    )
+                })
                 .collect::<Vec<_>>()
                 .join(", ");
             out.push((key, (label, vec![point])));
@@ -157,8 +218,14 @@ fn envelope_chart(
     records: &[Record],
     a: usize,
 ) -> Result<(), Box<dyn std::error::Error>> {
+    let (_, unit) = reach_unit(header);
+    let labels = EnvelopeLabels {
+        reach: format!("horizontal reach z {unit}"),
+        height: format!("height above the clamp −x {unit}"),
+    };
     envelopes(
         out,
+        &labels,
         &[
             (
                 "a) optimized intrinsic curvature: R*".to_string(),
