@@ -285,7 +285,7 @@ fn polyline(frame: &Frame, s: Option<&Vec<f64>>) -> Result<Polyline, vtk::VtkErr
         .collect();
     let mut fields = vec![];
     if frame.equally_spaced {
-        if let Some(s) = s {
+        if let Some(s) = s.filter(|_| !frame.has_field("s")) {
             fields.push(PointField::new("s", 1, s.clone())?);
         }
         fields.push(PointField::new(
@@ -443,7 +443,7 @@ fn stored(file: &str, a: &Array) -> Result<Stored, xdmf::XdmfError> {
 fn grid(file: &str, frame: &Frame, time: f64, s: Option<&Vec<f64>>) -> Result<Grid, String> {
     let mut attributes = vec![];
     if frame.equally_spaced {
-        if let Some(s) = s {
+        if let Some(s) = s.filter(|_| !frame.has_field("s")) {
             attributes
                 .push(Attribute::new("s", Values::Inline(s.clone())).map_err(|e| e.to_string())?);
         }

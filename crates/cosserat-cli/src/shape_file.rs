@@ -8,7 +8,9 @@
 //! Kinds of file with a shape: an equilibrium (`solve -o`, `stability -o`:
 //! `/solution`, every field), a diagram (`continue -o`, the `--*-path`
 //! files of `optimize`: `/branches/<i>/shapes`, the centreline at equally
-//! spaced points of each continuation point) and an arm study
+//! spaced points of each continuation point, and in files written since
+//! the diagram keeps the whole rod there: s, directors, curvature, moment
+//! and force) and an arm study
 //! (`optimize -o`: the designs' loaded and unloaded centrelines). A fixed
 //! shape's stability report and a sweep hold none.
 
@@ -43,6 +45,17 @@ pub struct Array {
 }
 
 impl Array {
+    /// Row `k` of the first axis of a whole dataset (a diagram point).
+    fn row(&self, k: usize) -> Array {
+        let width: usize = self.dims.iter().skip(1).product();
+        Array {
+            dataset: self.dataset.clone(),
+            dims: self.dims.clone(),
+            row: Some(k),
+            values: self.values[k * width..(k + 1) * width].to_vec(),
+        }
+    }
+
     /// The points of the selection (its first axis after the row).
     pub fn points(&self) -> usize {
         let axis = usize::from(self.row.is_some());
@@ -78,6 +91,13 @@ pub struct Frame {
     pub fields: Vec<Field>,
     /// The points are at equally spaced arc lengths from s = 0 to s = L.
     pub equally_spaced: bool,
+}
+
+impl Frame {
+    /// Whether the frame carries a stored field `name`.
+    pub fn has_field(&self, name: &str) -> bool {
+        self.fields.iter().any(|f| f.name == name)
+    }
 }
 
 /// A diagram branch's continued key and the earlier stages' keys held on
@@ -285,6 +305,7 @@ fn branch_frames(g: &Group, i: usize) -> StoreResult<Vec<Frame>> {
     }
     let values = shapes.floats()?;
     let width = dims[1] * 3;
+    let stored = branch_fields(g, i, &dims)?;
     Ok((0..m)
         .map(|k| Frame {
             label: format!("branch {i} point {k}"),
@@ -298,10 +319,62 @@ fn branch_frames(g: &Group, i: usize) -> StoreResult<Vec<Frame>> {
                 row: Some(k),
                 values: values[k * width..(k + 1) * width].to_vec(),
             },
-            fields: vec![],
+            fields: stored
+                .iter()
+                .map(|(name, a)| Field {
+                    name,
+                    array: a.row(k),
+                })
+                .collect(),
             equally_spaced: true,
         })
         .collect())
+}
+
+/// The fields stored at a branch's shape points (files written since the
+/// diagram keeps the whole rod at its shape points; older files hold the
+/// centreline only): the same names as an equilibrium's.
+const BRANCH_FIELDS: [(&str, &str); 7] = [
+    ("shape_s", "s"),
+    ("shape_d1", "d1"),
+    ("shape_d2", "d2"),
+    ("shape_d3", "d3"),
+    ("shape_curvature", "curvature_body"),
+    ("shape_moment", "moment_body"),
+    ("shape_force", "force"),
+];
+
+/// Branch `i`'s stored fields, each checked against the centreline's
+/// shape `dims` (m×n×3; `shape_s` m×n).
+fn branch_fields(g: &Group, i: usize, dims: &[usize]) -> StoreResult<Vec<(&'static str, Array)>> {
+    let mut fields = vec![];
+    for (dataset, name) in BRANCH_FIELDS {
+        let Ok(ds) = g.dataset(dataset) else {
+            continue;
+        };
+        let want: &[usize] = if dataset == "shape_s" {
+            &dims[..2]
+        } else {
+            dims
+        };
+        if ds.shape() != want {
+            return Err(format!(
+                "branch {i}: {dataset} has shape {:?}, the centreline {dims:?}",
+                ds.shape()
+            )
+            .into());
+        }
+        fields.push((
+            name,
+            Array {
+                dataset: format!("/branches/{i}/{dataset}"),
+                dims: ds.shape().to_vec(),
+                row: None,
+                values: ds.floats()?.to_vec(),
+            },
+        ));
+    }
+    Ok(fields)
 }
 
 fn read_arm(file: &Group) -> StoreResult<Vec<Frame>> {

@@ -206,11 +206,18 @@ fn shapes_have_the_asked_resolution() {
     let d = continuation(&family, &opts, &mut |_, _| true).unwrap();
     let point = d.branches[1].points.last().unwrap();
     assert_eq!(point.shape.len(), 401);
-    assert!((point.shape[400] - point.tip.position).norm() < 1e-12);
+    assert!((point.shape[400].position - point.tip.position).norm() < 1e-12);
     let h = 1.0 / 400.0;
     for w in point.shape.windows(2) {
-        let chord = (w[1] - w[0]).norm();
+        let chord = (w[1].position - w[0].position).norm();
         assert!(chord <= h * (1.0 + 1e-9) && chord > 0.99 * h, "{chord}");
+        // Equally spaced in s, and each sample a rod: orthonormal directors.
+        assert!((w[1].s - w[0].s - h).abs() < 1e-12, "{}", w[1].s - w[0].s);
+        let d = &w[1].directors;
+        for (i, j) in [(0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2)] {
+            let want = if i == j { 1.0 } else { 0.0 };
+            assert!((d[i].dot(&d[j]) - want).abs() < 1e-8);
+        }
     }
     let bad = ["continuation.shape_points=1".to_string()];
     let err = Problem::from_str_with(EULER, &bad).unwrap_err().to_string();

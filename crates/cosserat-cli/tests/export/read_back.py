@@ -77,6 +77,12 @@ def check_equilibrium(name, data, h5, length):
     check_arc_length(name, got["s"], length)
 
 
+# A diagram point's exported arrays and the branch datasets they come from.
+DIAGRAM = {"s": "shape_s", "d1": "shape_d1", "d2": "shape_d2", "d3": "shape_d3",
+           "curvature_body": "shape_curvature", "moment_body": "shape_moment",
+           "force": "shape_force"}
+
+
 def expected_rows(h5, branch):
     """The diagram points in the exported order, and their times."""
     branches = h5["branches"]
@@ -102,6 +108,18 @@ def check_diagram_point(name, data, h5, row, length):
         length = float(h5["branches"][str(b)]["parameter"][k])
     check_arc_length(name, got["s"], length)
     close(f"{name} s_over_L", got["s_over_L"], np.linspace(0, 1, shape.shape[0]))
+    # The whole rod at the shape points: every field as stored, the shape
+    # points equally spaced in s, the directors orthonormal.
+    branch = h5["branches"][str(b)]
+    for exported, stored in DIAGRAM.items():
+        if exported not in got:
+            fail(f"{name}: no point array {exported}")
+        close(f"{name} {exported}", got[exported], branch[stored][k])
+    close(f"{name} s equally spaced", got["s"], np.linspace(0, length, shape.shape[0]))
+    d = np.stack([got["d1"], got["d2"], got["d3"]], axis=1)
+    drift = np.max(np.abs(np.einsum("nij,nkj->nik", d, d) - np.eye(3)))
+    if drift > 1e-8:
+        fail(f"{name}: directors not orthonormal (drift {drift:.2e})")
 
 
 def read_vtp(path):

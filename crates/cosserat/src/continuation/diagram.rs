@@ -28,8 +28,10 @@ pub struct Point {
     pub stable: bool,
     /// The L² norm of the curvature, √∫|κ|².
     pub norm: f64,
-    /// Positions along the rod (for pictures).
-    pub shape: Vec<Vector3<f64>>,
+    /// The rod at equally spaced points (`continuation.shape_points`):
+    /// position, directors, curvature, moment and force — for pictures
+    /// and for ParaView (`cosserat export`).
+    pub shape: Vec<RodSample>,
     /// The values of the run's measures
     /// ([`super::ContinuationOptions::measures`]), in their order.
     pub measures: Vec<f64>,

@@ -662,7 +662,8 @@ fn distance(a: &Point, b: &Point) -> f64 {
 fn symmetry_breaking(block: Block, point: &Point, mode: &[nalgebra::Vector3<f64>]) -> bool {
     // Straight: no curvature, or a twisted rod whose centreline is a line
     // (Greenhill's shaft carries its twist κ3 ≠ 0 before it buckles).
-    let straight = point.norm < 1e-8 || collinear(&point.shape);
+    let straight =
+        point.norm < 1e-8 || collinear(&point.shape.iter().map(|r| r.position).collect::<Vec<_>>());
     let out_of_plane = mode.iter().map(|w| w[0].abs() + w[2].abs()).sum::<f64>();
     let in_plane = mode.iter().map(|w| w[1].abs()).sum::<f64>();
     match block {

@@ -47,8 +47,9 @@ pub struct Spectrum {
     pub morse_index: usize,
     /// √∫|κ|² ds.
     pub curvature_norm: f64,
-    /// Positions at the tracker's equally spaced shape points.
-    pub shape: Vec<Vector3<f64>>,
+    /// The rod at the tracker's equally spaced shape points (position,
+    /// directors, curvature, moment, force).
+    pub shape: Vec<RodSample>,
     /// The tip sample.
     pub tip: RodSample,
 }
@@ -257,7 +258,6 @@ impl Tracker {
                     })?,
             );
         }
-        let shape = shape_samples.iter().map(|s| s.position).collect();
         Ok(Spectrum {
             tip: shape_samples
                 .last()
@@ -268,7 +268,7 @@ impl Tracker {
             morse_index: block_morse.iter().sum(),
             block_morse,
             curvature_norm: norm,
-            shape,
+            shape: shape_samples,
         })
     }
 

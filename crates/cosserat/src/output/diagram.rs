@@ -28,10 +28,13 @@ use std::path::Path;
 
 use super::hdf5_output::{set_generator, write_atomically, OutputError};
 use super::store::{Dataset, Group, StoreError, StoreResult, Values};
+use nalgebra::Vector3;
+
 use crate::continuation::{
-    stage_of, BranchEnd, Diagram, Location, RunState, SavedBranch, SavedDiagram, SavedSpecial,
-    SpecialKind, Stage,
+    stage_of, BranchEnd, Diagram, Location, Point, RunState, SavedBranch, SavedDiagram,
+    SavedSpecial, SpecialKind, Stage,
 };
+use crate::equations::RodSample;
 use crate::stability::Block;
 
 /// The names a stored flag takes: (true, false).
@@ -152,13 +155,7 @@ fn write_branches(root: &mut Group, d: &Diagram, stages: &[Stage]) -> StoreResul
         g.floats("unknowns", &[m, n], &x)?;
         let t: Vec<f64> = b.points.iter().flat_map(|p| p.tangent.clone()).collect();
         g.floats("tangent", &[m, n + 1], &t)?;
-        let shapes: Vec<f64> = b
-            .points
-            .iter()
-            .flat_map(|p| p.shape.iter().flat_map(|r| r.as_slice().to_vec()))
-            .collect();
-        let n_shape = b.points.first().map_or(0, |p| p.shape.len());
-        g.floats("shapes", &[m, n_shape, 3], &shapes)?;
+        write_shapes(g, &b.points)?;
         // −1: a primary branch, with no parent.
         g.attrs
             .set_signed("parent", b.parent.map_or(-1, |p| p as i64));
@@ -168,6 +165,35 @@ fn write_branches(root: &mut Group, d: &Diagram, stages: &[Stage]) -> StoreResul
         write_stage(g, stages, i)?;
     }
     Ok(())
+}
+
+/// The rod at each point's equally spaced shape points: the centreline
+/// (`shapes`, m×n×3) and the fields ParaView shows (`shape_s` m×n; the
+/// directors, curvature, moment and force m×n×3).
+fn write_shapes(g: &mut Group, points: &[Point]) -> StoreResult<()> {
+    let m = points.len();
+    let n = points.first().map_or(0, |p| p.shape.len());
+    if points.iter().any(|p| p.shape.len() != n) {
+        return Err("the points of a branch have different numbers of shape points".into());
+    }
+    let vectors = |f: &dyn Fn(&RodSample) -> Vector3<f64>| -> Vec<f64> {
+        points
+            .iter()
+            .flat_map(|p| p.shape.iter().flat_map(|r| f(r).as_slice().to_vec()))
+            .collect()
+    };
+    g.floats("shapes", &[m, n, 3], &vectors(&|r| r.position))?;
+    let s: Vec<f64> = points
+        .iter()
+        .flat_map(|p| p.shape.iter().map(|r| r.s))
+        .collect();
+    g.floats("shape_s", &[m, n], &s)?;
+    for (i, name) in ["shape_d1", "shape_d2", "shape_d3"].into_iter().enumerate() {
+        g.floats(name, &[m, n, 3], &vectors(&|r| r.directors[i]))?;
+    }
+    g.floats("shape_curvature", &[m, n, 3], &vectors(&|r| r.curvature))?;
+    g.floats("shape_moment", &[m, n, 3], &vectors(&|r| r.moment))?;
+    g.floats("shape_force", &[m, n, 3], &vectors(&|r| r.force))
 }
 
 /// The stage of branch `i`: its number, key and held keys.
