@@ -153,6 +153,9 @@ impl Diagram {
     }
 }
 
+/// A quantity read off a point.
+type PointValue = fn(&Point) -> f64;
+
 /// One branch: its points' parameter, measures, eigenvalues and stability.
 #[pyclass(module = "cosserat", frozen)]
 pub struct Branch {
@@ -181,7 +184,7 @@ impl Branch {
     /// (`[continuation] measures`).
     #[getter]
     fn measures<'py>(&self, py: Python<'py>) -> BTreeMap<String, Bound<'py, PyArray1<f64>>> {
-        let tip: [(&str, fn(&Point) -> f64); 5] = [
+        let tip: [(&str, PointValue); 5] = [
             ("tip_x", |p| p.tip.position[0]),
             ("tip_y", |p| p.tip.position[1]),
             ("tip_z", |p| p.tip.position[2]),
