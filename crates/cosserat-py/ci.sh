@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The Python package in CI: a virtual environment with maturin, pytest,
+# The Python package in CI: a virtual environment with pytest,
 # NumPy, matplotlib and h5py; `pip install ./crates/cosserat-py` as the
 # README says; the pytest suite (tests/, the quickstart example included).
 # Builds into the workspace's target directory, so that after the
@@ -18,7 +18,7 @@ fi
 echo "== Python virtual environment ($VENV)"
 python3 -m venv "$VENV"
 "$VENV/bin/python" -m pip install -q --upgrade pip
-"$VENV/bin/python" -m pip install -q maturin pytest numpy matplotlib h5py
+"$VENV/bin/python" -m pip install -q pytest numpy matplotlib h5py
 
 echo "== pip install ./crates/cosserat-py"
 export CARGO_TARGET_DIR="$PWD/target"
