@@ -21,7 +21,7 @@ python3 -m venv "$VENV"
 "$VENV/bin/python" -m pip install -q pytest numpy matplotlib h5py
 
 echo "== pip install ./crates/cosserat-py"
-export CARGO_TARGET_DIR="$PWD/target"
+export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$PWD/target}"
 "$VENV/bin/python" -m pip install -q ./crates/cosserat-py
 
 echo "== pytest crates/cosserat-py/tests"

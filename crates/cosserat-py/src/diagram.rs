@@ -183,7 +183,10 @@ impl Branch {
     /// as `cosserat plot --measure` names them) and the run's own
     /// (`[continuation] measures`).
     #[getter]
-    fn measures<'py>(&self, py: Python<'py>) -> BTreeMap<String, Bound<'py, PyArray1<f64>>> {
+    fn measures<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<BTreeMap<String, Bound<'py, PyArray1<f64>>>> {
         let tip: [(&str, PointValue); 5] = [
             ("tip_x", |p| p.tip.position[0]),
             ("tip_y", |p| p.tip.position[1]),
@@ -196,10 +199,17 @@ impl Branch {
             .map(|(name, value)| (name.to_string(), column(py, self.each(value))))
             .collect();
         for (i, name) in self.measure_names.iter().enumerate() {
-            let values = self.each(|p| p.measures.get(i).copied().unwrap_or(f64::NAN));
+            let values: Option<Vec<f64>> = self
+                .followed
+                .points
+                .iter()
+                .map(|p| p.measures.get(i).copied())
+                .collect();
+            let values = values
+                .ok_or_else(|| Failure::Internal(format!("a point lacks the measure {name}")))?;
             measures.insert(name.clone(), column(py, values));
         }
-        measures
+        Ok(measures)
     }
 
     /// The tip position at each point, shape (n, 3).
@@ -228,7 +238,7 @@ impl Branch {
 
     /// The tracked eigenvalues, shape (n, k); columns `eigenvalue_names`.
     #[getter]
-    fn eigenvalues<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+    fn eigenvalues<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let k = self.eigenvalue_names.len();
         let rows: Vec<&[f64]> = self
             .followed
@@ -236,10 +246,13 @@ impl Branch {
             .iter()
             .map(|p| &p.eigenvalues[..])
             .collect();
-        if rows.iter().all(|r| r.len() == k) {
-            table(py, &rows, k)
-        } else {
-            table(py, &[], 0)
+        match rows.iter().find(|r| r.len() != k) {
+            None => Ok(table(py, &rows, k)),
+            Some(r) => Err(Failure::Internal(format!(
+                "a point tracks {} eigenvalues, the diagram names {k}",
+                r.len()
+            ))
+            .into()),
         }
     }
 
