@@ -19,9 +19,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use crate::chart_style::{
-    self, colour, colour_bar, draw_tags, equal_aspect, frame, legend, line, padded, render, tick,
-    Chart2d, Failure, Figure, Glyph, LegendEntry, PixelBox, Stroke, Tag, AXIS_FONT, TEXT_FONT,
-    TITLE_FONT,
+    self, colour, colour_bar, draw_grid, draw_tags, equal_aspect, frame, legend, line, padded,
+    render, Chart2d, Failure, Figure, Glyph, LegendEntry, PixelBox, Stroke, Tag, TITLE_FONT,
 };
 use cosserat::study::arm::ArmWeight;
 
@@ -195,18 +194,7 @@ where
         .x_label_area_size(50)
         .y_label_area_size(70)
         .build_cartesian_2d(xs.0..xs.1, ys.0..ys.1)?;
-    let (xspan, yspan) = (xs.1 - xs.0, ys.1 - ys.0);
-    chart
-        .configure_mesh()
-        .x_desc(axes.0)
-        .y_desc(axes.1)
-        .x_label_formatter(&|v| tick(*v, xspan))
-        .y_label_formatter(&|v| tick(*v, yspan))
-        .label_style(("sans-serif", TEXT_FONT))
-        .axis_desc_style(("sans-serif", AXIS_FONT))
-        .light_line_style(WHITE)
-        .bold_line_style(BLACK.mix(0.12))
-        .draw()?;
+    draw_grid(&mut chart, axes.0, axes.1, (xs.1 - xs.0, ys.1 - ys.0))?;
     let range = padded(dots.iter().map(|d| d.2));
     let range = if dots.len() > 1 {
         (dots[0].2, dots[dots.len() - 1].2)
@@ -319,18 +307,12 @@ where
         pixels,
     );
     let mut chart: Chart2d<DB> = build(zs, hs)?;
-    let (zspan, hspan) = (zs.1 - zs.0, hs.1 - hs.0);
-    chart
-        .configure_mesh()
-        .x_desc(format!("z {}", reach_unit(p)))
-        .y_desc(format!("height −x {}", reach_unit(p)))
-        .x_label_formatter(&|v| tick(*v, zspan))
-        .y_label_formatter(&|v| tick(*v, hspan))
-        .label_style(("sans-serif", TEXT_FONT))
-        .axis_desc_style(("sans-serif", AXIS_FONT))
-        .light_line_style(WHITE)
-        .bold_line_style(BLACK.mix(0.12))
-        .draw()?;
+    draw_grid(
+        &mut chart,
+        format!("z {}", reach_unit(p)),
+        format!("height −x {}", reach_unit(p)),
+        (zs.1 - zs.0, hs.1 - hs.0),
+    )?;
     for s in shapes {
         let pts: Vec<(f64, f64)> = s.points.iter().map(|r| (r[2], -r[0])).collect();
         line(&mut chart, pts, colour(s.colour), s.stroke, 2)?;

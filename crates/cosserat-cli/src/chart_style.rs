@@ -297,6 +297,32 @@ pub struct Tag {
     pub glyph: Option<Glyph>,
 }
 
+/// The grid every Cartesian chart draws: axis descriptions, tick labels
+/// with the digits their spacing needs (`spans`: the axes' lengths, see
+/// [`tick`]), faint major lines and no minor ones.
+pub fn draw_grid<DB: DrawingBackend>(
+    chart: &mut Chart2d<DB>,
+    x_desc: impl Into<String>,
+    y_desc: impl Into<String>,
+    spans: (f64, f64),
+) -> Result<(), Failure>
+where
+    DB::ErrorType: 'static,
+{
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .x_label_formatter(&|v| tick(*v, spans.0))
+        .y_label_formatter(&|v| tick(*v, spans.1))
+        .label_style(("sans-serif", TEXT_FONT))
+        .axis_desc_style(("sans-serif", AXIS_FONT))
+        .light_line_style(WHITE)
+        .bold_line_style(BLACK.mix(0.12))
+        .draw()?;
+    Ok(())
+}
+
 /// Draws `tags` (markers, then their texts placed apart and clear of the
 /// markers and `obstacles`, absolute pixels) on `chart`.
 pub fn draw_tags<DB: DrawingBackend>(

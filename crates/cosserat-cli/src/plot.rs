@@ -13,8 +13,8 @@ use plotters::prelude::*;
 
 use crate::axis_label::{measure_label, parameter_label, Scale};
 use crate::chart_style::{
-    self, colour, draw_tags, equal_aspect, frame, legend, line, padded, render, tick, Failure,
-    Figure, Glyph, LegendEntry, PixelBox, Stroke, Tag, AXIS_FONT, TEXT_FONT, TITLE_FONT,
+    self, colour, draw_grid, draw_tags, equal_aspect, frame, legend, line, padded, render, Failure,
+    Figure, Glyph, LegendEntry, PixelBox, Stroke, Tag, TITLE_FONT,
 };
 
 /// One branch as read from a diagram file.
@@ -580,18 +580,12 @@ impl DiagramChart<'_> {
             .x_label_area_size(50)
             .y_label_area_size(80)
             .build_cartesian_2d(xs.0..xs.1, ys.0..ys.1)?;
-        let (xspan, yspan) = (xs.1 - xs.0, ys.1 - ys.0);
-        chart
-            .configure_mesh()
-            .x_desc(parameter_label(&data.parameter_name, scale))
-            .y_desc(measure_label(self.measure, scale))
-            .x_label_formatter(&|v| tick(*v, xspan))
-            .y_label_formatter(&|v| tick(*v, yspan))
-            .label_style(("sans-serif", TEXT_FONT))
-            .axis_desc_style(("sans-serif", AXIS_FONT))
-            .light_line_style(WHITE)
-            .bold_line_style(BLACK.mix(0.12))
-            .draw()?;
+        draw_grid(
+            &mut chart,
+            parameter_label(&data.parameter_name, scale),
+            measure_label(self.measure, scale),
+            (xs.1 - xs.0, ys.1 - ys.0),
+        )?;
         for (bi, b) in data.branches.iter().enumerate() {
             let mut start = 0;
             while start + 1 < b.parameter.len() {
@@ -649,7 +643,9 @@ impl DiagramChart<'_> {
             Scale::Nondimensional => ("z/L", "height −x/L"),
             Scale::Dimensional => ("z (m)", "height −x (m)"),
         };
-        let inner = area.titled("rod shapes (to scale)", ("sans-serif", TITLE_FONT))?;
+        let inner = area
+            .margin(12, 0, 0, 0)
+            .titled("rod shapes (to scale)", ("sans-serif", TITLE_FONT))?;
         // Built twice: first to learn the plotting area's pixels, then
         // with the ranges of equal aspect (building draws nothing).
         let build = |zs: (f64, f64), hs: (f64, f64)| {
@@ -673,18 +669,7 @@ impl DiagramChart<'_> {
             )
         };
         let mut chart = build(zs, hs)?;
-        let (zspan, hspan) = (zs.1 - zs.0, hs.1 - hs.0);
-        chart
-            .configure_mesh()
-            .x_desc(x_unit)
-            .y_desc(h_unit)
-            .x_label_formatter(&|v| tick(*v, zspan))
-            .y_label_formatter(&|v| tick(*v, hspan))
-            .label_style(("sans-serif", TEXT_FONT))
-            .axis_desc_style(("sans-serif", AXIS_FONT))
-            .light_line_style(WHITE)
-            .bold_line_style(BLACK.mix(0.12))
-            .draw()?;
+        draw_grid(&mut chart, x_unit, h_unit, (zs.1 - zs.0, hs.1 - hs.0))?;
         for (m, s) in &shown {
             let pts = s.iter().map(|r| (r[2], -r[0])).collect();
             line(&mut chart, pts, colour(m.branch), Stroke::Solid, 2)?;

@@ -21,8 +21,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use crate::chart_style::{
-    colour, colour_bar, equal_aspect, frame, legend, line, padded, render, tick, Failure, Figure,
-    Glyph, LegendEntry, Stroke, AXIS_FONT, TEXT_FONT, TITLE_FONT,
+    colour, colour_bar, draw_grid, equal_aspect, frame, legend, line, padded, render, tick,
+    Failure, Figure, Glyph, LegendEntry, Stroke, AXIS_FONT, TEXT_FONT, TITLE_FONT,
 };
 use cosserat::study::sweep::contour::{GridField, PowerFit};
 
@@ -343,18 +343,12 @@ impl Envelopes<'_> {
         DB::ErrorType: 'static,
     {
         let mut chart = build(area, z, h)?;
-        let (zspan, hspan) = (z.1 - z.0, h.1 - h.0);
-        chart
-            .configure_mesh()
-            .x_desc(self.labels.reach.as_str())
-            .y_desc(self.labels.height.as_str())
-            .x_label_formatter(&|v| tick(*v, zspan))
-            .y_label_formatter(&|v| tick(*v, hspan))
-            .label_style(("sans-serif", TEXT_FONT))
-            .axis_desc_style(("sans-serif", AXIS_FONT))
-            .light_line_style(WHITE)
-            .bold_line_style(BLACK.mix(0.12))
-            .draw()?;
+        draw_grid(
+            &mut chart,
+            self.labels.reach.as_str(),
+            self.labels.height.as_str(),
+            (z.1 - z.0, h.1 - h.0),
+        )?;
         let grey = RGBColor(110, 110, 110);
         let rb = std::f64::consts::FRAC_PI_2;
         line(
