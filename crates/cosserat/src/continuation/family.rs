@@ -355,7 +355,9 @@ impl Family {
             d
         };
         let norm = d.iter().map(|v| v * v).sum::<f64>().sqrt();
-        d.iter_mut().for_each(|v| *v /= norm);
+        for v in &mut d {
+            *v /= norm;
+        }
         Some(d)
     }
 
