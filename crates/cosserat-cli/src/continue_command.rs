@@ -92,7 +92,13 @@ fn read_problem(args: &ContinueArgs) -> Result<(Problem, Option<StoredStart>), E
     .map_err(|e| fail(BAD_INPUT, e))?;
     let mut set = stored.sets.clone();
     set.extend_from_slice(args.set);
-    Ok((read(&set)?, Some(stored)))
+    let problem = read(&set)?;
+    // The stored point in the scaling of the family that runs.
+    let stored = match &problem.continuation {
+        Some((family, _)) => stored.onto(family).map_err(|e| fail(BAD_INPUT, e))?,
+        None => stored,
+    };
+    Ok((problem, Some(stored)))
 }
 
 /// Runs the continuation of a problem file.

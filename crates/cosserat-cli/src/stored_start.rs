@@ -13,11 +13,21 @@
 //! stored shape with the stored value of the first parameter held; a
 //! point of a later stage of a chained run holds that stage's held keys
 //! too.
+//!
+//! A diagram stores its unknowns scaled by its own problem's state scales
+//! (lengths, curvatures, reactions of the base rod, which move with the
+//! loads, the length and the stiffness). So the stored point is carried
+//! over ([`StoredStart::onto`]): unscaled by the family the stored problem
+//! text (the branch's held keys set) makes, integrated onto the new
+//! family's nodes where the mesh differs, scaled by the new family. A
+//! point of another model level or state layout is refused by name.
 
 use std::path::Path;
 
 use cosserat::continuation::{Family, Parameter, SavedDiagram, StartPoint};
 use cosserat::output::{read_saved, read_solved};
+
+use crate::energies::read_problem_text;
 
 /// Where the new run begins.
 pub enum Start {
@@ -36,10 +46,109 @@ pub enum Start {
 pub struct StoredStart {
     /// `KEY=VALUE` overrides to apply before the user's.
     pub sets: Vec<String>,
-    /// The unknowns and direction, or the branch point.
+    /// The unknowns and direction, or the branch point: in the scaling of
+    /// the family that stored them until [`StoredStart::onto`] carries
+    /// them onto the new run's.
     pub start: Start,
     /// One line for the report.
     pub summary: String,
+    /// The family that stored the point and the point's parameter value,
+    /// for a start read from a diagram (none from a solve file, whose
+    /// unknowns are raw).
+    stored: Option<(Box<Family>, f64)>,
+}
+
+impl StoredStart {
+    /// The start carried onto `family` (the new run's, read with
+    /// [`StoredStart::sets`]): the stored unknowns (and direction, and for
+    /// a switch the whole stored diagram) unscaled by the family that
+    /// stored them and scaled by `family` ([`Family::carried`]). Refused
+    /// by name where they cannot be (another model level, a switch on
+    /// another mesh).
+    pub fn onto(mut self, family: &Family) -> Result<StoredStart, String> {
+        let Some((from, p)) = self.stored.take() else {
+            return Ok(self);
+        };
+        let refuse = |e: &dyn std::fmt::Display| format!("--from: {e}");
+        self.start = match self.start {
+            Start::Point(point) => {
+                let x = family
+                    .carried(&from, point.unknowns(), p)
+                    .map_err(|e| refuse(&e))?;
+                let direction = point
+                    .direction()
+                    .and_then(|t| family.carried_direction(&from, t));
+                Start::Point(StartPoint::new(x, direction))
+            }
+            Start::Switch { saved, special } => Start::Switch {
+                saved: Box::new(carried_diagram(*saved, &from, family).map_err(|e| refuse(&e))?),
+                special,
+            },
+        };
+        Ok(self)
+    }
+}
+
+/// A stored diagram's unknowns and tangents in `family`'s scaling: every
+/// point is rescaled as [`Family::carried`] does on the same mesh. A
+/// switch replays the stored branch on its own points, so a diagram of
+/// another mesh is refused.
+fn carried_diagram(
+    mut saved: SavedDiagram,
+    from: &Family,
+    family: &Family,
+) -> Result<SavedDiagram, String> {
+    if from.size() != family.size() {
+        return Err(format!(
+            "the stored diagram has {} unknowns per point, this problem's discretization {}: \
+             switch at a stored branch point with the stored solver.method and mesh",
+            from.size(),
+            family.size()
+        ));
+    }
+    let carry = |x: &mut Vec<f64>, p: f64| -> Result<(), String> {
+        *x = family.carried(from, x, p).map_err(|e| e.to_string())?;
+        Ok(())
+    };
+    let turn = |t: &mut Vec<f64>| {
+        if let Some(d) = family.carried_direction(from, t) {
+            *t = d;
+        }
+    };
+    for b in &mut saved.branches {
+        for ((x, t), p) in b.unknowns.iter_mut().zip(&mut b.tangent).zip(&b.parameter) {
+            carry(x, *p)?;
+            turn(t);
+        }
+    }
+    for sp in &mut saved.specials {
+        carry(&mut sp.unknowns, sp.parameter)?;
+        turn(&mut sp.tangent);
+    }
+    Ok(saved)
+}
+
+/// The family of the stored problem `text` that made a branch holding
+/// `held` (a later stage of a chained run holds the keys of the stages
+/// before it, one per stage): the problem's own continuation, or that of
+/// stage `held.len() + 1` with `held` set.
+fn stored_family(file: &Path, text: &str, held: &[(String, f64)]) -> Result<Family, String> {
+    let unreadable = |e: &dyn std::fmt::Display| {
+        format!(
+            "{}: its problem does not read, so its scaled unknowns cannot be carried over: {e}",
+            file.display()
+        )
+    };
+    let mut problem = read_problem_text(text, &[]).map_err(|e| unreadable(&e))?;
+    if !held.is_empty() {
+        problem = problem
+            .stage_in(held.len() + 1, held, crate::energies::catalog())
+            .map_err(|e| unreadable(&e))?;
+    }
+    problem
+        .continuation
+        .map(|(family, _)| family)
+        .ok_or_else(|| unreadable(&"it has no [continuation] table"))
 }
 
 /// `B/I`: branch B, point I (`last` for its last point).
@@ -84,7 +193,7 @@ pub fn stored_start(file: &Path, spec: &str, new_key: &str) -> Result<StoredStar
         )
     })?;
     if let Some(k) = spec.strip_prefix("special/") {
-        return switch_start(file, k, saved, &old_key, new_key);
+        return switch_start(file, &text, k, saved, &old_key, new_key);
     }
     let (b, i) = parse_point(spec, &saved)?;
     let branch = &saved.branches[b];
@@ -114,8 +223,10 @@ pub fn stored_start(file: &Path, spec: &str, new_key: &str) -> Result<StoredStar
         ));
     }
     let direction = same.then(|| branch.tangent[i].clone());
+    let from = stored_family(file, &text, &branch.held)?;
     Ok(StoredStart {
         sets,
+        stored: Some((Box::new(from), value)),
         start: Start::Point(StartPoint::new(branch.unknowns[i].clone(), direction)),
         summary: format!(
             "{} branch {b} point {i}: {old_key} = {value}{}",
@@ -133,6 +244,7 @@ pub fn stored_start(file: &Path, spec: &str, new_key: &str) -> Result<StoredStar
 /// stored parameter (at its stored value: the branch point's own family).
 fn switch_start(
     file: &Path,
+    text: &str,
     k: &str,
     saved: SavedDiagram,
     old_key: &str,
@@ -163,12 +275,13 @@ fn switch_start(
         ));
     }
     let value = saved.specials[special].parameter;
-    let mut sets: Vec<String> = branch
-        .map(|b| b.held.iter().map(|(k, v)| format!("{k}={v}")).collect())
-        .unwrap_or_default();
+    let held = branch.map(|b| b.held.clone()).unwrap_or_default();
+    let mut sets: Vec<String> = held.iter().map(|(k, v)| format!("{k}={v}")).collect();
     sets.push(format!("continuation.start={value}"));
+    let from = stored_family(file, text, &held)?;
     Ok(StoredStart {
         sets,
+        stored: Some((Box::new(from), value)),
         summary: format!(
             "{} special point {special}: {} at {old_key} = {value}",
             file.display(),
@@ -247,6 +360,7 @@ pub fn solved_start(
         .map_err(|e| format!("--from {}: {e}", file.display()))?;
     Ok(StoredStart {
         sets: vec![],
+        stored: None,
         start: Start::Point(StartPoint::new(x, None)),
         summary: format!(
             "{}: the equilibrium solved by {} ({} unknowns), Newton at {} = {start}",

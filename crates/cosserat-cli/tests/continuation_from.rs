@@ -410,3 +410,179 @@ fn wrong_solve_files_are_refused() {
         assert!(!out.exists(), "nothing written");
     }
 }
+
+/// The cantilever of problems/cantilever_tip_load.toml (B = (10, 1, 10),
+/// a 3 N tip force across it) with a `[continuation]` of its length —
+/// the number that moves the state scales (positions L, curvatures 1/L)
+/// by which a diagram stores its node states. Two shape points: the
+/// continued length moves the equally spaced shape points, and only the
+/// tip is compared here.
+const LENGTH_TABLE: &str = "
+[continuation]
+parameter = \"rod.length\"
+start = 1.0
+bounds = [1.0, 1.35]
+step = 0.1
+max_step = 0.2
+switch_depth = 0
+shape_points = 2
+";
+
+/// The `--set` of a discretization: single shooting, multiple shooting
+/// on 8 segments, Gauss collocation on 32 intervals.
+fn method_sets(method: &str) -> Vec<String> {
+    let mut sets = vec![format!("solver.method=\"{method}\"")];
+    match method {
+        "multiple-shooting" => sets.push("solver.segments=8".into()),
+        "collocation" => sets.push("continuation.intervals=32".into()),
+        _ => {}
+    }
+    sets.into_iter()
+        .flat_map(|s| ["--set".to_string(), s])
+        .collect()
+}
+
+/// `cosserat` with `args` then `sets`, which must succeed.
+fn run_ok(args: &[&str], sets: &[String]) -> std::process::Output {
+    let mut all: Vec<&str> = args.to_vec();
+    all.extend(sets.iter().map(String::as_str));
+    let o = run(&all);
+    assert!(o.status.success(), "{all:?}: {}", stderr(&o));
+    o
+}
+
+/// Starting in another key from a stored point: a diagram of the
+/// cantilever's length (each method), then from its last point a run
+/// continuing the tip force (each method: the stored mesh, or another one
+/// the point is carried onto). The first point of the new branch is the
+/// stored equilibrium: its tip agrees to 1e-9 with an independent
+/// `cosserat solve` (single shooting) of the problem at the stored length.
+#[test]
+fn a_point_starts_another_key_at_its_equilibrium() {
+    let dir = scratch("from", "other-key");
+    let problem = dir.join("cantilever.toml");
+    let text = std::fs::read_to_string(shipped("cantilever_tip_load")).unwrap();
+    std::fs::write(&problem, text + LENGTH_TABLE).unwrap();
+    let problem = problem.to_str().unwrap();
+    let force = [
+        "continuation.parameter=\"loads.tip_force[0]\"",
+        "continuation.start=3.0",
+        "continuation.bounds=[3.0, 4.0]",
+    ]
+    .iter()
+    .flat_map(|s| ["--set".to_string(), s.to_string()])
+    .collect::<Vec<_>>();
+    let methods = ["shooting", "multiple-shooting", "collocation"];
+    for stored in methods {
+        let diagram = dir.join(format!("length-{stored}.h5"));
+        let d = diagram.to_str().unwrap();
+        run_ok(&["continue", problem, "-o", d], &method_sets(stored));
+        let file = common::h5::open(&diagram);
+        let length = *read_f64(file.group("branches/0").unwrap(), "parameter")
+            .last()
+            .unwrap();
+        drop(file);
+        assert!(length > 1.3, "the diagram reached L = {length}");
+        let solved = dir.join(format!("solve-{stored}.h5"));
+        let set = format!("rod.length={length}");
+        run_ok(
+            &[
+                "solve",
+                problem,
+                "-o",
+                solved.to_str().unwrap(),
+                "--set",
+                &set,
+            ],
+            &[],
+        );
+        let solution = common::h5::open(&solved);
+        let position = read_f64(solution.group("solution").unwrap(), "position");
+        let exact = &position[position.len() - 3..];
+        drop(solution);
+        for method in methods {
+            let out = dir.join(format!("force-{stored}-{method}.h5"));
+            let mut sets = method_sets(method);
+            sets.extend(force.iter().cloned());
+            let o = run_ok(
+                &[
+                    "continue",
+                    problem,
+                    "-o",
+                    out.to_str().unwrap(),
+                    "--from",
+                    d,
+                    "--point",
+                    "0/last",
+                ],
+                &sets,
+            );
+            let said = String::from_utf8_lossy(&o.stdout);
+            assert!(said.contains(&format!("rod.length = {length}")), "{said}");
+            let file = common::h5::open(&out);
+            let branch = file.group("branches/0").unwrap();
+            assert_eq!(read_f64(branch, "parameter")[0], 3.0);
+            let tip = &read_f64(branch, "tip_position")[..3];
+            let worst = tip
+                .iter()
+                .zip(exact)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max);
+            assert!(
+                worst < 1e-9,
+                "stored by {stored}, run by {method}: the first tip {tip:?} is {worst:e} from \
+                 the solve's {exact:?}"
+            );
+        }
+    }
+}
+
+/// A stored point of another state layout is refused by name (exit 2,
+/// nothing written): a planar diagram started in the spatial model; and
+/// a switch at a stored branch point on another mesh, which replays the
+/// stored branch on its own points.
+#[test]
+fn a_point_of_another_discretization_is_refused_by_name() {
+    let dir = scratch("from", "other-mesh");
+    let out = dir.join("out.h5");
+    let full = dir.join("full.h5");
+    let euler = shipped("euler_column");
+    let sets = [
+        "--set",
+        "solver.method=\"multiple-shooting\"",
+        "--set",
+        "solver.segments=4",
+        "--set",
+        "continuation.bounds=[0.0, 3.0]",
+        "--set",
+        "continuation.switch_depth=0",
+    ];
+    let mut args = vec!["continue", euler.as_str(), "-o", full.to_str().unwrap()];
+    args.extend_from_slice(&sets);
+    let o = run(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let cases: [(&str, &[&str], &str); 2] = [
+        (
+            "0/3",
+            &["--set", "solver.model=\"kirchhoff\""],
+            "the stored point is of the planar model",
+        ),
+        (
+            "special/0",
+            &[],
+            "switch at a stored branch point with the stored solver.method and mesh",
+        ),
+    ];
+    for (point, extra, says) in cases {
+        let o = continue_from(
+            &euler,
+            out.to_str().unwrap(),
+            full.to_str().unwrap(),
+            point,
+            extra,
+        );
+        assert_eq!(o.status.code(), Some(2), "{point}: {}", stderr(&o));
+        assert!(stderr(&o).contains(says), "{point}: {}", stderr(&o));
+        assert!(!out.exists(), "nothing written");
+    }
+}

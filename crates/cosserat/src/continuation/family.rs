@@ -299,6 +299,68 @@ impl Family {
         }
     }
 
+    /// This family's unknowns from the unknowns `x` of another family
+    /// `from` (a stored diagram's) at its parameter value `p`: unscaled
+    /// by `from`'s weights (its base rod's state scales, which move with
+    /// the loads, length and stiffness the stored problem had), then, on
+    /// another mesh, carried onto this family's nodes by integrating the
+    /// stored solution of `from`'s rod at `p`
+    /// ([`ShootingSystem::refined_unknowns`]), and scaled by this
+    /// family's weights. Reusing the scaled vector as it is would start
+    /// Newton from another shape wherever the two base rods' scales
+    /// differ. Refused, naming both, when the states differ in size
+    /// (another model level or tip support) or `x` is not of `from`.
+    pub fn carried(&self, from: &Family, x: &[f64], p: f64) -> Result<Vec<f64>, CarryError> {
+        if x.len() != from.size() {
+            return Err(CarryError::Size {
+                found: x.len(),
+                expected: from.size(),
+            });
+        }
+        let (dim_from, dim) = (
+            equations(&from.base, from.level).dim(),
+            equations(&self.base, self.level).dim(),
+        );
+        if from.level != self.level || dim_from != dim {
+            return Err(CarryError::Layout {
+                from: format!("{} model, {dim_from} states", from.level.name()),
+                to: format!("{} model, {dim} states", self.level.name()),
+            });
+        }
+        let raw = from.unscaled(x);
+        if from.segments == self.segments {
+            return Ok(self.scaled(&raw));
+        }
+        let rod = from.rod_at(p).map_err(PointError::from)?;
+        let eq = equations(&rod, from.level);
+        let mut sys = ShootingSystem::new(eq.as_ref(), from.segments, from.tolerances);
+        let fine = sys
+            .refined_unknowns(&raw, self.segments)
+            .map_err(PointError::from)?;
+        Ok(self.scaled(&fine))
+    }
+
+    /// A direction of travel (x, p) of `from` as one of this family: the
+    /// x part rescaled as [`Family::carried`] does on the same mesh; on
+    /// another mesh only the sense in p is kept (x part zero).
+    pub fn carried_direction(&self, from: &Family, t: &[f64]) -> Option<Vec<f64>> {
+        let (tp, tx) = t.split_last()?;
+        let mut d = if from.segments == self.segments && tx.len() == self.size() {
+            let mut d = self.scaled(&from.unscaled(tx));
+            d.push(*tp);
+            d
+        } else {
+            let mut d = vec![0.0; self.size()];
+            d.push(tp.signum());
+            d
+        };
+        let norm = d.iter().map(|v| v * v).sum::<f64>().sqrt();
+        for v in &mut d {
+            *v /= norm;
+        }
+        Some(d)
+    }
+
     /// The length of the base rod (the problem's `rod.length`).
     pub fn base_length(&self) -> f64 {
         self.base.length()
@@ -560,6 +622,36 @@ impl std::fmt::Display for DerivativeMethod {
             DerivativeMethod::CentralDifference => "central difference in p",
         })
     }
+}
+
+/// Why unknowns of one family cannot start another ([`Family::carried`]).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum CarryError {
+    /// The unknowns are not of the family they are said to be of.
+    #[error(
+        "the stored point has {found} unknowns, its own problem's discretization {expected}: \
+         the file's problem does not describe its points"
+    )]
+    Size {
+        /// Unknowns found.
+        found: usize,
+        /// Unknowns of the stored family.
+        expected: usize,
+    },
+    /// Another state layout: no node state carries over.
+    #[error(
+        "the stored point is of the {from}, this continuation of the {to}; set solver.model \
+         (and the support) as the stored problem had them"
+    )]
+    Layout {
+        /// The stored family's model and state size.
+        from: String,
+        /// This family's.
+        to: String,
+    },
+    /// The stored solution could not be integrated onto the new nodes.
+    #[error("carrying the stored point onto this mesh: {0}")]
+    Point(#[from] PointError),
 }
 
 /// Why a point of the family could not be evaluated.

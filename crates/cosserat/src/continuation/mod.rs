@@ -47,7 +47,7 @@ pub use diagram::{
     Branch, ContinuationError, Diagram, Location, Point, Progress, SpecialKind, SpecialPoint,
 };
 pub use driver::continuation;
-pub use family::{tip_angle, DerivativeMethod, Family, FamilyError, PointError};
+pub use family::{tip_angle, CarryError, DerivativeMethod, Family, FamilyError, PointError};
 pub use lens::{Lens, Parameter, RodLens};
 pub use measure::{Measure, Quantity};
 pub use options::ContinuationOptions;

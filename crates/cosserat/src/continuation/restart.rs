@@ -39,6 +39,11 @@ impl StartPoint {
     pub fn unknowns(&self) -> &[f64] {
         &self.unknowns
     }
+
+    /// The direction of travel, if given.
+    pub fn direction(&self) -> Option<&[f64]> {
+        self.direction.as_deref()
+    }
 }
 
 /// [`super::continuation`] from `start` instead of the problem's own
