@@ -223,3 +223,51 @@ fn shapes_have_the_asked_resolution() {
     let err = Problem::from_str_with(EULER, &bad).unwrap_err().to_string();
     assert!(err.contains("continuation.shape_points"), "{err}");
 }
+
+const CANTILEVER: &str = include_str!("../../../problems/cantilever_tip_load.toml");
+
+/// A continuation in the rod's length keeps each point's shape points on
+/// that point's rod (equally spaced on [0, L], the last one the tip) and
+/// its tip where an independent solve at that length puts it — for every
+/// method. It starts at L = 1.715, where L·20/20 > L in floating point.
+/// (L·i/20 once landed an ulp beyond the tip at such lengths, the
+/// sampler left that point out, and shape points were paired with the
+/// wrong samples: a tip 0.085 off at L = 1.715.)
+#[test]
+fn a_length_continuation_keeps_each_points_rod() {
+    for method in ["shooting", "multiple-shooting", "collocation"] {
+        let mut text = CANTILEVER.to_string();
+        text.push_str(
+            "\n[continuation]\nparameter = \"rod.length\"\nstart = 1.715\nbounds = [1.0, 2.0]\n\
+             step = 0.07\nmax_step = 0.07\nelements = 16\neigenvalues = 1\n",
+        );
+        let set = [format!("solver.method=\"{method}\"")];
+        let problem = Problem::from_str_with(&text, &set).unwrap();
+        let (family, opts) = problem.continuation.clone().unwrap();
+        let d = continuation(&family, &opts, &mut |_, _| true).unwrap();
+        let points = &d.branches[0].points;
+        assert!(points.len() > 3, "{method}: {} points", points.len());
+        for point in points {
+            let l = point.parameter;
+            let n = point.shape.len();
+            assert_eq!(n, 21, "{method} at L = {l}");
+            for (i, sample) in point.shape.iter().enumerate() {
+                let s = l * i as f64 / (n - 1) as f64;
+                assert!(
+                    (sample.s - s).abs() < 1e-12 * l,
+                    "{method} at L = {l}: s {}",
+                    sample.s
+                );
+            }
+            assert!((point.shape[n - 1].position - point.tip.position).norm() < 1e-12);
+            let at = Problem::from_str_with(CANTILEVER, &[format!("rod.length={l:e}")]).unwrap();
+            let eq = cosserat::bvp::solve(&at.rod, &at.model, &at.options).unwrap();
+            let tip = eq.samples.last().unwrap().position;
+            let off = (point.tip.position - tip).norm();
+            assert!(
+                off < 1e-7 * l,
+                "{method} at L = {l}: tip {off:e} from the solve"
+            );
+        }
+    }
+}

@@ -594,7 +594,17 @@ impl Family {
         let rod = self.rod_at(p)?;
         let eq = equations(&rod, self.level);
         let mut sys = self.system(eq.as_ref());
-        Ok(sys.sample_interpolated(&self.unscaled(x), points)?.0)
+        let samples = sys.sample_interpolated(&self.unscaled(x), points)?.0;
+        // One sample per point, or the callers' pairing of samples with
+        // points (quadrature and shape points) would go silently wrong.
+        if samples.len() != points.len() {
+            return Err(PointError::Sampling {
+                p,
+                asked: points.len(),
+                served: samples.len(),
+            });
+        }
+        Ok(samples)
     }
 
     /// The tip sample (position, directors) at (x, p).
@@ -682,6 +692,17 @@ pub enum PointError {
         turn: f64,
         /// Elements that would resolve it.
         elements: f64,
+    },
+    /// The discretization served fewer samples than asked (a point
+    /// outside the rod): never paired off silently.
+    #[error("at p = {p}: {asked} sample points asked, {served} served (a point outside [0, L])")]
+    Sampling {
+        /// The parameter value.
+        p: f64,
+        /// Points asked for.
+        asked: usize,
+        /// Samples served.
+        served: usize,
     },
     /// Newton at fixed parameter did not converge.
     #[error("Newton did not converge at p = {0}")]

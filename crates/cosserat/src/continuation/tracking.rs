@@ -132,9 +132,12 @@ impl Tracker {
         // One integration for the quadrature points and the shape points
         // (the last is the tip).
         let quadrature = fe.quadrature_points();
+        // L·(i/last), not L·i/last: i/last ≤ 1 rounds to exactly 1 at the
+        // tip, so no shape point lands an ulp beyond the rod (the
+        // sampler serves [0, L] and would leave such a point out).
         let last = (self.shape_points - 1) as f64;
         let grid: Vec<f64> = (0..self.shape_points)
-            .map(|i| rod.length() * i as f64 / last)
+            .map(|i| rod.length() * (i as f64 / last))
             .collect();
         let mut all: Vec<(f64, bool)> = quadrature
             .iter()
