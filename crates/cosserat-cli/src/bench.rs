@@ -337,7 +337,9 @@ fn work_precision(dir: &Path) -> Result<(), Box<dyn std::error::Error>> {
         )
         .expect("writing to a String cannot fail");
     }
-    std::fs::write(dir.join("work_precision.csv"), csv)?;
+    cosserat::output::target::replace_atomically(&dir.join("work_precision.csv"), |tmp| {
+        std::fs::write(tmp, &csv)
+    })?;
     draw_work_precision(dir, &points)?;
     println!("written   {}", dir.join("work_precision.csv").display());
     Ok(())

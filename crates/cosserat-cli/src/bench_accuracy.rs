@@ -167,7 +167,7 @@ fn matching_point<'c>(
 /// tables are the same problem solved by possibly different methods.
 fn physics(text: &str) -> Option<toml::Table> {
     let mut table: toml::Table = text.parse().ok()?;
-    let method_keys: Vec<String> = ["shooting", "collocation-3"]
+    let method_keys: Vec<String> = validate::METHODS
         .iter()
         .flat_map(|m| validate::method_overrides(m))
         .filter_map(|o| o.split_once('=').map(|(k, _)| k.trim().to_string()))
