@@ -199,8 +199,9 @@ fn bench_optimize_times_a_small_search() {
     assert_eq!(rows[0]["elements"], "20");
 }
 
-/// A missing problem, `--repeat 0`, a bad `--set`, an existing CSV without
-/// `--force`, the problem as the CSV: exit 2, the directory as it was.
+/// A missing problem, `--repeat 0`, a bad `--set`, a problem without what
+/// the verb needs, an existing CSV without `--force`, the problem as the
+/// CSV: exit 2, the directory as it was.
 #[test]
 fn bad_input_exits_2_and_writes_nothing() {
     let dir = scratch("bench", "bad");
@@ -208,35 +209,20 @@ fn bad_input_exits_2_and_writes_nothing() {
     let csv_arg = csv.to_str().unwrap();
     let problem = shipped("cantilever_tip_load");
     let missing = dir.join("missing.toml");
-    let cases: [Vec<&str>; 3] = [
-        vec![
-            "bench",
-            "solve",
-            missing.to_str().unwrap(),
-            "--csv",
-            csv_arg,
-        ],
-        vec![
-            "bench",
-            "stability",
-            &problem,
-            "--repeat",
-            "0",
-            "--csv",
-            csv_arg,
-        ],
-        vec![
-            "bench",
-            "solve",
-            &problem,
-            "--set",
-            "rod.length=-1",
-            "--csv",
-            csv_arg,
-        ],
+    let column = shipped("euler_column");
+    let missing = missing.to_str().unwrap();
+    let cases: [&[&str]; 6] = [
+        &["solve", missing],
+        &["stability", &problem, "--repeat", "0"],
+        &["solve", &problem, "--set", "rod.length=-1"],
+        // No [continuation], no [arm], a [shape] with no equilibrium to solve.
+        &["continue", &problem],
+        &["optimize", &problem],
+        &["solve", &column],
     ];
-    for args in &cases {
-        let o = run(args);
+    for case in cases {
+        let args = [&["bench"], case, &["--csv", csv_arg]].concat();
+        let o = run(&args);
         assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
         assert!(
             entries(&dir).is_empty(),
