@@ -93,6 +93,19 @@ impl Record {
             t.max() * 1e3,
             t.runs()
         );
+        let w = &self.work;
+        let counts: Vec<String> = [
+            (w.newton_iterations, "Newton iterations"),
+            (w.integration_steps, "integration steps or intervals"),
+            (w.elements, "elements"),
+            (w.evaluations, "points or evaluations"),
+        ]
+        .iter()
+        .filter_map(|(n, what)| n.map(|n| format!("{n} {what}")))
+        .collect();
+        if !counts.is_empty() {
+            let _ = writeln!(out, "work      {} (last run)", counts.join(", "));
+        }
         if self.accuracy.is_empty() {
             out.push_str("accuracy  none (no validation case is this problem)\n");
         }
