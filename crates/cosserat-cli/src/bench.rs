@@ -1,7 +1,8 @@
 //! `cosserat bench work-precision`: error against wall time for every
 //! method and order on scenes with independent references.
-//! `cosserat bench continue PROBLEM`: the wall time of a problem's whole
-//! bifurcation diagram beside its summary.
+//! `cosserat bench solve|stability|continue|optimize PROBLEM`: the wall
+//! time of a command's computation beside its accuracy
+//! ([`crate::bench_timed`]).
 //!
 //! Scenes: the planar cantilever under a tip force k = F L²/B = 3 and 10
 //! (reference: the elliptic-integral closed form of Bisshopp & Drucker,
@@ -23,6 +24,8 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use clap::Subcommand;
+
+use crate::bench_timed::{run as timed, Timed, TimedArgs};
 use nalgebra::{Matrix3, Vector3};
 use plotters::prelude::*;
 
@@ -44,19 +47,21 @@ pub enum BenchCommand {
         #[arg(long, value_name = "CSV")]
         redraw: Option<PathBuf>,
     },
-    /// Wall time of a problem's whole `[continuation]` diagram (median, min,
-    /// max after one warm-up run) with the diagram's branches and special
-    /// points, so that speed and accuracy are read together.
-    Continue {
-        /// The problem file (TOML) with a `[continuation]` table.
-        problem: PathBuf,
-        /// Override any key of the problem file, e.g. --set continuation.elements=32.
-        #[arg(long = "set", value_name = "KEY=VALUE")]
-        set: Vec<String>,
-        /// Timed runs after the warm-up.
-        #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u32).range(1..))]
-        repeat: u32,
-    },
+    /// Wall time of `cosserat solve`'s computation (the equilibrium and
+    /// its stability verdict; no file written): median, min, max after
+    /// one warm-up, the work of a run, the accuracy where a validation
+    /// case gives a reference.
+    Solve(TimedArgs),
+    /// Wall time of `cosserat stability`'s computation (a critical load,
+    /// or an equilibrium's decided stability), as `bench solve`.
+    Stability(TimedArgs),
+    /// Wall time of a problem's whole `[continuation]` diagram with its
+    /// branches and special points, so that speed and result are read
+    /// together.
+    Continue(TimedArgs),
+    /// Wall time of `cosserat optimize`'s computation (the search, R0 and
+    /// the reach map; no paths, no file), as `bench solve`.
+    Optimize(TimedArgs),
 }
 
 /// Runs a benchmark; the exit code of the command.
@@ -82,65 +87,15 @@ pub fn run(command: BenchCommand) -> ExitCode {
                 ExitCode::from(3)
             }
         },
-        BenchCommand::Continue {
-            problem,
-            set,
-            repeat,
-        } => continue_diagram(&problem, &set, repeat as usize),
+        BenchCommand::Solve(args) => timed(Timed::Solve, &args),
+        BenchCommand::Stability(args) => timed(Timed::Stability, &args),
+        BenchCommand::Continue(args) => timed(Timed::Continue, &args),
+        BenchCommand::Optimize(args) => timed(Timed::Optimize, &args),
     }
-}
-
-/// `cosserat bench continue`: one warm-up run of the problem's diagram
-/// (detection, location, switching, every branch to its end), then
-/// `repeat` timed runs in this process; prints the median, min and max
-/// wall time and the diagram of the last run (branches with their points
-/// and stop reasons, special points with their parameter to 12 digits).
-/// Exit 2 for a bad problem, 3 when the diagram cannot start.
-fn continue_diagram(path: &Path, set: &[String], repeat: usize) -> ExitCode {
-    use crate::exit::{fail, BAD_INPUT, NO_RESULT};
-    use cosserat::continuation::continuation;
-    let problem = match crate::energies::read_problem(path, set) {
-        Ok(p) => p,
-        Err(e) => return fail(BAD_INPUT, format!("{}: {e}", path.display())),
-    };
-    let (family, opts) = match crate::continue_command::continued(&problem, path) {
-        Ok(c) => c,
-        Err(code) => return code,
-    };
-    let mut times = Vec::with_capacity(repeat);
-    let mut last = None;
-    for run in 0..=repeat {
-        let t = Instant::now();
-        let diagram = match continuation(family, opts, &mut |_, _| true) {
-            Ok(d) => d,
-            Err(e) => return fail(NO_RESULT, e),
-        };
-        if run > 0 {
-            times.push(t.elapsed().as_secs_f64());
-        }
-        last = Some(diagram);
-    }
-    let diagram = last.expect("at least the warm-up run");
-    times.sort_by(f64::total_cmp);
-    println!("problem   {}", path.display());
-    if let Ok(method) = family.derivative_method(opts.start) {
-        println!(
-            "F_p       {}",
-            crate::continue_command::derivative_line(method)
-        );
-    }
-    println!(
-        "time      median {:.3} ms, min {:.3} ms, max {:.3} ms over {repeat} runs (after 1 warm-up)",
-        median(times.clone()) * 1e3,
-        times[0] * 1e3,
-        times[times.len() - 1] * 1e3
-    );
-    print!("{}", diagram_summary(&diagram));
-    ExitCode::SUCCESS
 }
 
 /// Branches and special points of a diagram, one line each.
-fn diagram_summary(d: &cosserat::continuation::Diagram) -> String {
+pub fn diagram_summary(d: &cosserat::continuation::Diagram) -> String {
     let mut out = String::new();
     for w in &d.warnings {
         let _ = writeln!(out, "warning   {w}");
@@ -382,7 +337,9 @@ fn work_precision(dir: &Path) -> Result<(), Box<dyn std::error::Error>> {
         )
         .expect("writing to a String cannot fail");
     }
-    std::fs::write(dir.join("work_precision.csv"), csv)?;
+    cosserat::output::target::replace_atomically(&dir.join("work_precision.csv"), |tmp| {
+        std::fs::write(tmp, &csv)
+    })?;
     draw_work_precision(dir, &points)?;
     println!("written   {}", dir.join("work_precision.csv").display());
     Ok(())

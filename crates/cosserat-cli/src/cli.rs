@@ -200,7 +200,8 @@ pub enum Command {
         set: Vec<String>,
     },
     /// Benchmarks: `cosserat bench work-precision [-o DIR]`,
-    /// `cosserat bench continue PROBLEM [--set KEY=VALUE ...] [--repeat N]`.
+    /// `cosserat bench solve|stability|continue|optimize PROBLEM [--set
+    /// KEY=VALUE ...] [--repeat N] [--csv FILE]` (docs/performance.md).
     Bench {
         /// Which benchmark.
         #[command(subcommand)]

@@ -17,7 +17,7 @@
 //! | `sweep`, `merge` | [`sweep_command`] | `study::sweep::Sweep` → `study::sweep::run` over `ArmJob` or `SolveJob` | checkpointed records (HDF5), merged shards, charts by [`sweep_figure`] and [`sweep_chart`] (Figs. 6, 7) |
 //! | `validate` | [`validate`] | every case of validation/*.toml with every method, against `cosserat::references` | a Markdown report |
 //! | `export` | [`export_command`] (reads through [`shape_file`]) | none: the shapes a result file holds | VTK (.vtp, .pvd) or XDMF (.xmf) for ParaView |
-//! | `bench` | [`mod@bench`] | `bvp::solve` for every method and order | a work-precision chart and CSV |
+//! | `bench` | [`mod@bench`], [`bench_timed`] (accuracy by [`bench_accuracy`], CSV by [`bench_record`]) | `bvp::solve` for every method and order; the `compute_*` functions of `solve`, `stability`, `optimize` and the continuation | a work-precision chart and CSV; timings with accuracy (CSV) |
 //!
 //! Every command first reads its problem (`cosserat::input::Problem`, the only
 //! reader of problem files) and claims its outputs
@@ -34,6 +34,9 @@
 pub mod arm_chart;
 pub mod axis_label;
 pub mod bench;
+pub mod bench_accuracy;
+pub mod bench_record;
+pub mod bench_timed;
 pub mod chain;
 pub mod chart_style;
 pub mod cli;

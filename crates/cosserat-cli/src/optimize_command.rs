@@ -116,10 +116,7 @@ pub fn run_optimize(run: &OptimizeRun) -> ExitCode {
     // study then stays marked interrupted (its search complete), so that
     // `--resume` computes the rest.
     signals::set_mode(signals::Mode::NextPoint);
-    let straight = (*straight && scene.weight == ArmWeight::Weightless)
-        .then(|| straight_optimum(arm, &opt))
-        .flatten();
-    let extras = map_extras(arm, search, scene, *map_samples, &opt);
+    let (straight, extras) = after_search(arm, search, scene, (*map_samples, *straight), &opt);
     if signals::requested() {
         return keep_interrupted(run, &problem.text, &opt, &progress);
     }
@@ -188,9 +185,42 @@ fn run_search(
     outcome
 }
 
+/// The search of `cosserat optimize` with neither checkpoints nor
+/// progress (what `cosserat bench optimize` times with [`after_search`]).
+pub fn search_only(
+    arm: &ArmProblem,
+    search: &SearchOptions,
+    scene: &ArmScene,
+) -> Option<ArmOptimum> {
+    arm.search(
+        scene,
+        search,
+        SearchProgress::default(),
+        &|| false,
+        &mut |_| {},
+    )
+    .0
+}
+
+/// What `cosserat optimize` computes after its search: the intrinsically
+/// straight arm's R0 (when `straight` asks for it and the arm is
+/// weightless) and the Fig. 5 data set of `samples` map points.
+pub fn after_search(
+    arm: &ArmProblem,
+    search: &SearchOptions,
+    scene: &ArmScene,
+    (samples, straight): (usize, bool),
+    opt: &ArmOptimum,
+) -> (Option<StraightArm>, MapExtras) {
+    let straight = (straight && scene.weight == ArmWeight::Weightless)
+        .then(|| straight_optimum(arm, opt))
+        .flatten();
+    (straight, map_extras(arm, search, scene, samples, opt))
+}
+
 /// The Fig. 5 data set: the map, its 'Q', the least-Σb² design.
 #[derive(Default)]
-struct MapExtras {
+pub struct MapExtras {
     map: Option<ReachMap>,
     closest: Option<ClosestStraight>,
     least: Option<ClosestStraight>,

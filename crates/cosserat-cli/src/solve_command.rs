@@ -33,7 +33,7 @@ fn prepare(
 /// A failed solve: options the solver cannot run are bad input (2), a
 /// solver that found no equilibrium is no result (3); each with what to
 /// try next.
-fn solve_failed(e: &cosserat::bvp::SolveError) -> ExitCode {
+pub fn solve_failed(e: &cosserat::bvp::SolveError) -> ExitCode {
     use cosserat::bvp::SolveError as E;
     let (code, hint) = match e {
         E::Options(_) | E::Model(_) => (BAD_INPUT, "correct the problem file"),
@@ -87,40 +87,24 @@ pub fn run_stability(path: &Path, output: Option<&Path>, set: &[String], force: 
         opts.elements(),
         opts.order()
     );
-    let result = if let Some(shape) = &problem.shape {
-        match critical_load(&problem.rod, shape, opts) {
-            Ok(c) => {
-                report_critical(&c);
-                StabilityResult::FixedShape(c)
-            }
-            Err(e) => return fail(NO_RESULT, e),
-        }
-    } else {
+    if problem.shape.is_none() {
         println!(
             "model     {} ({})",
             problem.model.level.name(),
             problem.model.reason
         );
-        let eq = match solve(&problem.rod, &problem.model, &problem.options) {
-            Ok(eq) => eq,
-            Err(e) => return solve_failed(&e),
-        };
-        // The verdict is decided on meshes that resolve the shape and agree
-        // ([`cosserat::stability::decide`]), never read off one mesh.
-        let decision = match cosserat::stability::decide(&problem.rod, &eq, &problem.options, opts)
-        {
-            Ok(d) => d,
-            Err(e) => return fail(NO_RESULT, e),
-        };
-        let Some(st) = decision.stability.clone() else {
-            let reason = match &decision.verdict {
-                cosserat::stability::Verdict::Undecided { reason } => reason.clone(),
-                _ => "no mesh was analysed".into(),
-            };
-            return fail(NO_RESULT, format!("stability undecided: {reason}"));
-        };
-        report_decision(&st, &decision);
-        StabilityResult::Equilibrium(Box::new(eq), st)
+    }
+    let result = match compute_stability(&problem) {
+        Ok(StabilityOutcome::FixedShape(c)) => {
+            report_critical(&c);
+            StabilityResult::FixedShape(c)
+        }
+        Ok(StabilityOutcome::Decided(eq, decision, st)) => {
+            report_decision(&st, &decision);
+            StabilityResult::Equilibrium(eq, st)
+        }
+        Err(StabilityFailure::Solve(e)) => return solve_failed(&e),
+        Err(StabilityFailure::NoResult(e)) => return fail(NO_RESULT, e),
     };
     if let Some(out) = output {
         if let Err(e) = write_stability(out, &problem.text, &result, true) {
@@ -129,6 +113,50 @@ pub fn run_stability(path: &Path, output: Option<&Path>, set: &[String], force: 
         println!("written   {}", out.display());
     }
     ExitCode::SUCCESS
+}
+
+/// What `cosserat stability` computes: the critical load of a `[shape]`,
+/// or the equilibrium with its verdict decided on meshes that resolve the
+/// shape and agree ([`cosserat::stability::decide`]), never read off one
+/// mesh.
+pub enum StabilityOutcome {
+    /// The critical load of the fixed loaded shape.
+    FixedShape(CriticalLoad),
+    /// The equilibrium, the decision, and the analysis on its finest mesh.
+    Decided(Box<Equilibrium>, cosserat::stability::Decision, Stability),
+}
+
+/// Why `cosserat stability` has no result.
+pub enum StabilityFailure {
+    /// The equilibrium was not found (exit code by [`SolveError`](cosserat::bvp::SolveError)'s kind).
+    Solve(cosserat::bvp::SolveError),
+    /// The analysis failed or the verdict is undecided (exit 3).
+    NoResult(String),
+}
+
+/// The computation of `cosserat stability`, without printing or writing
+/// (also what `cosserat bench stability` times).
+pub fn compute_stability(problem: &Problem) -> Result<StabilityOutcome, StabilityFailure> {
+    let opts = &problem.stability;
+    if let Some(shape) = &problem.shape {
+        return critical_load(&problem.rod, shape, opts)
+            .map(StabilityOutcome::FixedShape)
+            .map_err(|e| StabilityFailure::NoResult(e.to_string()));
+    }
+    let eq =
+        solve(&problem.rod, &problem.model, &problem.options).map_err(StabilityFailure::Solve)?;
+    let decision = cosserat::stability::decide(&problem.rod, &eq, &problem.options, opts)
+        .map_err(|e| StabilityFailure::NoResult(e.to_string()))?;
+    let Some(st) = decision.stability.clone() else {
+        let reason = match &decision.verdict {
+            cosserat::stability::Verdict::Undecided { reason } => reason.clone(),
+            _ => "no mesh was analysed".into(),
+        };
+        return Err(StabilityFailure::NoResult(format!(
+            "stability undecided: {reason}"
+        )));
+    };
+    Ok(StabilityOutcome::Decided(Box::new(eq), decision, st))
 }
 
 /// The spectrum on the finest mesh used and the decided verdict.
@@ -191,12 +219,12 @@ pub fn run_solve(path: &Path, output: Option<&Path>, set: &[String], force: bool
         problem.model.reason
     );
     println!("energy    {}", problem.rod.energy().name());
-    let eq = match solve(&problem.rod, &problem.model, &problem.options) {
-        Ok(eq) => eq,
+    let Solved { eq, decision } = match compute_solve(&problem) {
+        Ok(s) => s,
         Err(e) => return solve_failed(&e),
     };
     report(&eq);
-    verdict(&problem, &eq);
+    verdict(decision);
     let tolerance = problem.options.newton.tolerance;
     if eq.residual.is_nan() || eq.residual > tolerance {
         // Belt and braces: solve() returns only converged results, but a
@@ -237,15 +265,33 @@ fn write_polyline(path: &Path, eq: &Equilibrium) -> Result<(), String> {
     cosserat::output::target::replace_atomically(path, |tmp| std::fs::write(tmp, &text))
 }
 
-/// The stability verdict of a solved equilibrium (conservative loads), on a
-/// mesh refined from the problem's `[stability]` settings until the Morse
-/// index and the signs of the lowest eigenvalues are certain
-/// ([`cosserat::stability::decide`]): a converged but unstable equilibrium
-/// is one the loading does not reach — say so rather than let it pass as
-/// the answer — and an uncertain one is "undecided".
-fn verdict(problem: &Problem, eq: &Equilibrium) {
-    use cosserat::stability::{decide, Verdict};
-    match decide(&problem.rod, eq, &problem.options, &problem.stability) {
+/// What `cosserat solve` computes: the equilibrium and its stability
+/// verdict ([`cosserat::stability::decide`]).
+pub struct Solved {
+    /// The equilibrium.
+    pub eq: Equilibrium,
+    /// Its stability decision, or why none was made.
+    pub decision: Result<cosserat::stability::Decision, cosserat::stability::StabilityError>,
+}
+
+/// The computation of `cosserat solve`, without printing or writing (also
+/// what `cosserat bench solve` times).
+pub fn compute_solve(problem: &Problem) -> Result<Solved, cosserat::bvp::SolveError> {
+    let eq = solve(&problem.rod, &problem.model, &problem.options)?;
+    let decision =
+        cosserat::stability::decide(&problem.rod, &eq, &problem.options, &problem.stability);
+    Ok(Solved { eq, decision })
+}
+
+/// Prints the stability verdict of a solved equilibrium (conservative
+/// loads), decided on a mesh refined from the problem's `[stability]`
+/// settings until the Morse index and the signs of the lowest eigenvalues
+/// are certain: a converged but unstable equilibrium is one the loading
+/// does not reach — say so rather than let it pass as the answer — and an
+/// uncertain one is "undecided".
+fn verdict(decision: Result<cosserat::stability::Decision, cosserat::stability::StabilityError>) {
+    use cosserat::stability::Verdict;
+    match decision {
         Ok(d) => match d.verdict {
             Verdict::Stable => println!(
                 "stability stable (Morse index 0; {} elements, eigenvalue error ≤ {:.1e})",

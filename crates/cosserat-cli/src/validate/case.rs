@@ -137,6 +137,18 @@ pub struct Tolerance {
     pub absolute: Option<f64>,
 }
 
+impl Tolerance {
+    /// Whether `computed` is within this tolerance of `reference`.
+    pub fn admits(&self, computed: f64, reference: f64) -> bool {
+        let abs = (computed - reference).abs();
+        match (self.relative, self.absolute) {
+            (Some(r), _) => abs <= r * reference.abs(),
+            (None, Some(a)) => abs <= a,
+            _ => false,
+        }
+    }
+}
+
 /// A case with its name (the file stem) and location.
 #[derive(Debug, Clone)]
 pub struct Case {

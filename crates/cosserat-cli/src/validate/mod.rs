@@ -25,6 +25,7 @@ pub use case::{
 };
 pub use cosserat::references as reference;
 pub use report::{counts, markdown, text_table, Row, Status};
+pub(crate) use runner::{fill, method_overrides, point_params, tip_quantities};
 pub use runner::{run, RunOptions};
 
 use std::path::PathBuf;
