@@ -81,7 +81,9 @@ impl Constraints {
         v.iter_mut().zip(off.iter()).for_each(|(a, b)| *a -= b);
         let norm = g.inner(v, v).sqrt();
         if norm > 0.0 && norm.is_finite() {
-            v.iter_mut().for_each(|a| *a /= norm);
+            for a in v.iter_mut() {
+                *a /= norm;
+            }
         }
     }
 }
