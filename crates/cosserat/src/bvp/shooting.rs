@@ -220,14 +220,15 @@ impl<'a> ShootingSystem<'a> {
             }
             let mut y = self.node_state(x, j);
             let eq = self.eq;
-            let stats = self.dop.integrate(
+            // The new nodes read from the continuous extension: a fine mesh
+            // costs the steps the tolerance needs, not one per node.
+            let stats = self.dop.integrate_serving(
                 |s, y: &[f64], d: &mut [f64]| eq.rhs(s, y, d),
-                a,
-                b,
+                (a, b, n),
                 &mut y,
-                n,
                 &self.tol,
                 &stops,
+                Stops::Interpolated,
                 |_, y| out.extend_from_slice(&y[..n]),
                 |y| eq.project(y),
             )?;
@@ -416,31 +417,33 @@ impl<'a> ShootingSystem<'a> {
     }
 
     /// Samples the solution at `points` (sorted, in [0, L]) and measures the
-    /// largest departure of the directors from orthonormality.
+    /// largest departure of the directors from orthonormality. The points
+    /// between steps are read from the integrator's continuous extension
+    /// ([`Stops::Interpolated`]): the steps are those the tolerance needs,
+    /// whatever the number of points, so that a stability mesh of 10⁵
+    /// elements (3·10⁵ quadrature points) costs no more steps than 10²
+    /// (landing a step on every point once ran out of the step budget).
     pub fn sample(
         &mut self,
         x: &[f64],
         points: &[f64],
     ) -> Result<(Vec<RodSample>, f64), IntegrationError> {
-        self.sample_served(x, points, Stops::Landed)
+        self.sample_served(x, points)
     }
 
-    /// As [`ShootingSystem::sample`], the points between steps read from
-    /// the integrator's continuous extension ([`Stops::Interpolated`]):
-    /// many points for the cost of the steps the tolerance needs.
+    /// [`ShootingSystem::sample`] (the name continuation calls it by).
     pub fn sample_interpolated(
         &mut self,
         x: &[f64],
         points: &[f64],
     ) -> Result<(Vec<RodSample>, f64), IntegrationError> {
-        self.sample_served(x, points, Stops::Interpolated)
+        self.sample(x, points)
     }
 
     fn sample_served(
         &mut self,
         x: &[f64],
         points: &[f64],
-        serve: Stops,
     ) -> Result<(Vec<RodSample>, f64), IntegrationError> {
         let n = self.eq.dim();
         let mut samples = Vec::with_capacity(points.len());
@@ -460,7 +463,7 @@ impl<'a> ShootingSystem<'a> {
                 &mut y,
                 &self.tol,
                 &stops,
-                serve,
+                Stops::Interpolated,
                 |s, y| samples.push(eq.sample(s, y)),
                 |y| eq.project(y),
             )?;

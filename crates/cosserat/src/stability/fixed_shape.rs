@@ -16,7 +16,7 @@ use super::second_variation::{Block, FiniteElements, FormCoefficients};
 use super::{StabilityError, StabilityOptions};
 use crate::equations::RodSample;
 use crate::model::{Profile, Rod};
-use crate::numerics::integrator::{Dop853, Tolerances};
+use crate::numerics::integrator::{Dop853, Stops, Tolerances};
 
 /// A loaded shape held fixed while the load varies.
 #[derive(Debug, Clone, PartialEq)]
@@ -61,15 +61,17 @@ impl FixedShape {
         let mut states = Vec::with_capacity(stops.len());
         let mut y = [0.0; 4];
         let tol = Tolerances::default();
+        // The stops (every quadrature point) are read from the continuous
+        // extension: the steps are those the tolerance needs however fine
+        // the mesh (one step per stop once ran out of the step budget).
         Dop853::new(4)
-            .integrate(
+            .integrate_serving(
                 rhs,
-                0.0,
-                rod.length(),
+                (0.0, rod.length(), 4),
                 &mut y,
-                4,
                 &tol,
                 &stops,
+                Stops::Interpolated,
                 |s, y| states.push((s, [y[0], y[1], y[2], y[3]])),
                 |_| {},
             )

@@ -23,7 +23,7 @@ use super::iteration::{Linearization, NewtonOutcome};
 use super::lu::{dense_lu, dense_solve, BandLu};
 use super::{CollocationSolution, Tableau};
 use crate::equations::{RodEquations, RodSample};
-use crate::numerics::integrator::{Dop853, Tolerances};
+use crate::numerics::integrator::{Dop853, Stops, Tolerances};
 
 /// The collocation equations on one mesh. Unknown vector layout:
 /// [u (p) | y_1 … y_N (n each) | Y_0 … Y_{N−1} (m·n each)].
@@ -203,14 +203,15 @@ impl<'a> Grid<'a> {
         };
         let eq = self.eq;
         let mut out = Vec::with_capacity(points.len());
-        let _ = Dop853::new(n).integrate(
+        // Points read from the continuous extension: a fine mesh costs the
+        // steps the tolerance needs, not one per point.
+        let _ = Dop853::new(n).integrate_serving(
             |s, y: &[f64], d: &mut [f64]| eq.rhs(s, y, d),
-            0.0,
-            eq.length(),
+            (0.0, eq.length(), n),
             &mut y,
-            n,
             &tol,
             points,
+            Stops::Interpolated,
             |_, y| out.push(y.to_vec()),
             |y| eq.project(y),
         );

@@ -1,0 +1,110 @@
+//! Stability on meshes far finer than the integrator's step budget (issue
+//! 18): sampling an equilibrium at 3·10⁵ quadrature points once landed
+//! one DOP853 step on each and failed with "more than 100000 steps". The
+//! samples now come from the continuous extension. Checked against
+//! Timoshenko's lateral–torsional buckling load 2 j (j the first zero of
+//! J₋₁/₄, `references::evaluate("timoshenko_ltb")`) and the classical
+//! Euler load π²/4 of the shipped cantilever column.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use cosserat::bvp::solve;
+use cosserat::input::Problem;
+use cosserat::references::evaluate;
+use cosserat::stability::{analyze, critical_load, FiniteElements, StabilityOptions};
+
+/// The shipped problem `name` (problems/<name>.toml).
+fn shipped(name: &str) -> Problem {
+    let path = format!(
+        "{}/problems/{name}.toml",
+        concat!(env!("CARGO_MANIFEST_DIR"), "/../..")
+    );
+    Problem::from_path(Path::new(&path), &[]).unwrap()
+}
+
+/// A mesh with more quadrature points (3 per element at order 2) than the
+/// 100 000 steps of the default integration budget; smaller in debug builds
+/// but still above it.
+fn large_mesh() -> usize {
+    if cfg!(debug_assertions) {
+        40_000
+    } else {
+        100_000
+    }
+}
+
+/// γ_cr of the Timoshenko problem's fixed shape on `elements` elements.
+fn timoshenko_gamma(problem: &Problem, elements: usize) -> f64 {
+    let opts = problem.stability.with_elements(elements).unwrap();
+    critical_load(&problem.rod, problem.shape.as_ref().unwrap(), &opts)
+        .unwrap()
+        .gamma
+        .unwrap()
+}
+
+/// The fixed-shape critical load on a large mesh succeeds and agrees with
+/// 2 j; on coarse meshes the error falls at the measured order ≈ 2p = 4 of
+/// Lagrange elements of order p = 2 (not a number taken from the code).
+#[test]
+fn timoshenko_load_converges_and_survives_a_large_mesh() {
+    let problem = shipped("timoshenko_ltb");
+    assert_eq!(problem.stability.order(), 2);
+    let exact = evaluate("timoshenko_ltb", &BTreeMap::new()).unwrap();
+    let errors: Vec<f64> = [4, 8, 16]
+        .iter()
+        .map(|&n| (timoshenko_gamma(&problem, n) - exact).abs())
+        .collect();
+    for w in errors.windows(2) {
+        let order = (w[0] / w[1]).log2();
+        assert!(
+            (3.5..4.5).contains(&order),
+            "measured order {order} from errors {errors:?}"
+        );
+    }
+    let large = timoshenko_gamma(&problem, large_mesh());
+    let relative = (large - exact).abs() / exact;
+    // The discretization error at 10⁵ elements is ~1e-20; what remains is
+    // the round-off of a stiffness matrix whose condition grows like N².
+    assert!(
+        relative < 1e-5,
+        "γ_cr on {} elements: {large} against {exact} ({relative:e})",
+        large_mesh()
+    );
+}
+
+/// Sampling the shipped cantilever's equilibrium at the quadrature points
+/// of a large mesh (what failed): every point served, the last one the
+/// solve's own tip; in release builds the whole analysis on that mesh too,
+/// with the same Morse index and lowest eigenvalues as the problem's own
+/// mesh, to that mesh's discretization error plus round-off (debug builds
+/// skip the eigen solve, ~1 min there).
+#[test]
+fn equilibrium_stability_survives_a_large_mesh() {
+    let problem = shipped("cantilever_tip_load");
+    let eq = solve(&problem.rod, &problem.model, &problem.options).unwrap();
+    let opts: StabilityOptions = problem.stability.with_elements(large_mesh()).unwrap();
+    let fe = FiniteElements::new(problem.rod.length(), opts.elements(), opts.order());
+    let mut points = fe.quadrature_points();
+    points.push(problem.rod.length());
+    assert!(points.len() > 100_000, "{} points", points.len());
+    let samples = eq
+        .resample(&problem.rod, &problem.options, &points)
+        .unwrap();
+    assert_eq!(samples.len(), points.len());
+    let tip = samples.last().unwrap();
+    assert!((tip.position - eq.tip().position).norm() < 1e-10);
+    if cfg!(debug_assertions) {
+        return;
+    }
+    let coarse = analyze(&problem.rod, &eq, &problem.options, &problem.stability).unwrap();
+    let fine = analyze(&problem.rod, &eq, &problem.options, &opts).unwrap();
+    assert_eq!(fine.morse_index, coarse.morse_index);
+    for (a, b) in coarse.blocks.iter().zip(&fine.blocks) {
+        let (a, b) = (a.eigenvalues[0], b.eigenvalues[0]);
+        assert!(
+            (a - b).abs() <= 1e-5 * a.abs(),
+            "λ1 {a} (coarse) against {b}"
+        );
+    }
+}
