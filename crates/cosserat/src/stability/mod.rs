@@ -417,8 +417,9 @@ fn resolved_elements(
 ) -> Result<usize, StabilityError> {
     let count = (8 * opts.elements).max(64);
     let length = rod.length();
+    // L·(i/count): the last point is L exactly, never an ulp beyond it.
     let points: Vec<f64> = (0..=count)
-        .map(|i| length * i as f64 / count as f64)
+        .map(|i| length * (i as f64 / count as f64))
         .collect();
     let kappa = eq
         .resample(rod, solver, &points)?

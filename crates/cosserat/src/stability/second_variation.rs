@@ -206,7 +206,10 @@ impl FiniteElements {
     /// All nodes s_0 = 0, …, s_{pE} = L.
     pub fn nodes(&self) -> Vec<f64> {
         let n = self.elements * self.order;
-        (0..=n).map(|i| self.length * i as f64 / n as f64).collect()
+        // L·(i/n): the last node is L exactly, never an ulp beyond it.
+        (0..=n)
+            .map(|i| self.length * (i as f64 / n as f64))
+            .collect()
     }
 
     /// The quadrature points in increasing order (where the equilibrium
