@@ -12,7 +12,7 @@ use std::path::Path;
 use cosserat::bvp::Method;
 use cosserat::input::Problem;
 
-use crate::validate::{self, Case, Point, Tolerance};
+use crate::validate::{self, error_of, Case, Point, Tolerance};
 
 /// The analysis of a validation case a benchmark compares with.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -56,14 +56,15 @@ pub struct Accuracy {
 impl Accuracy {
     /// |computed − reference|.
     pub fn error(&self) -> Option<f64> {
-        self.computed.map(|c| (c - self.reference).abs())
+        self.computed
+            .map(|c| error_of(&self.quantity, c, self.reference))
     }
 
     /// Whether the computed value is within the tolerance (None for an
     /// informational check).
     pub fn within(&self) -> Option<bool> {
         let t = self.tolerance?;
-        Some(self.computed.is_some_and(|c| t.admits(c, self.reference)))
+        Some(self.error().is_some_and(|e| t.admits(e, self.reference)))
     }
 }
 

@@ -137,10 +137,24 @@ pub struct Tolerance {
     pub absolute: Option<f64>,
 }
 
+/// The error of `computed` against `reference` for `quantity`. An angle
+/// (`tip_angle`, in (−π, π]) is compared on the circle: −π and π are one
+/// direction — a rod rolled into a half circle points its tip back along
+/// the clamp, and the sign of its angle is the sign of a rounding error.
+pub fn error_of(quantity: &str, computed: f64, reference: f64) -> f64 {
+    use std::f64::consts::{PI, TAU};
+    let d = computed - reference;
+    if quantity == "tip_angle" {
+        ((d + PI).rem_euclid(TAU) - PI).abs()
+    } else {
+        d.abs()
+    }
+}
+
 impl Tolerance {
-    /// Whether `computed` is within this tolerance of `reference`.
-    pub fn admits(&self, computed: f64, reference: f64) -> bool {
-        let abs = (computed - reference).abs();
+    /// Whether an error `abs` (from [`error_of`]) is within this tolerance
+    /// of `reference`.
+    pub fn admits(&self, abs: f64, reference: f64) -> bool {
         match (self.relative, self.absolute) {
             (Some(r), _) => abs <= r * reference.abs(),
             (None, Some(a)) => abs <= a,
@@ -289,4 +303,19 @@ pub fn load_case(path: &Path) -> Result<Case, InputError> {
         path: path.to_path_buf(),
         file,
     })
+}
+
+#[cfg(test)]
+mod angle_tests {
+    use super::error_of;
+    use std::f64::consts::PI;
+
+    /// −π and π are one direction; other quantities are plain numbers.
+    #[test]
+    fn angles_are_compared_on_the_circle() {
+        assert!(error_of("tip_angle", -PI, PI) < 1e-15);
+        assert!((error_of("tip_angle", -PI + 0.1, PI) - 0.1).abs() < 1e-12);
+        assert!((error_of("tip_angle", 0.5, 0.2) - 0.3).abs() < 1e-12);
+        assert_eq!(error_of("tip_x", -PI, PI), 2.0 * PI);
+    }
 }

@@ -20,8 +20,8 @@ mod report;
 mod runner;
 
 pub use case::{
-    default_dir, load_case, load_cases, Case, CaseFile, Check, InputError, Point, Reference, Scan,
-    Tolerance,
+    default_dir, error_of, load_case, load_cases, Case, CaseFile, Check, InputError, Point,
+    Reference, Scan, Tolerance,
 };
 pub use cosserat::references as reference;
 pub use report::{counts, markdown, text_table, Row, Status};

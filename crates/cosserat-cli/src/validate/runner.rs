@@ -410,7 +410,7 @@ fn compare(
             row.message.clone_from(&o.message);
             row.computed = o.values.get(&check.quantity).copied().flatten();
             if let Some(c) = row.computed {
-                let abs = (c - reference).abs();
+                let abs = super::case::error_of(&check.quantity, c, reference);
                 row.absolute_error = Some(abs);
                 row.relative_error = Some(if reference == 0.0 {
                     abs
@@ -418,7 +418,7 @@ fn compare(
                     abs / reference.abs()
                 });
                 row.status = match check.tolerance {
-                    Some(t) if t.admits(c, reference) => Status::Pass,
+                    Some(t) if t.admits(abs, reference) => Status::Pass,
                     _ => Status::Fail,
                 };
             }
