@@ -19,8 +19,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 use crate::chart_style::{
-    self, colour, colour_bar, draw_grid, draw_tags, equal_aspect, frame, legend, line, padded,
-    render, Chart2d, Failure, Figure, Glyph, LegendEntry, PixelBox, Stroke, Tag, TITLE_FONT,
+    self, colour, colour_bar, draw_grid, draw_tags, frame, legend, line, padded, render,
+    shape_chart, Failure, Figure, Glyph, LegendEntry, PixelBox, Stroke, Tag, ARROW, TITLE_FONT,
 };
 use cosserat::study::arm::ArmWeight;
 
@@ -250,8 +250,6 @@ impl<'a> Shape<'a> {
     }
 }
 
-/// Length of a load arrow (pixels): a direction, not a magnitude.
-const ARROW: f64 = 42.0;
 /// The colour of load arrows.
 const LOAD: RGBColor = RGBColor(200, 0, 0);
 
@@ -291,22 +289,7 @@ where
     legend(&top.margin(4, 0, 70, 0), &entries, 3)?;
     let zs = padded(shapes.iter().flat_map(|s| s.points.iter().map(|r| r[2])));
     let hs = padded(shapes.iter().flat_map(|s| s.points.iter().map(|r| -r[0])));
-    let build = |zs: (f64, f64), hs: (f64, f64)| {
-        ChartBuilder::on(&plot)
-            .margin(15)
-            .x_label_area_size(50)
-            .y_label_area_size(70)
-            .build_cartesian_2d(zs.0..zs.1, hs.0..hs.1)
-    };
-    let pixels = build(zs, hs)?.plotting_area().dim_in_pixel();
-    let (zs, hs) = equal_aspect(zs, hs, pixels);
-    let room = (ARROW + 12.0) * (zs.1 - zs.0) / f64::from(pixels.0.max(1));
-    let (zs, hs) = equal_aspect(
-        (zs.0 - room, zs.1 + room),
-        (hs.0 - room, hs.1 + room),
-        pixels,
-    );
-    let mut chart: Chart2d<DB> = build(zs, hs)?;
+    let (mut chart, zs, hs) = shape_chart(&plot, zs, hs, true)?;
     draw_grid(
         &mut chart,
         format!("z {}", reach_unit(p)),

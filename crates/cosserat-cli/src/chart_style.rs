@@ -115,6 +115,48 @@ pub fn equal_aspect(x: (f64, f64), y: (f64, f64), pixels: (u32, u32)) -> ((f64, 
     (widen(x, w), widen(y, h))
 }
 
+/// Length of a load arrow (pixels): a direction, not a magnitude.
+pub const ARROW: f64 = 42.0;
+
+/// A chart of rod shapes to scale on `area`: the ranges `zs` × `hs`
+/// widened to equal aspect on its plotting pixels, and by room for the
+/// load arrows at the tips when `arrows`. Built twice — first to learn the
+/// plotting area's pixels, then with the final ranges (building draws
+/// nothing). Returns the chart and its ranges.
+pub fn shape_chart<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    zs: (f64, f64),
+    hs: (f64, f64),
+    arrows: bool,
+) -> Result<ShapeChart<'_, DB>, Failure>
+where
+    DB::ErrorType: 'static,
+{
+    let build = |zs: (f64, f64), hs: (f64, f64)| {
+        ChartBuilder::on(area)
+            .margin(15)
+            .x_label_area_size(50)
+            .y_label_area_size(70)
+            .build_cartesian_2d(zs.0..zs.1, hs.0..hs.1)
+    };
+    let pixels = build(zs, hs)?.plotting_area().dim_in_pixel();
+    let (zs, hs) = equal_aspect(zs, hs, pixels);
+    let (zs, hs) = if arrows {
+        let room = (ARROW + 12.0) * (zs.1 - zs.0) / f64::from(pixels.0.max(1));
+        equal_aspect(
+            (zs.0 - room, zs.1 + room),
+            (hs.0 - room, hs.1 + room),
+            pixels,
+        )
+    } else {
+        (zs, hs)
+    };
+    Ok((build(zs, hs)?, zs, hs))
+}
+
+/// A shape chart and its ranges (z, height).
+pub type ShapeChart<'a, DB> = (Chart2d<'a, DB>, (f64, f64), (f64, f64));
+
 /// A tick label with the decimals its axis needs: `span` is the axis
 /// length in data units (scientific notation beyond 1e5 or below 1e-4).
 pub fn tick(v: f64, span: f64) -> String {

@@ -13,8 +13,8 @@ use plotters::prelude::*;
 
 use crate::axis_label::{measure_label, parameter_label, Scale};
 use crate::chart_style::{
-    self, colour, draw_grid, draw_tags, equal_aspect, frame, legend, line, padded, render, Failure,
-    Figure, Glyph, LegendEntry, PixelBox, Stroke, Tag, TITLE_FONT,
+    self, colour, draw_grid, draw_tags, frame, legend, line, padded, render, shape_chart, Failure,
+    Figure, Glyph, LegendEntry, PixelBox, Stroke, Tag, ARROW, TITLE_FONT,
 };
 
 /// One branch as read from a diagram file.
@@ -646,29 +646,9 @@ impl DiagramChart<'_> {
         let inner = area
             .margin(12, 0, 0, 0)
             .titled("rod shapes (to scale)", ("sans-serif", TITLE_FONT))?;
-        // Built twice: first to learn the plotting area's pixels, then
-        // with the ranges of equal aspect (building draws nothing).
-        let build = |zs: (f64, f64), hs: (f64, f64)| {
-            ChartBuilder::on(&inner)
-                .margin(15)
-                .x_label_area_size(50)
-                .y_label_area_size(70)
-                .build_cartesian_2d(zs.0..zs.1, hs.0..hs.1)
-        };
-        let pixels = build(zs, hs)?.plotting_area().dim_in_pixel();
-        let (zs, hs) = equal_aspect(zs, hs, pixels);
-        // Room for the load arrows at the tips.
-        let (zs, hs) = if self.view.load == LoadRule::Unknown {
-            (zs, hs)
-        } else {
-            let room = (ARROW + 12.0) * (zs.1 - zs.0) / f64::from(pixels.0.max(1));
-            equal_aspect(
-                (zs.0 - room, zs.1 + room),
-                (hs.0 - room, hs.1 + room),
-                pixels,
-            )
-        };
-        let mut chart = build(zs, hs)?;
+        // Room for the load arrows at the tips where the load is known.
+        let arrows = self.view.load != LoadRule::Unknown;
+        let (mut chart, zs, hs) = shape_chart(&inner, zs, hs, arrows)?;
         draw_grid(&mut chart, x_unit, h_unit, (zs.1 - zs.0, hs.1 - hs.0))?;
         for (m, s) in &shown {
             let pts = s.iter().map(|r| (r[2], -r[0])).collect();
@@ -701,9 +681,6 @@ impl DiagramChart<'_> {
         Ok(!arrows.is_empty())
     }
 }
-
-/// Length of a load arrow (pixels): a direction, not a magnitude.
-const ARROW: f64 = 42.0;
 
 /// One tag per distinct shape at its tip: marks whose shapes coincide
 /// (the two sides of one branch point, a trivial branch's end) share it.
