@@ -151,3 +151,51 @@ fn keys_that_are_not_numbers_of_the_rod_are_refused() {
         );
     }
 }
+
+const CANTILEVER: &str = include_str!("../../../problems/cantilever_tip_load.toml");
+
+/// A stiffness continued downwards with a step whose predictor leaves the
+/// physical domain (B ≤ 0, where no rod exists) is cut back and lands
+/// exactly on its lower bound, where the cantilever is Bisshopp and
+/// Drucker's at k = F L²/B2 (B1 does not enter the planar equilibrium:
+/// k = 3 there; B2 = 0.2: k = 15).
+#[test]
+fn a_stiffness_step_beyond_the_physical_domain_lands_on_the_bound() {
+    for (key, k_at_bound) in [("energy.stiffness[0]", 3.0), ("energy.stiffness[1]", 15.0)] {
+        // (Longer steps on this unit range jump to another equilibrium
+        // of the loaded cantilever, which the diagram warns of.)
+        for step in ["0.5", "1.0"] {
+            let parameter = format!("continuation.parameter=\"{key}\"");
+            let step_key = format!("continuation.step={step}");
+            let max_step = format!("continuation.max_step={step}");
+            let (_, d) = diagram(
+                CANTILEVER,
+                &[
+                    &parameter,
+                    "continuation.start=1.0",
+                    "continuation.bounds=[0.2, 1.0]",
+                    &step_key,
+                    &max_step,
+                    "continuation.both_directions=true",
+                    "continuation.switch_depth=0",
+                ],
+            );
+            let down = &d.branches[1];
+            let last = down.points.last().unwrap();
+            assert_eq!(
+                down.stop_reason,
+                cosserat::continuation::BranchEnd::ReachedBound(0.2),
+                "{key}, step {step}"
+            );
+            assert_eq!(last.parameter, 0.2, "{key}, step {step}: on the bound");
+            let (deflection, projection, _) = cosserat::references::cantilever_tip(k_at_bound);
+            let tip = last.tip.position;
+            assert!(
+                (tip[0] - deflection).abs() < 1e-8 && (tip[2] - projection).abs() < 1e-8,
+                "{key}, step {step}: tip ({}, {}) against ({deflection}, {projection})",
+                tip[0],
+                tip[2]
+            );
+        }
+    }
+}

@@ -336,6 +336,38 @@ impl<'a> Run<'a> {
         }
     }
 
+    /// The shorter step after a step of length `ds` from `last` failed
+    /// with `error`, or None when the failure ends the branch. Only a rod
+    /// that cannot be built at a trial value (a stiffness or length that
+    /// left the physical domain, a value the problem refuses) is cut back:
+    /// to the step whose predictor reaches the bound the predictor crossed,
+    /// so that [`Run::land_on_bound`] lands the branch exactly there, or
+    /// else to half the step, down to the minimum step, below which the
+    /// rod's own reason ends the branch. Any other failure is reported.
+    fn cut_back(&self, last: &Point, sign: f64, ds: f64, error: &PointError) -> Option<f64> {
+        if !matches!(error, PointError::Family(_)) {
+            return None;
+        }
+        let n = last.unknowns.len();
+        let rate = sign * last.tangent[n];
+        let predicted = last.parameter + ds * rate;
+        let (lo, hi) = self.opts.bounds;
+        let bound = if predicted < lo && last.parameter > lo {
+            Some(lo)
+        } else if predicted > hi && last.parameter < hi {
+            Some(hi)
+        } else {
+            None
+        };
+        // The predictor on the bound; a corrector that then ends a little
+        // beyond it is pulled back by Newton at the bound.
+        let to_bound = bound
+            .map(|b| (b - last.parameter) / rate)
+            .filter(|h| h.is_finite() && *h > 0.0 && *h < ds);
+        let shorter = to_bound.unwrap_or(0.5 * ds);
+        (shorter >= self.opts.min_step).then_some(shorter)
+    }
+
     /// Follows one branch from `start` in direction `sign`, appending its
     /// points to `diagram.branches[branch]` as they come (so a monitor that
     /// saves the diagram keeps every point).
@@ -404,7 +436,13 @@ impl<'a> Run<'a> {
                     }
                     continue;
                 }
-                Err(e) => return end(specials, BranchEnd::Failed(e.to_string()), false),
+                Err(e) => match self.cut_back(&last, sign, ds, &e) {
+                    Some(shorter) => {
+                        ds = shorter;
+                        continue;
+                    }
+                    None => return end(specials, BranchEnd::Failed(e.to_string()), false),
+                },
             };
             let (x, p, tangent) = self.land_on_bound(&last, x, p, tangent);
             if let Some(reason) = self.not_conservative(p) {
