@@ -19,9 +19,9 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use super::engine::{self, ContinuationProblem, Jacobian, StepFailure};
 use super::{Family, Point, PointError, Run};
 use crate::numerics::dense::DenseLu;
-use crate::numerics::newton::{self, Damping, NewtonError, Options, System};
 use crate::numerics::staircase::{least_squares, Border, Staircase, StaircaseLu};
 
 /// Solves the dense bordered system by LU, or — where it is singular,
@@ -55,7 +55,7 @@ pub(super) const DENSE_UP_TO: usize = 200;
 /// ([`Staircase`]) for multiple shooting and collocation beyond
 /// [`DENSE_UP_TO`] unknowns, so that every step costs O(N) there.
 #[derive(Debug, Clone)]
-pub(super) enum Linearization {
+pub enum Linearization {
     /// The small dense F_x of single shooting or of a coarse mesh.
     Dense(DMatrix<f64>),
     /// The block-banded F_x of K > 1 segments or intervals.
@@ -173,201 +173,116 @@ impl BorderedFactors {
     }
 }
 
-/// F(x, p) = 0 in x at a fixed parameter value p, for
-/// [`crate::numerics::newton`]: the family's residual and F_x, solved by
-/// dense LU (single shooting) or band LU of the staircase.
-struct FixedParameter<'a> {
-    family: &'a Family,
-    p: f64,
-    r: DVector<f64>,
-    fx: Linearization,
+/// The factorizations of the rod's F_x: plain (Newton at a fixed p) and
+/// bordered (the corrector and the tangent).
+#[derive(Debug, Default)]
+pub struct RodFactors {
     dense: DenseLu,
     banded: StaircaseLu,
+    bordered: BorderedFactors,
 }
 
-impl<'a> FixedParameter<'a> {
-    fn new(family: &'a Family, p: f64, n: usize) -> Self {
-        FixedParameter {
-            family,
-            p,
-            r: DVector::zeros(n),
-            fx: Linearization::of(family),
-            dense: DenseLu::default(),
-            banded: StaircaseLu::default(),
-        }
-    }
-}
+impl Jacobian for Linearization {
+    type Factors = RodFactors;
 
-impl System for FixedParameter<'_> {
-    type Error = PointError;
-
-    fn size(&self) -> usize {
-        self.r.len()
-    }
-
-    fn residual(&mut self, x: &[f64], r: &mut [f64]) -> Result<(), PointError> {
-        self.fx.evaluate(self.family, x, self.p, &mut self.r)?;
-        r.copy_from_slice(self.r.as_slice());
-        Ok(())
-    }
-
-    fn linearize(&mut self, _x: &[f64]) -> bool {
-        match &self.fx {
+    fn factor(&self, factors: &mut RodFactors) -> bool {
+        match self {
             Linearization::Dense(fx) => {
-                self.dense.factor(fx);
+                factors.dense.factor(fx);
                 true
             }
-            Linearization::Staircase(a) => self.banded.factor(a, None).is_ok(),
+            Linearization::Staircase(a) => factors.banded.factor(a, None).is_ok(),
         }
     }
 
-    fn solve(&mut self, f: &[f64], delta: &mut [f64]) -> bool {
-        match &self.fx {
-            Linearization::Dense(_) => self.dense.newton_step(f, delta),
+    fn newton_step(&self, factors: &mut RodFactors, f: &[f64], delta: &mut [f64]) -> bool {
+        match self {
+            Linearization::Dense(_) => factors.dense.newton_step(f, delta),
             Linearization::Staircase(_) => {
                 delta.iter_mut().zip(f).for_each(|(d, v)| *d = -v);
-                self.banded.solve(delta)
+                factors.banded.solve(delta)
             }
         }
     }
-}
 
-/// The bordered system of a pseudo-arclength corrector in z = (x, p),
-///
-///   F(x, p) = 0,   ⟨z − z_pred, τ⟩ = 0,
-///
-/// with z_pred = z₀ + Δs τ the predictor along the unit tangent τ at z₀,
-/// so that the second row is Keller's (1977) arclength constraint
-/// ⟨x − x₀, ẋ₀⟩ + (p − p₀)ṗ₀ − Δs = 0. Its Jacobian is the bordered matrix
-/// [F_x F_p; τᵀ], regular at folds where F_x alone is singular, with F_p
-/// taken once at the predictor (a chord in the parameter column), when
-/// the first Newton step linearizes there: an exact F_p then comes with
-/// that evaluation's integration ([`Family::parameter_derivative`]). The
-/// constraint row is linear, so one step satisfies it to round-off; it is
-/// measured against an absolute 1e-13 (its residual scale is 1e-13/τ).
-struct PseudoArclength<'a> {
-    family: &'a Family,
-    pred: &'a [f64],
-    tangent: &'a [f64],
-    /// F_p at the predictor, from the first linearization.
-    fp: Option<DVector<f64>>,
-    /// Why F_p could not be had (the corrector's error).
-    failure: Option<PointError>,
-    tolerance: f64,
-    r: DVector<f64>,
-    /// F_x at the last evaluated point (the corrected one on success).
-    fx: Linearization,
-    bordered: BorderedFactors,
-    rhs: Vec<f64>,
-}
+    fn factor_bordered(&self, factors: &mut RodFactors, border: &Border) {
+        factors
+            .bordered
+            .factor(self, border.column, border.row, border.corner);
+    }
 
-impl<'a> PseudoArclength<'a> {
-    fn new(family: &'a Family, pred: &'a [f64], tangent: &'a [f64], tolerance: f64) -> Self {
-        let n = pred.len() - 1;
-        PseudoArclength {
-            family,
-            pred,
-            tangent,
-            fp: None,
-            failure: None,
-            tolerance,
-            r: DVector::zeros(n),
-            fx: Linearization::of(family),
-            bordered: BorderedFactors::default(),
-            rhs: vec![0.0; n + 1],
-        }
+    fn solve_bordered(
+        &self,
+        factors: &mut RodFactors,
+        border: &Border,
+        rhs: &[f64],
+        z: &mut [f64],
+    ) -> bool {
+        factors
+            .bordered
+            .solve(self, border.column, border.row, border.corner, rhs, z)
     }
 }
 
-impl System for PseudoArclength<'_> {
+/// The rod as the engine sees it: F(x, p) of the family's discretization
+/// (shooting, multiple shooting, fixed-mesh collocation) with its exact
+/// F_x in the shape of [`Linearization`] and F_p from
+/// [`Family::parameter_derivative`].
+impl ContinuationProblem for Family {
     type Error = PointError;
+    type Jacobian = Linearization;
 
     fn size(&self) -> usize {
-        self.pred.len()
+        Family::size(self)
     }
 
-    fn residual(&mut self, z: &[f64], r: &mut [f64]) -> Result<(), PointError> {
-        let n = self.r.len();
-        self.fx.evaluate(self.family, &z[..n], z[n], &mut self.r)?;
-        let arc: f64 = self
-            .tangent
-            .iter()
-            .zip(z.iter().zip(self.pred))
-            .map(|(t, (a, b))| t * (a - b))
-            .sum();
-        r[..n].copy_from_slice(self.r.as_slice());
-        r[n] = arc;
-        Ok(())
+    fn jacobian(&self) -> Linearization {
+        Linearization::of(self)
     }
 
-    fn linearize(&mut self, z: &[f64]) -> bool {
-        let n = self.r.len();
-        if self.fp.is_none() {
-            match self.family.parameter_derivative(&z[..n], z[n]) {
-                Ok(fp) => self.fp = Some(fp),
-                Err(e) => {
-                    self.failure = Some(e);
-                    return false;
-                }
-            }
-        }
-        let Some(fp) = &self.fp else {
-            return false;
-        };
-        let (row, corner) = self.tangent.split_at(n);
-        self.bordered
-            .factor(&self.fx, fp.as_slice(), row, corner[0]);
-        true
+    fn evaluate(
+        &self,
+        x: &[f64],
+        p: f64,
+        r: &mut DVector<f64>,
+        fx: &mut Linearization,
+    ) -> Result<(), PointError> {
+        fx.evaluate(self, x, p, r)
     }
 
-    fn solve(&mut self, f: &[f64], delta: &mut [f64]) -> bool {
-        let n = self.r.len();
-        let Some(fp) = &self.fp else {
-            return false;
-        };
-        self.rhs.iter_mut().zip(f).for_each(|(r, v)| *r = -v);
-        let (row, corner) = self.tangent.split_at(n);
-        self.bordered
-            .solve(&self.fx, fp.as_slice(), row, corner[0], &self.rhs, delta)
-    }
-
-    fn residual_scales(&self) -> Vec<f64> {
-        let mut scales = vec![1.0; self.size()];
-        scales[self.r.len()] = ARC_TOLERANCE / self.tolerance;
-        scales
+    fn parameter_derivative(&self, x: &[f64], p: f64) -> Result<DVector<f64>, PointError> {
+        Family::parameter_derivative(self, x, p)
     }
 }
 
-/// The absolute tolerance on the arclength constraint of the corrector.
-const ARC_TOLERANCE: f64 = 1e-13;
+impl From<StepFailure<PointError>> for PointError {
+    fn from(failure: StepFailure<PointError>) -> Self {
+        match failure {
+            StepFailure::Problem(e) => e,
+            StepFailure::NoConvergence(p) => PointError::NoConvergence(p),
+            StepFailure::SingularTangent(p) => PointError::SingularTangent(p),
+        }
+    }
+}
 
 /// A converged corrector: (x, p), its iterations and F_x there.
-pub(super) type Corrected = (Vec<f64>, usize, Linearization);
+pub(super) type Corrected = engine::Corrected<Linearization>;
 
 /// A corrected step: unknowns, parameter, tangent, corrector iterations.
-pub(super) type Stepped = (Vec<f64>, f64, Vec<f64>, usize);
+pub(super) type Stepped = engine::Stepped;
 
 impl Run<'_> {
     /// Newton in x at fixed p (the start point of a branch, or a step
-    /// pulled back onto a bound): plain Newton steps ([`Damping::Full`]),
-    /// at most 29 of them (30 tests, as the loop this replaced), from a
+    /// pulled back onto a bound): the engine's
+    /// [`engine::newton_at_fixed_p`], at most 29 plain Newton steps from a
     /// guess already close.
-    pub(super) fn newton_at_fixed_p(
-        &self,
-        mut x: Vec<f64>,
-        p: f64,
-    ) -> Result<Vec<f64>, PointError> {
-        let mut system = FixedParameter::new(self.family, p, x.len());
-        let opts = Options {
-            tolerance: self.opts.tolerance,
-            max_iterations: 29,
-            damping: Damping::Full,
-        };
-        match newton::solve(&mut system, &mut x, &opts) {
-            Ok(_) => Ok(x),
-            Err(NewtonError::BadStart(e) | NewtonError::Evaluation { error: e, .. }) => Err(e),
-            Err(_) => Err(PointError::NoConvergence(p)),
-        }
+    pub(super) fn newton_at_fixed_p(&self, x: Vec<f64>, p: f64) -> Result<Vec<f64>, PointError> {
+        Ok(engine::newton_at_fixed_p(
+            self.family,
+            x,
+            p,
+            self.opts.tolerance,
+        )?)
     }
 
     /// The unit tangent at (x, p): the null vector of [F_x F_p], oriented
@@ -378,65 +293,18 @@ impl Run<'_> {
         p: f64,
         previous: &[f64],
     ) -> Result<Vec<f64>, PointError> {
-        let mut fx = Linearization::of(self.family);
-        fx.evaluate(self.family, x, p, &mut DVector::zeros(x.len()))?;
-        self.tangent_from(&fx, x, p, previous)
+        Ok(engine::tangent(self.family, x, p, previous)?)
     }
 
-    /// The tangent with F_x already known at (x, p): the solution of
-    /// [F_x F_p; previousᵀ] t = (0, 1), normalized.
-    pub(super) fn tangent_from(
-        &self,
-        fx: &Linearization,
-        x: &[f64],
-        p: f64,
-        previous: &[f64],
-    ) -> Result<Vec<f64>, PointError> {
-        let n = x.len();
-        let fp = self.family.parameter_derivative(x, p)?;
-        let (row, corner) = previous.split_at(n);
-        let mut rhs = vec![0.0; n + 1];
-        rhs[n] = 1.0;
-        let mut factors = BorderedFactors::default();
-        factors.factor(fx, fp.as_slice(), row, corner[0]);
-        let mut t = DVector::zeros(n + 1);
-        let solved = factors.solve(fx, fp.as_slice(), row, corner[0], &rhs, t.as_mut_slice());
-        if !solved || !t.iter().all(|v| v.is_finite()) || t.norm() == 0.0 {
-            return Err(PointError::SingularTangent(p));
-        }
-        let t = t.normalize();
-        Ok(t.as_slice().to_vec())
-    }
-
-    /// Newton on the bordered system F(x, p) = 0, τᵀ(z − z_pred) = 0 from
-    /// the predictor z_pred ([`PseudoArclength`]): plain Newton steps, at
-    /// most 9 (10 tests). No damping on purpose: a corrector that does not
-    /// converge fast means the step was too long, and the caller halves
-    /// the arclength step instead (`walk`), which keeps the points evenly
-    /// spaced along the branch.
+    /// Newton on the bordered pseudo-arclength system from the predictor
+    /// (the engine's [`engine::correct`]); None where it does not converge
+    /// (the caller halves the step).
     pub(super) fn correct(
         &self,
         pred: &[f64],
         tangent: &[f64],
     ) -> Result<Option<Corrected>, PointError> {
-        let mut system = PseudoArclength::new(self.family, pred, tangent, self.opts.tolerance);
-        let opts = Options {
-            tolerance: self.opts.tolerance,
-            max_iterations: 9,
-            damping: Damping::Full,
-        };
-        let mut z = pred.to_vec();
-        let outcome = newton::solve(&mut system, &mut z, &opts);
-        if let Some(e) = system.failure {
-            return Err(e);
-        }
-        Ok(match outcome {
-            Ok(report) => Some((z, report.iterations, system.fx)),
-            // Not evaluable at the predictor: the error F_p there gave
-            // before Newton started, as when it was taken first.
-            Err(NewtonError::BadStart(e)) => return Err(e),
-            Err(_) => None,
-        })
+        engine::correct(self.family, pred, tangent, self.opts.tolerance)
     }
 
     /// Corrector from `from` along its tangent (times `sign`) by `ds`.
@@ -447,9 +315,6 @@ impl Run<'_> {
         ds: f64,
     ) -> Result<Option<Stepped>, PointError> {
         let t: Vec<f64> = from.tangent.iter().map(|v| v * sign).collect();
-        let mut z = from.unknowns.clone();
-        z.push(from.parameter);
-        let pred: Vec<f64> = z.iter().zip(&t).map(|(a, b)| a + ds * b).collect();
         // A branch of symmetric copies keeps a null vector of F_x: step in
         // the slice through the last point (`slice.rs`).
         let kernel = if self.sliced {
@@ -458,6 +323,13 @@ impl Run<'_> {
             None
         };
         if let Some(kernel) = kernel {
+            let pred: Vec<f64> = from
+                .unknowns
+                .iter()
+                .chain([&from.parameter])
+                .zip(&t)
+                .map(|(a, b)| a + ds * b)
+                .collect();
             let Some((z, iterations)) = self.correct_sliced(&from.unknowns, &pred, &t, &kernel)?
             else {
                 return Ok(None);
@@ -467,13 +339,19 @@ impl Run<'_> {
             let stored: Vec<f64> = tangent.iter().map(|v| v * sign).collect();
             return Ok(Some((z[..n].to_vec(), z[n], stored, iterations)));
         }
-        let Some((z, iterations, fx)) = self.correct(&pred, &t)? else {
+        let Some((x, p, tangent, iterations)) = engine::step(
+            self.family,
+            &from.unknowns,
+            from.parameter,
+            &t,
+            ds,
+            self.opts.tolerance,
+        )?
+        else {
             return Ok(None);
         };
-        let n = z.len() - 1;
-        let tangent = self.tangent_from(&fx, &z[..n], z[n], &t)?;
         // Keep the stored tangent oriented along the travel direction.
         let stored: Vec<f64> = tangent.iter().map(|v| v * sign).collect();
-        Ok(Some((z[..n].to_vec(), z[n], stored, iterations)))
+        Ok(Some((x, p, stored, iterations)))
     }
 }

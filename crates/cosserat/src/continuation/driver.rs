@@ -2,10 +2,13 @@
 //! steps with step-size control), stops them for a reason, hands every
 //! point to the monitor, and switches onto new branches at branch points.
 //!
-//! The step-size control lives here, not in Newton: a corrector that fails
-//! halves the arclength step Δs (down to the minimum), one that converges
-//! in at most 3 iterations lengthens it by 1.5 (up to the maximum).
+//! The step-size control is the engine's ([`super::engine::StepControl`]),
+//! not Newton's: a corrector that fails halves the arclength step Δs (down
+//! to the minimum), one that converges in at most 3 iterations lengthens
+//! it by 1.5 (up to the maximum). The steps themselves are the engine's
+//! ([`super::engine::step`]) on the rod's [`Family`].
 
+use super::engine::StepControl;
 use super::{
     tip_angle, Branch, BranchEnd, ContinuationError, ContinuationOptions, Diagram, Family, Point,
     PointError, Progress, RunState, Spectrum, Tracker,
@@ -336,6 +339,14 @@ impl<'a> Run<'a> {
         }
     }
 
+    /// The engine's step control with the run's limits.
+    fn control(&self) -> StepControl {
+        StepControl {
+            min_step: self.opts.min_step,
+            max_step: self.opts.max_step,
+        }
+    }
+
     /// The shorter step after a step of length `ds` from `last` failed
     /// with `error`, or None when the failure ends the branch. Only a rod
     /// that cannot be built at a trial value (a stiffness or length that
@@ -429,11 +440,11 @@ impl<'a> Run<'a> {
             let (x, p, tangent, iterations) = match self.step(&last, sign, ds) {
                 Ok(Some(stepped)) => stepped,
                 Ok(None) => {
-                    ds *= 0.5;
-                    if ds < self.opts.min_step {
+                    let Some(shorter) = self.control().after_failure(ds) else {
                         let reason = BranchEnd::StepTooSmall(self.opts.min_step);
                         return end(specials, reason, false);
-                    }
+                    };
+                    ds = shorter;
                     continue;
                 }
                 Err(e) => match self.cut_back(&last, sign, ds, &e) {
@@ -461,9 +472,7 @@ impl<'a> Run<'a> {
             diagram.warnings.extend(missed);
             diagram.branches[branch].points.push(next);
             self.total_points += 1;
-            if iterations <= 3 {
-                ds = (ds * 1.5).min(self.opts.max_step);
-            }
+            ds = self.control().after_success(ds, iterations);
             diagram.branches[branch].next_step = ds;
             let progress = Progress {
                 points: self.total_points,

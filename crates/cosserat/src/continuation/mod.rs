@@ -28,6 +28,7 @@ mod codim2;
 mod corrector;
 mod diagram;
 mod driver;
+pub mod engine;
 mod events;
 mod family;
 mod fold;
@@ -43,6 +44,7 @@ mod status;
 mod tracking;
 
 pub use codim2::{follow_singular, CurveOptions, CurvePoint, Lens2, ParameterOn, SingularCurve};
+pub use corrector::{Linearization, RodFactors};
 pub use diagram::{
     Branch, ContinuationError, Diagram, Location, Point, Progress, SpecialKind, SpecialPoint,
 };
