@@ -53,7 +53,7 @@ pub(super) const DENSE_UP_TO: usize = 200;
 /// F_x at a point in the shape of the family's discretization: dense for
 /// single shooting and small systems, almost block diagonal
 /// ([`Staircase`]) for multiple shooting and collocation beyond
-/// [`DENSE_UP_TO`] unknowns, so that every step costs O(N) there.
+/// 200 unknowns (`DENSE_UP_TO`), so that every step costs O(N) there.
 #[derive(Debug, Clone)]
 pub enum Linearization {
     /// The small dense F_x of single shooting or of a coarse mesh.
