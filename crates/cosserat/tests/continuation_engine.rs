@@ -146,6 +146,15 @@ impl ContinuationProblem for Bratu {
         }
         Some(count)
     }
+
+    /// With an odd n, the middle node reaching u = 1: u_{(n+1)/2} − 1.
+    fn test_functions(&self, u: &[f64], _p: f64) -> Vec<f64> {
+        if self.n % 2 == 1 {
+            vec![u[self.n / 2] - 1.0]
+        } else {
+            vec![]
+        }
+    }
 }
 
 /// u_{n+1} and its derivatives in a = u_1 and λ by the recurrence
@@ -314,6 +323,59 @@ fn the_monitor_sees_the_lower_branch_stable_and_the_upper_unstable() {
     let mut fu = problem.jacobian();
     problem.evaluate(&last.u, 1.0, &mut r, &mut fu).unwrap();
     assert!(r.amax() < 1e-12, "residual {:e}", r.amax());
+}
+
+/// λ where the symmetric discrete solution has u = 1 at its middle node
+/// m = (n + 1)/2: the recurrence marched from the middle (u_m = 1,
+/// u_{m−1} = u_{m+1} = 1 − h²λe/2) to u_0(λ), bisected to u_0 = 0 below
+/// the fold (on the lower branch u_m grows from 0 to ≈ 1.18 at the fold;
+/// the continuous problem has u(½) = 1 at λ ≈ 3.488, the fold at 3.514).
+fn middle_at_one(n: usize) -> f64 {
+    let h2 = (1.0 / (n as f64 + 1.0)).powi(2);
+    let m = n.div_ceil(2);
+    let u0 = |lambda: f64| {
+        let (mut right, mut here) = (1.0_f64, 1.0 - 0.5 * h2 * lambda * 1f64.exp());
+        for _ in 1..m {
+            let left = 2.0 * here - right - h2 * lambda * here.exp();
+            (right, here) = (here, left);
+        }
+        here
+    };
+    let (mut lo, mut hi) = (0.1, 3.5);
+    assert!(u0(lo) > 0.0 && u0(hi) < 0.0, "bracket");
+    while !cosserat::numerics::scalar::adjacent(lo, hi) {
+        let mid = 0.5 * (lo + hi);
+        if u0(mid) > 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// The problem's own test function is located like a fold: the middle
+/// node of n = 31 reaching 1, against the recurrence marched from the
+/// middle.
+#[test]
+fn a_test_function_of_the_problem_is_located() {
+    let n = 31;
+    let problem = Bratu { n };
+    let t = trace(&problem, vec![0.0; n], 0.1, &options((1.0, 4.0))).unwrap();
+    assert!(t.unlocated.is_empty(), "{:?}", t.unlocated);
+    assert_eq!(t.events.len(), 1, "u_mid = 1 once, below the fold");
+    let event = &t.events[0];
+    let reference = middle_at_one(n);
+    eprintln!(
+        "event at λ = {:.15}, recurrence {reference:.15}",
+        event.point.p
+    );
+    assert!(
+        (event.point.p - reference).abs() <= 1e-10 * reference,
+        "event at λ = {}, recurrence {reference}",
+        event.point.p
+    );
+    assert!((event.point.u[n / 2] - 1.0).abs() <= 1e-10);
 }
 
 /// The engine is the boundary: its sources import nothing of rods.

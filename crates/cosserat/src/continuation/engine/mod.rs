@@ -8,8 +8,8 @@
 //! stability monitor (the Morse index at a point). The algorithm is one
 //! predictor–corrector step (`corrector`: Newton on the bordered system
 //! [F_u F_p; τᵀ], the tangent as the null vector of [F_u F_p], Newton at a
-//! fixed p) and the branch loop with step control, bounds and folds
-//! (`trace`). The options are [`TraceOptions`].
+//! fixed p) and the branch loop with step control, bounds, folds and the
+//! problem's own test functions (`trace`). The options are [`TraceOptions`].
 //!
 //! The rod's [`super::Family`] is one implementation
 //! (`continuation/corrector.rs`); its driver adds what only rods have —
@@ -21,7 +21,9 @@ mod corrector;
 mod trace;
 
 pub use corrector::{correct, newton_at_fixed_p, step, tangent, tangent_from, Corrected, Stepped};
-pub use trace::{trace, StepControl, Trace, TraceEnd, TraceOptions, TracePoint, TracedFold};
+pub use trace::{
+    trace, StepControl, Trace, TraceEnd, TraceOptions, TracePoint, TracedEvent, TracedFold,
+};
 
 use nalgebra::DVector;
 
@@ -90,6 +92,13 @@ pub trait ContinuationProblem {
     /// has none or cannot decide it there.
     fn morse_index(&self, _u: &[f64], _p: f64) -> Option<usize> {
         None
+    }
+
+    /// Optional test functions of events: each one whose sign changes
+    /// between two points of a branch marks an event there, located where
+    /// it vanishes (by [`trace`]). None by default.
+    fn test_functions(&self, _u: &[f64], _p: f64) -> Vec<f64> {
+        vec![]
     }
 }
 

@@ -10,7 +10,9 @@
 //! O(δh²) only: the fold's parameter comes out to the corrector's
 //! tolerance. (The rod's driver refines its folds on Govaerts' augmented
 //! system instead, `continuation/fold.rs`, which needs second derivatives
-//! this trait does not ask for.)
+//! this trait does not ask for.) An event of the problem's own
+//! ([`ContinuationProblem::test_functions`]) is located the same way, on
+//! the test function that changed sign instead of τ_p.
 
 use super::corrector::{newton_at_fixed_p, step, tangent};
 use super::{ContinuationProblem, StepFailure};
@@ -85,6 +87,18 @@ pub struct TracedFold {
     pub after: usize,
 }
 
+/// A located event of one of the problem's test functions.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TracedEvent {
+    /// Which test function vanished (its index).
+    pub test: usize,
+    /// The point where it vanishes (to the tolerance, or the bracket's
+    /// round-off).
+    pub point: TracePoint,
+    /// The index of the branch point before it.
+    pub after: usize,
+}
+
 /// Why a traced branch ended.
 #[derive(Debug, Clone, PartialEq)]
 pub enum TraceEnd {
@@ -105,6 +119,13 @@ pub struct Trace {
     pub points: Vec<TracePoint>,
     /// The folds located between them.
     pub folds: Vec<TracedFold>,
+    /// The test functions' events located between them (an event that
+    /// could not be located is left out of `events` and named in
+    /// `unlocated`: the index of its test function and of the point
+    /// before it).
+    pub events: Vec<TracedEvent>,
+    /// Events detected by a sign change but not located.
+    pub unlocated: Vec<(usize, usize)>,
     /// Why the branch ended.
     pub end: TraceEnd,
 }
@@ -128,6 +149,8 @@ where
     let mut trace = Trace {
         points: vec![point(problem, u, p0, t)],
         folds: vec![],
+        events: vec![],
+        unlocated: vec![],
         end: TraceEnd::MaxPoints,
     };
     let mut ds = opts.step;
@@ -160,12 +183,30 @@ where
             return Ok(trace);
         }
         let n = u.len();
+        let after = trace.points.len() - 1;
         if last.tangent[n] * t[n] < 0.0 {
-            if let Some(fold) = locate_fold(problem, &last, ds, t[n], opts.tolerance) {
-                trace.folds.push(TracedFold {
-                    point: fold,
-                    after: trace.points.len() - 1,
-                });
+            let fold = |_: &[f64], _: f64, t: &[f64]| t[n];
+            let ends = (last.tangent[n], t[n]);
+            if let Some(point) = locate(problem, &last, ds, ends, opts.tolerance, fold) {
+                trace.folds.push(TracedFold { point, after });
+            }
+        }
+        let before = problem.test_functions(&last.u, last.p);
+        let now = problem.test_functions(&u, p);
+        for (test, (&a, &b)) in before.iter().zip(&now).enumerate() {
+            if a * b > 0.0 || a == 0.0 {
+                continue;
+            }
+            let value = |u: &[f64], p: f64, _: &[f64]| {
+                problem
+                    .test_functions(u, p)
+                    .get(test)
+                    .copied()
+                    .unwrap_or(f64::NAN)
+            };
+            match locate(problem, &last, ds, (a, b), opts.tolerance, value) {
+                Some(point) => trace.events.push(TracedEvent { test, point, after }),
+                None => trace.unlocated.push((test, after)),
             }
         }
         trace.points.push(point(problem, u, p, t));
@@ -217,35 +258,39 @@ fn land<P: ContinuationProblem>(
     Ok(point(problem, ub, bound, tb))
 }
 
-/// Trials of the fold location at most.
-const FOLD_TRIALS: usize = 60;
+/// Trials of an event's location at most.
+const TRIALS: usize = 60;
 
-/// The fold between `last` and its step of length `ds` (whose tangent's
-/// parameter component is `tp_end`): the point of the step of length h
-/// with τ_p(h) = 0, by the Illinois method on h ∈ (0, ds), converged when
-/// |τ_p| ≤ the tolerance or the bracket has shrunk to round-off. None when
-/// a trial step fails (the fold is then reported by the sign change only).
-fn locate_fold<P: ContinuationProblem>(
+/// The zero of a test function g between `last` and its step of length
+/// `ds` (g at the two ends in `ends`, of opposite signs): the point of the
+/// step of length h with g(h) = 0, by the Illinois method on h ∈ (0, ds),
+/// converged when |g| ≤ the tolerance or the bracket has shrunk to
+/// round-off (the point of least |g| is kept). None when a trial step
+/// fails or g is not finite there.
+fn locate<P: ContinuationProblem>(
     problem: &P,
     last: &TracePoint,
     ds: f64,
-    tp_end: f64,
+    ends: (f64, f64),
     tolerance: f64,
+    g: impl Fn(&[f64], f64, &[f64]) -> f64,
 ) -> Option<TracePoint> {
-    let n = last.u.len();
-    let mut bracket = Illinois::new(0.0, ds, last.tangent[n], tp_end)?;
+    let mut bracket = Illinois::new(0.0, ds, ends.0, ends.1)?;
     let mut best: Option<(f64, TracePoint)> = None;
-    for _ in 0..FOLD_TRIALS {
+    for _ in 0..TRIALS {
         let h = bracket.next_point();
         let (u, p, t, _) = step(problem, &last.u, last.p, &last.tangent, h, tolerance).ok()??;
-        let tp = t[n];
-        if best.as_ref().is_none_or(|(b, _)| tp.abs() < *b) {
-            best = Some((tp.abs(), point(problem, u, p, t)));
+        let value = g(&u, p, &t);
+        if !value.is_finite() {
+            return None;
         }
-        if tp.abs() <= tolerance {
+        if best.as_ref().is_none_or(|(b, _)| value.abs() < *b) {
+            best = Some((value.abs(), point(problem, u, p, t)));
+        }
+        if value.abs() <= tolerance {
             break;
         }
-        bracket.update(h, tp);
+        bracket.update(h, value);
         if bracket.width() <= 4.0 * f64::EPSILON * ds {
             break;
         }
