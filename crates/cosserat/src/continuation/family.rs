@@ -411,10 +411,25 @@ impl Family {
     /// unknowns x are the shooting unknowns divided by these, so that the
     /// arclength of continuation is not dominated by node positions of long
     /// rods.
+    ///
+    /// On the collocation mesh the node states are further divided by
+    /// √K (K intervals), so that their part of the arclength is the
+    /// root-mean-square of the node states — a discrete L² norm of the
+    /// solution, as AUTO's integral norm — and a step moves the parameter
+    /// as far on 32 intervals as on 8 or on shooting's few unknowns (with
+    /// the Euclidean norm of all node states, 33 nodes moved p three times
+    /// less per step than shooting: docs/performance.md). Multiple
+    /// shooting keeps the plain scales: the arm's loading path on 32
+    /// segments runs its correctors at the noise floor near λ = 0.976
+    /// and keeps its points as they were.
     fn weights(&self) -> Vec<f64> {
         let eq = equations(&self.base, self.level);
         let mut w = vec![1.0; eq.unknowns()];
-        let scales = eq.state_scales();
+        let per_node = match self.stages {
+            Some(_) => (self.segments as f64).sqrt(),
+            None => 1.0,
+        };
+        let scales: Vec<f64> = eq.state_scales().iter().map(|s| s * per_node).collect();
         for _ in 1..self.segments {
             w.extend_from_slice(&scales);
         }
