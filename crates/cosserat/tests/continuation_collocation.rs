@@ -115,3 +115,45 @@ fn the_structured_jacobian_is_the_derivative_of_the_residual() {
         dense.amax()
     );
 }
+
+/// The points of the loading branch up to λ = 0.4 (below the first
+/// branch point), with `extra` overrides.
+fn points_to(extra: &[String]) -> usize {
+    let mut set = vec![
+        "continuation.switch_depth=0".to_string(),
+        "continuation.bounds=[0.0, 0.4]".to_string(),
+    ];
+    set.extend_from_slice(extra);
+    let p = Problem::from_str_with(LTB, &set).unwrap();
+    let (family, opts) = p.continuation.clone().unwrap();
+    let d = continuation(&family, &opts, &mut |_, _| true).unwrap();
+    d.branches[0].points.len()
+}
+
+/// The collocation mesh's node states enter the arclength as their
+/// root-mean-square (a discrete L² norm), so a step moves the load as far
+/// on 32 intervals as on 8 and about as far as shooting's: the same steps
+/// take the same number of points (measured: 8 and 8 points on 8 and 32
+/// intervals, shooting 7; with the Euclidean norm of all node states 10
+/// and 17).
+#[test]
+fn collocation_steps_do_not_shrink_with_the_mesh() {
+    let shooting = points_to(&[]);
+    let coarse = points_to(&[
+        "solver.method=\"collocation\"".into(),
+        "continuation.intervals=8".into(),
+    ]);
+    let fine = points_to(&[
+        "solver.method=\"collocation\"".into(),
+        "continuation.intervals=32".into(),
+    ]);
+    eprintln!("points to λ = 0.4: shooting {shooting}, collocation 8: {coarse}, 32: {fine}");
+    assert!(
+        fine <= coarse + 1,
+        "32 intervals {fine} points, 8 intervals {coarse}"
+    );
+    assert!(
+        fine <= shooting + 2,
+        "collocation {fine} points, shooting {shooting}"
+    );
+}
