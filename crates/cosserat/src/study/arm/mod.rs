@@ -30,6 +30,7 @@ pub mod fig5;
 mod resolve;
 mod sampling;
 pub mod scene;
+pub mod taper;
 
 pub use control_path::{
     control_path, control_path_until, loading_path_in, loading_path_until, shape_holding_path,
