@@ -326,10 +326,9 @@ pub fn write_tapered_arm(
         g.floats("section_knots", &[s.len()], &s)?;
         let p = &o.section_at_points;
         g.floats("section_profile", &[p.len()], p)?;
+        g.float("min_section", o.min_section)?;
         g.attrs.set_count("elements", o.elements as u64);
-        g.attrs.set_float("min_section", o.min_section);
         g.attrs.set_text("critical_block", o.block.name());
-        g.attrs.set_count("rounds", o.rounds as u64);
         g.attrs.set_count("evaluations", o.evaluations as u64);
         let search = if o.section_converged {
             "converged"
@@ -342,7 +341,7 @@ pub fn write_tapered_arm(
             Some(v) => (v.name(), v.value()),
         };
         g.attrs.set_text("loading_path", verdict);
-        g.attrs.set_float("loading_path_value", value);
+        g.float("loading_path_value", value)?;
         let g = root.create_group("prismatic");
         g.float("reach", o.prismatic.reach)?;
         g.float("load_factor", o.prismatic.gamma)?;

@@ -26,6 +26,7 @@ pub mod xdmf;
 
 #[cfg(feature = "hdf5")]
 pub use arm_output::{read_search, write_arm, write_arm_study, ArmStudy, SavedSearch};
+#[cfg(feature = "hdf5")]
 pub use arm_output::{write_tapered_arm, TaperedStudy};
 #[cfg(feature = "hdf5")]
 pub use curve::write_curve;

@@ -14,8 +14,8 @@
 //!
 //! For a loaded shape held fixed the moments, and so K1 of the fixed-shape
 //! pencil K0 + λK1 ([`crate::stability::critical_load`]), do not depend
-//! on the section, while every coefficient of K0 (A = H, B = H[κ]×,
-//! C = [κ]×ᵀH[κ]× at zero load) is linear in H ∝ A². So the critical load
+//! on the section, while every coefficient of K0 (A = H, `B = H[κ]×`,
+//! `C = [κ]×ᵀH[κ]×` at zero load) is linear in H ∝ A². So the critical load
 //! of a section is a generalized Rayleigh quotient
 //! λ(A) = Σ_q w_q A_q² e_q / D, e_q the K0 density of the prismatic rod at
 //! the quadrature point s_q for the critical mode and D = −vᵀK1v > 0, and
