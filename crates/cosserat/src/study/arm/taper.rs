@@ -368,19 +368,27 @@ pub fn strongest_section(
     start: Section,
     opts: &SectionSearch,
 ) -> Result<SectionOptimum, TaperError> {
+    strongest_section_until(pencil, taper, start, opts, &|| false)
+}
+
+/// [`strongest_section`], stopping at the next step once `stop()` turns
+/// true (an interrupt): the section so far, not converged.
+pub fn strongest_section_until(
+    pencil: &SectionPencil,
+    taper: &Taper,
+    start: Section,
+    opts: &SectionSearch,
+    stop: &dyn Fn() -> bool,
+) -> Result<SectionOptimum, TaperError> {
     let mut section = start;
     let mut current = pencil.critical(&section)?;
     let mut moving = 0.2;
     let mut converged = false;
     let mut iterations = 0;
-    while iterations < opts.iterations {
+    while iterations < opts.iterations && !stop() {
         iterations += 1;
         let trial = criterion_step(&section, &current.gradient, taper.min_section, moving);
-        let next = match pencil.critical(&trial) {
-            Ok(n) => n,
-            Err(TaperError::Unloaded) => return Err(TaperError::Unloaded),
-            Err(e) => return Err(e),
-        };
+        let next = pencil.critical(&trial)?;
         if next.load_factor >= current.load_factor {
             let change = trial
                 .values

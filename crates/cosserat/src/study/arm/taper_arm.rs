@@ -23,7 +23,9 @@ use argmin::core::{CostFunction, Error as ArgminError, Executor, State};
 use argmin::solver::neldermead::NelderMead;
 
 use super::design::intrinsic_shape;
-use super::taper::{strongest_section, Section, SectionPencil, SectionSearch, Taper, TaperError};
+use super::taper::{
+    strongest_section_until, Section, SectionPencil, SectionSearch, Taper, TaperError,
+};
 use super::{continue_to_design, derivative, polynomial};
 use super::{ArmDesign, ArmProblem, ArmScene, SearchOptions, SearchProgress};
 use crate::continuation::{ContinuationError, Diagram, Parameter};
@@ -205,7 +207,7 @@ impl TaperedArm {
         let mut rounds = 0;
         while rounds < MAX_ROUNDS && !stop() {
             rounds += 1;
-            let (found, ok, used) = self.strongest_for(&rest, section.clone(), &mesh)?;
+            let (found, ok, used) = self.strongest_for(&rest, section.clone(), &mesh, stop)?;
             section = found;
             converged &= ok;
             evaluations += used;
@@ -222,7 +224,7 @@ impl TaperedArm {
         if stop() {
             return Ok(None);
         }
-        let (found, ok, used) = self.strongest_for(&rest, section, &mesh)?;
+        let (found, ok, used) = self.strongest_for(&rest, section, &mesh, stop)?;
         evaluations += used;
         self.finish(
             &rest,
@@ -239,11 +241,13 @@ impl TaperedArm {
         rest: &[f64],
         start: Section,
         mesh: &StabilityOptions,
+        stop: &dyn Fn() -> bool,
     ) -> Result<(Section, bool, usize), TaperError> {
         let Some((_, pencil, _)) = self.evaluate(rest, &start, mesh) else {
             return Err(TaperError::Unloaded);
         };
-        let o = strongest_section(&pencil, &self.taper, start, &SectionSearch::default())?;
+        let o =
+            strongest_section_until(&pencil, &self.taper, start, &SectionSearch::default(), stop)?;
         Ok((o.section, o.converged, o.iterations + 1))
     }
 
