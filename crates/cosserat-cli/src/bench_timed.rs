@@ -238,6 +238,15 @@ fn bench_continue(path: &Path, problem: &Problem, repeat: usize) -> Measured {
 
 fn bench_optimize(path: &Path, problem: &Problem, repeat: usize) -> Measured {
     use crate::optimize_command::{after_search, search_only};
+    if problem.arm_taper.is_some() {
+        return Err(fail(
+            BAD_INPUT,
+            format!(
+                "{}: arm.taper: the bench times the prismatic search only",
+                path.display()
+            ),
+        ));
+    }
     let (Some((arm, search, straight)), Some((scene, samples))) =
         (&problem.arm, &problem.arm_scene)
     else {

@@ -55,6 +55,8 @@ pub mod stored_start;
 pub mod sweep_chart;
 pub mod sweep_command;
 pub mod sweep_figure;
+pub mod taper_chart;
+pub mod taper_command;
 pub mod validate;
 
 use std::process::ExitCode;

@@ -77,6 +77,9 @@ pub fn run_optimize(run: &OptimizeRun) -> ExitCode {
             format!("{}: arm: the problem has no [arm] table", path.display()),
         );
     };
+    if let Some(taper) = problem.arm_taper {
+        return crate::taper_command::run_tapered(run, &problem, arm, search, taper);
+    }
     let progress = match start_from(run, &problem, arm, scene) {
         Ok(p) => p,
         Err(code) => return code,

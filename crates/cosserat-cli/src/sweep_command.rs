@@ -79,6 +79,12 @@ fn prepare(args: &SweepArgs) -> Result<Option<Setup>, ExitCode> {
         None => Shard::ALL,
     };
     check_points(&problem.text, &sweep, shard).map_err(|e| at(&e))?;
+    if problem.arm_taper.is_some() {
+        return Err(fail(
+            BAD_INPUT,
+            "arm.taper: a tapered arm runs with `cosserat optimize` only, not in a sweep",
+        ));
+    }
     let job: Box<dyn Job> = match &problem.arm {
         Some(_) => Box::new(ArmJob {
             families: sweep.families,

@@ -51,6 +51,12 @@ impl Interruption {
 fn arm_of(
     problem: &Problem,
 ) -> Result<(&ArmProblem, &SearchOptions, bool, &ArmScene, usize), Failure> {
+    if problem.arm_taper.is_some() {
+        return Err(Failure::problem(
+            "arm.taper",
+            "a tapered arm runs with `cosserat optimize` only (not yet in Python)",
+        ));
+    }
     match (&problem.arm, &problem.arm_scene) {
         (Some((arm, search, straight)), Some((scene, samples))) => {
             Ok((arm, search, *straight, scene, *samples))

@@ -344,6 +344,39 @@ pub fn clamped_elastica_load(shortening: f64) -> f64 {
     16.0 * ellip_f(FRAC_PI_2, k).powi(2)
 }
 
+/// Keller's strongest column (Keller 1960, "The shape of the strongest
+/// column", Arch. Rational Mech. Anal. 5, 275–285; Tadjbakhsh & Keller
+/// 1962): the clamped–free column of unit length and unit volume, bending
+/// stiffness B = A² (similar sections), under a tip thrust. Returns the
+/// optimal area A(s) (clamp at s = 0) and, as `KELLER_GAIN`, its critical
+/// load over the uniform column's π²/4.
+///
+/// Derivation. The clamped–free column is half of the pinned–pinned one of
+/// length 2 (the clamp at its middle). For the pinned column of length ℓ,
+/// deflection w, the load is the Rayleigh quotient P = ∫A²w''² / ∫w'²;
+/// stationarity under ∫A = V gives 2A w''² = const·∫w'², and with the
+/// moment A²w'' = −Pw this is A ∝ w^{2/3}. The parametric solution
+/// x = (ℓ/π)(θ − ½ sin 2θ), w = sin³θ, A = k sin²θ, θ ∈ [0, π], satisfies
+/// it: dx/dθ = (2ℓ/π) sin²θ, w'' = −(3π²/4ℓ²)/sin θ, so
+/// A²w'' = −(3π²k²/4ℓ²) w, P = 3π²k²/(4ℓ²); the volume ∫A dx =
+/// (2kℓ/π)∫sin⁴θ dθ = 3kℓ/4 = V gives k = 4V/(3ℓ) and P = (4/3)π²(V/ℓ)²/ℓ²,
+/// 4/3 of the uniform column's π²(V/ℓ)²/ℓ². Half of it (ℓ = 2, V = 2,
+/// θ ∈ [0, π/2] from the free end) is the clamped–free column: with
+/// u = 1 − s the distance from the free end, u = (2/π)(θ − ½ sin 2θ) and
+/// A = (4/3) sin²θ, vanishing at the free end like u^{2/3}. θ(u) by
+/// bisection (u grows with θ).
+pub fn keller_section(s: f64) -> f64 {
+    let u = (1.0 - s).clamp(0.0, 1.0);
+    let distance = |t: f64| (2.0 / PI) * (t - 0.5 * (2.0 * t).sin());
+    let (lo, hi) = bisect(0.0, FRAC_PI_2, 200, |t| distance(t) < u, |_, _| false);
+    let theta = 0.5 * (lo + hi);
+    4.0 / 3.0 * theta.sin().powi(2)
+}
+
+/// The strongest column's gain over the uniform column of the same volume
+/// and length ([`keller_section`]).
+pub const KELLER_GAIN: f64 = 4.0 / 3.0;
+
 /// Evaluates the formula `name` with the point's parameters.
 pub fn evaluate(name: &str, params: &BTreeMap<String, f64>) -> Result<f64, String> {
     let k = || param(params, "k", name);

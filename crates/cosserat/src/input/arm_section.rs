@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 use super::mesh::MeshKeys;
 use super::problem::{invalid, ProblemError};
 use crate::model::Rod;
+use crate::study::arm::taper::Taper;
 use crate::study::arm::{ArmProblem, ArmScene, ArmWeight, SearchOptions};
 
 /// `[arm]`.
@@ -47,6 +48,22 @@ pub struct ArmSection {
     /// Halton samples of the reach map (the Fig. 5 data set); 0: none.
     #[serde(default)]
     pub map_samples: usize,
+    /// A non-prismatic arm: the section profile optimized with the shape
+    /// (`study::arm::taper`); absent: the prismatic arm.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub taper: Option<TaperKeys>,
+}
+
+/// `[arm] taper = { knots = K, min_section = A_min }`: the section A(s̄),
+/// piecewise linear through K uniform knots, of unit volume ∫A ds̄ = 1
+/// (the prismatic arm's), A ≥ A_min, every stiffness B_i A².
+#[derive(Debug, Clone, Copy, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct TaperKeys {
+    /// K, the knots of the section (2 ≤ K ≤ elements + 1).
+    pub knots: usize,
+    /// A_min in units of the prismatic section, in (0, 1).
+    pub min_section: f64,
 }
 
 fn default_samples() -> usize {
@@ -130,6 +147,54 @@ pub fn reach_direction(alpha: f64, elements: usize) -> Result<f64, ProblemError>
 }
 
 impl ArmSection {
+    /// The section's design space of a tapered arm (`arm.taper`), checked
+    /// against the scene and mesh: None for a prismatic arm. A tapered arm
+    /// is weightless under a tip load, without actuator limit or reach
+    /// map, on elements of order ≥ 2 with at least one element per knot
+    /// interval: a section resolved as finely as linear elements lets the
+    /// optimizer exploit the discretization (Keller's strongest column came
+    /// out 1.76 times the uniform one on linear elements with a knot at
+    /// every node, against the exact 4/3).
+    pub fn taper(&self, rod: &Rod, arm: &ArmProblem) -> Result<Option<Taper>, ProblemError> {
+        let Some(keys) = self.taper else {
+            return Ok(None);
+        };
+        let taper = Taper::new(keys.knots, keys.min_section)
+            .map_err(|e| invalid("arm.taper", e.to_string()))?;
+        if self.scene(rod)?.weight != ArmWeight::Weightless || self.max_curvature.is_some() {
+            return Err(invalid(
+                "arm.taper",
+                "a tapered arm takes a tip load alone (no weight, no arm.max_curvature)",
+            ));
+        }
+        if self.map_samples > 0 {
+            return Err(invalid(
+                "arm.map_samples",
+                "a tapered arm has no reach map; use 0",
+            ));
+        }
+        let mesh = &arm.stability;
+        if mesh.order() < 2 {
+            return Err(invalid(
+                "arm.order",
+                "a tapered arm needs elements of order 2 or 3 (linear elements let the section \
+                 optimizer exploit the discretization)",
+            ));
+        }
+        if keys.knots > mesh.elements() + 1 {
+            return Err(invalid(
+                "arm.taper.knots",
+                format!(
+                    "{} knots need at least {} elements (one per knot interval), got {}",
+                    keys.knots,
+                    keys.knots - 1,
+                    mesh.elements()
+                ),
+            ));
+        }
+        Ok(Some(taper))
+    }
+
     /// The arm's loads (from `[loads]`: a tip force, the weight as a
     /// distributed force, or both in the ratio w = qL/F) and actuator limit.
     pub fn scene(&self, rod: &Rod) -> Result<ArmScene, ProblemError> {

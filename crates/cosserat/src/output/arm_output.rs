@@ -49,6 +49,7 @@ use super::store::{Group, StoreError, StoreResult};
 use crate::study::arm::{
     ArmOptimum, ClosestStraight, ReachMap, Resolution, SearchProgress, StraightArm,
 };
+use crate::study::arm::{LoadingVerdict, TaperedOptimum};
 
 fn points(g: &mut Group, name: &str, v: &[[f64; 3]]) -> StoreResult<()> {
     let flat: Vec<f64> = v.iter().flatten().copied().collect();
@@ -270,5 +271,82 @@ pub fn read_search(path: &Path) -> StoreResult<SavedSearch> {
             .dataset("optimum/shape_coefficients")?
             .floats()?
             .to_vec(),
+    })
+}
+
+/// A tapered-arm study (`[arm] taper`): the optimum and the verdict of its
+/// loading path (None where the path was not computed).
+pub struct TaperedStudy<'a> {
+    /// The optimum.
+    pub optimum: &'a TaperedOptimum,
+    /// The loading path's verdict.
+    pub loading: Option<LoadingVerdict>,
+}
+
+/// Writes a tapered-arm study atomically: `/optimum/` as for the prismatic
+/// arm (`reach`, `load_factor`, `gamma_crit` — the designed rod's by the
+/// library's fixed-shape pencil —, `shape_coefficients`, `loaded_shape`,
+/// `unloaded_shape`, `intrinsic_curvature`, `reach_fine` on 2N elements,
+/// `reach_error` = `reach_fine` − `reach`) with the section:
+/// `section` (A at the knots, unit volume), `section_knots` (s̄ of the
+/// knots), `section_profile` (A at the shape points); attributes
+/// `elements`, `min_section`, `critical_block`, `rounds`, `evaluations`,
+/// `section_search` (`converged` or `budget`), `loading_path` (the
+/// verdict: `reaches_design`, `loses_stability`, `other_equilibrium`,
+/// `undecided`, or `not_computed`) and `loading_path_value` (the load
+/// factor where stability is lost, the tip's miss per L, or where the path
+/// ended); `/prismatic/` the prismatic optimum the search started from
+/// (`reach`, `load_factor`, `shape_coefficients`).
+pub fn write_tapered_arm(
+    path: &Path,
+    problem: &str,
+    study: &TaperedStudy,
+    force: bool,
+) -> Result<(), OutputError> {
+    let o = study.optimum;
+    write_atomically(path, force, |root| {
+        root.attrs.set_text("problem", problem);
+        root.attrs
+            .set_text("stop_reason", RunState::Completed.name());
+        let g = root.create_group("optimum");
+        g.float("reach", o.design.reach)?;
+        g.float("reach_fine", o.reach_fine)?;
+        g.float("reach_error", o.reach_error())?;
+        g.float("load_factor", o.design.gamma)?;
+        g.float("gamma_crit", o.critical_load)?;
+        let c = &o.design.shape_coefficients;
+        g.floats("shape_coefficients", &[c.len()], c)?;
+        points(g, "loaded_shape", &o.loaded_shape)?;
+        points(g, "unloaded_shape", &o.unloaded_shape)?;
+        let k = &o.intrinsic_curvature;
+        g.floats("intrinsic_curvature", &[k.len()], k)?;
+        let a = o.section.values();
+        g.floats("section", &[a.len()], a)?;
+        let s = o.section.knots();
+        g.floats("section_knots", &[s.len()], &s)?;
+        let p = &o.section_at_points;
+        g.floats("section_profile", &[p.len()], p)?;
+        g.float("min_section", o.min_section)?;
+        g.attrs.set_count("elements", o.elements as u64);
+        g.attrs.set_text("critical_block", o.block.name());
+        g.attrs.set_count("evaluations", o.evaluations as u64);
+        let search = if o.section_converged {
+            "converged"
+        } else {
+            "budget"
+        };
+        g.attrs.set_text("section_search", search);
+        let (verdict, value) = match study.loading {
+            None => ("not_computed", f64::NAN),
+            Some(v) => (v.name(), v.value()),
+        };
+        g.attrs.set_text("loading_path", verdict);
+        g.float("loading_path_value", value)?;
+        let g = root.create_group("prismatic");
+        g.float("reach", o.prismatic.reach)?;
+        g.float("load_factor", o.prismatic.gamma)?;
+        let c = &o.prismatic.shape_coefficients;
+        g.floats("shape_coefficients", &[c.len()], c)?;
+        Ok(())
     })
 }

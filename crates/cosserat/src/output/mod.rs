@@ -27,6 +27,8 @@ pub mod xdmf;
 #[cfg(feature = "hdf5")]
 pub use arm_output::{read_search, write_arm, write_arm_study, ArmStudy, SavedSearch};
 #[cfg(feature = "hdf5")]
+pub use arm_output::{write_tapered_arm, TaperedStudy};
+#[cfg(feature = "hdf5")]
 pub use curve::write_curve;
 #[cfg(feature = "hdf5")]
 pub use diagram::{read_saved, read_stable, write_diagram, write_stages};

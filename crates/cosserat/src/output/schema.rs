@@ -82,6 +82,12 @@ fn entry(parent: &str, name: &str) -> (&'static str, &'static str) {
         (_, "clamp_angle") => ("rad", "clamp angle of the straight arm"),
         (_, "leader_points") => ("1", "the best samples' coefficients"),
         (_, "leader_reach") => ("1", "the best samples' reach per rod length"),
+        // Tapered arms.
+        (_, "section") => ("1", "section area A at the knots, in units of the prismatic section (unit volume)"),
+        (_, "section_knots") => ("1", "arc length of the section's knots per rod length"),
+        (_, "min_section") => ("1", "lower bound A_min of the section, in units of the prismatic section"),
+        (_, "loading_path_value") => ("1", "the loading path's number: load factor of the loss of stability, tip miss per L, or where it ended"),
+        (_, "section_profile") => ("1", "section area A at the shape points, in units of the prismatic section"),
         // Sweeps.
         ("grid", "keys") => ("", "the --set key of each axis"),
         ("grid", "shape") => ("", "points along each axis"),

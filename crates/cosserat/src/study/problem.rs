@@ -48,6 +48,8 @@ pub struct Problem {
     pub arm: Option<(ArmProblem, SearchOptions, bool)>,
     /// The arm's loads and actuator limit, and the size of its reach map.
     pub arm_scene: Option<(ArmScene, usize)>,
+    /// `[arm] taper`: the section's design space of a tapered arm.
+    pub arm_taper: Option<crate::study::arm::taper::Taper>,
     /// The grid of a `[sweep]` table.
     pub sweep: Option<Sweep>,
     /// The keys of the later stages of a chained continuation

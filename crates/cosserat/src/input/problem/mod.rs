@@ -156,6 +156,10 @@ impl Problem {
             .as_ref()
             .map(|a| a.scene(&rod).map(|s| (s, a.map_samples)))
             .transpose()?;
+        let arm_taper = match (&file.arm, &arm) {
+            (Some(a), Some((p, _, _))) => a.taper(&rod, p)?,
+            _ => None,
+        };
         let sweep = file.sweep.as_ref().map(SweepSection::build).transpose()?;
         let problem = Problem {
             rod,
@@ -168,6 +172,7 @@ impl Problem {
             curve,
             arm,
             arm_scene,
+            arm_taper,
             sweep,
             stage_keys: vec![],
         };

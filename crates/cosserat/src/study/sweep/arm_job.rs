@@ -256,6 +256,14 @@ impl Job for ArmJob {
         stop: &dyn Fn() -> bool,
     ) -> Record {
         let mut record = Record::new(index);
+        if problem.arm_taper.is_some() {
+            // Never the prismatic search in place of the tapered one.
+            record.label(
+                "error",
+                "arm.taper: a tapered arm runs with `cosserat optimize` only",
+            );
+            return record;
+        }
         let (Some((arm, search, straight)), Some((scene, _))) = (&problem.arm, &problem.arm_scene)
         else {
             record.label("error", "the problem has no [arm] table");
