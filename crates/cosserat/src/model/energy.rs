@@ -75,6 +75,14 @@ pub trait StoredEnergy: std::fmt::Debug + Send + Sync {
     fn shear_stiffness(&self, _s: f64) -> Option<Vector3<f64>> {
         None
     }
+    /// The energy in all six strains, W(s, κ, ν), for an energy that can
+    /// shear or extend (None: an unshearable, inextensible rod, whose
+    /// equations are the Kirchhoff or planar ones). Where both this and
+    /// [`StoredEnergy::shear_stiffness`] are given they describe the same
+    /// W, and the equations may take the quadratic fast path.
+    fn strain_energy(&self) -> Option<&dyn super::StrainEnergy> {
+        None
+    }
     /// The same material with its intrinsic curvature κ⁰(s) multiplied by
     /// `factor`, for energies that have one as a separate profile (None
     /// otherwise): the control path of a designed arm raises κ⁰ with the

@@ -49,10 +49,10 @@ impl ModelChoice {
     /// energy admits planar bending about d2(0) and every load keeps the rod
     /// in the plane of d1(0), d3(0); Kirchhoff otherwise.
     pub fn for_rod(rod: &Rod) -> ModelChoice {
-        if rod.energy().shear_stiffness(0.0).is_some() {
+        if rod.energy().strain_energy().is_some() {
             return ModelChoice {
                 level: ModelLevel::Cosserat,
-                reason: "cosserat: the energy has finite shear and extension stiffnesses \
+                reason: "cosserat: the energy has shear and extension strains \
                          (energy.shear)"
                     .into(),
             };
@@ -76,7 +76,7 @@ impl ModelChoice {
     /// extension stiffnesses, and a shearable rod needs the Cosserat level
     /// (drop the shear part of the energy for the Kirchhoff limit).
     pub fn forced(rod: &Rod, level: ModelLevel) -> Result<ModelChoice, String> {
-        let shearable = rod.energy().shear_stiffness(0.0).is_some();
+        let shearable = rod.energy().strain_energy().is_some();
         match (level, planar_obstruction(rod)) {
             (ModelLevel::Cosserat, _) if !shearable => Err(
                 "the Cosserat level needs shear and extension stiffnesses (energy.shear)".into(),

@@ -15,6 +15,8 @@ mod loads;
 mod profile;
 mod rod;
 mod shear;
+mod strain;
+mod strain_autodiff;
 mod support;
 mod tangent;
 
@@ -32,5 +34,7 @@ pub use loads::DeadLoads;
 pub use profile::{Extremes, Knots, Profile, SplineKnots};
 pub use rod::{Clamp, ResidualScales, Rod};
 pub use shear::Shearable;
+pub use strain::{assemble_blocks, shear_strain, stack, StrainEnergy, StrainError, StrainJet};
+pub use strain_autodiff::{StrainAutoDiff, StrainDensity};
 pub use support::{across, Freedom, TipSupport};
 pub use tangent::{EnergyRate, RodTangent};

@@ -14,6 +14,7 @@ use std::sync::Arc;
 
 use nalgebra::{Matrix3, Vector3};
 
+use super::strain::{assemble_blocks, stack, StrainEnergy, StrainJet};
 use super::{ModelError, Profile, StoredEnergy};
 
 /// A bending energy W_b(s, κ) with the quadratic shear and extension
@@ -106,6 +107,10 @@ impl StoredEnergy for Shearable {
         Some(self.shear)
     }
 
+    fn strain_energy(&self) -> Option<&dyn StrainEnergy> {
+        Some(self)
+    }
+
     fn with_intrinsic_scaled(&self, factor: f64) -> Option<Arc<dyn StoredEnergy>> {
         let bending = self.bending.with_intrinsic_scaled(factor)?;
         Some(self.with_bending(bending))
@@ -132,6 +137,44 @@ impl StoredEnergy for Shearable {
     ) -> Option<Arc<dyn StoredEnergy>> {
         let bending = self.bending.with_intrinsic_towards(target, p)?;
         Some(self.with_bending(bending))
+    }
+}
+
+/// W = W_b(s, κ) + ½ (ν − e3)ᵀ S (ν − e3): H = diag(H_b, S), no coupling,
+/// the third derivative that of W_b alone.
+impl StrainEnergy for Shearable {
+    fn strain_density(&self, s: f64, kappa: &Vector3<f64>, nu: &Vector3<f64>) -> f64 {
+        let e = nu - Vector3::z();
+        self.bending.density(s, kappa) + 0.5 * self.shear.component_mul(&e).dot(&e)
+    }
+
+    fn strain_jet(&self, s: f64, kappa: &Vector3<f64>, nu: &Vector3<f64>) -> StrainJet {
+        let b = &self.bending;
+        let zero = Matrix3::zeros();
+        let force = self.shear.component_mul(&(nu - Vector3::z()));
+        StrainJet {
+            gradient: stack(&b.moment(s, kappa), &force),
+            hessian: assemble_blocks(
+                &b.stiffness(s, kappa),
+                &zero,
+                &Matrix3::from_diagonal(&self.shear),
+            ),
+            gradient_rate: stack(&b.moment_rate(s, kappa), &Vector3::zeros()),
+            hessian_rate: assemble_blocks(&b.stiffness_rate(s, kappa), &zero, &zero),
+        }
+    }
+
+    fn strain_hessian_derivative(
+        &self,
+        s: f64,
+        kappa: &Vector3<f64>,
+        _nu: &Vector3<f64>,
+        v: &nalgebra::Vector6<f64>,
+    ) -> nalgebra::Matrix6<f64> {
+        let vk = Vector3::new(v[0], v[1], v[2]);
+        let t = self.bending.stiffness_derivative(s, kappa, &vk);
+        let zero = Matrix3::zeros();
+        assemble_blocks(&t, &zero, &zero)
     }
 }
 
