@@ -16,7 +16,7 @@ use cosserat::bvp::{solve, Equilibrium, Method, SolveError, SolverOptions};
 use cosserat::equations::{KirchhoffEquations, RodEquations};
 use cosserat::model::{
     Clamp, DeadLoads, Frame, Freedom, LinearElastic, ModelChoice, ModelLevel, Rod, Shearable,
-    StoredEnergy, StrainAutoDiff, StrainDensity, StrainEnergy, TipSupport,
+    StoredEnergy, StrainAutoDiff, StrainDensity, StrainEnergy, StrainJet, TipSupport,
 };
 use cosserat::stability::{analyze, FormCoefficients, StabilityOptions};
 use nalgebra::{Matrix3, Rotation3, Vector3};
@@ -490,4 +490,103 @@ fn a_force_the_material_cannot_carry_is_a_named_failure() {
             "{method:?}: {text}"
         );
     }
+}
+
+/// A hand-written six-strain energy whose coupling entry H_κ2ν3 is 2 %
+/// off (everything else from automatic differentiation).
+#[derive(Debug)]
+struct WrongCoupling(StrainAutoDiff<Coupled>);
+
+impl StrainEnergy for WrongCoupling {
+    fn strain_density(&self, s: f64, kappa: &Vector3<f64>, nu: &Vector3<f64>) -> f64 {
+        self.0.strain_density(s, kappa, nu)
+    }
+    fn strain_jet(&self, s: f64, kappa: &Vector3<f64>, nu: &Vector3<f64>) -> StrainJet {
+        let mut jet = self.0.strain_jet(s, kappa, nu);
+        jet.hessian[(1, 5)] *= 1.02;
+        jet.hessian[(5, 1)] *= 1.02;
+        jet
+    }
+    fn strain_hessian_derivative(
+        &self,
+        s: f64,
+        kappa: &Vector3<f64>,
+        nu: &Vector3<f64>,
+        v: &nalgebra::Vector6<f64>,
+    ) -> nalgebra::Matrix6<f64> {
+        self.0.strain_hessian_derivative(s, kappa, nu, v)
+    }
+}
+
+impl StoredEnergy for WrongCoupling {
+    fn density(&self, s: f64, kappa: &Vector3<f64>) -> f64 {
+        self.0.density(s, kappa)
+    }
+    fn moment(&self, s: f64, kappa: &Vector3<f64>) -> Vector3<f64> {
+        self.0.moment(s, kappa)
+    }
+    fn stiffness(&self, s: f64, kappa: &Vector3<f64>) -> Matrix3<f64> {
+        self.0.stiffness(s, kappa)
+    }
+    fn moment_rate(&self, s: f64, kappa: &Vector3<f64>) -> Vector3<f64> {
+        self.0.moment_rate(s, kappa)
+    }
+    fn stiffness_rate(&self, s: f64, kappa: &Vector3<f64>) -> Matrix3<f64> {
+        self.0.stiffness_rate(s, kappa)
+    }
+    fn stiffness_derivative(&self, s: f64, kappa: &Vector3<f64>, v: &Vector3<f64>) -> Matrix3<f64> {
+        self.0.stiffness_derivative(s, kappa, v)
+    }
+    fn admits_planar_bending(&self) -> bool {
+        false
+    }
+    fn name(&self) -> &'static str {
+        "wrong coupling"
+    }
+    fn strain_energy(&self) -> Option<&dyn StrainEnergy> {
+        Some(self)
+    }
+}
+
+/// The derivative checker covers the six strains: a correct coupled,
+/// tapered energy passes every check; the same energy with the coupling
+/// entry of H 2 % off fails on the 6 × 6 Hessian (and on the derivatives
+/// differenced from it), and the solver refuses
+/// it (an untrusted energy) instead of converging to a wrong tip.
+#[test]
+fn the_checker_covers_the_six_strains() {
+    use cosserat::model::energy_check::{check, Property};
+    let coupled = Coupled {
+        b: [2.0, 1.5, 3.0],
+        shear: [9.0, 7.0, 12.0],
+        c: 0.8,
+        d: -0.6,
+        quartic: 0.7,
+        taper: 0.4,
+    };
+    let good = StrainAutoDiff::new(coupled.clone());
+    let report = check(&good, 1.0, 1.0);
+    assert!(report.passed() && report.findings.is_empty(), "{report}");
+    assert!(report.worst_passed < 1e-7, "{report}");
+    let wrong = WrongCoupling(StrainAutoDiff::new(coupled));
+    let report = check(&wrong, 1.0, 1.0);
+    assert!(!report.passed(), "{report}");
+    // The Hessian itself, and what is differenced from it (its
+    // derivative along v and in s), are caught; nothing in κ alone.
+    assert!(
+        report
+            .failures()
+            .any(|f| f.property == Property::StrainHessian),
+        "{report}"
+    );
+    assert!(
+        report.failures().all(|f| matches!(
+            f.property,
+            Property::StrainHessian | Property::StrainThird | Property::StrainRates
+        )),
+        "{report}"
+    );
+    let r = rod(Arc::new(wrong), tip_force(Vector3::new(0.3, 0.0, 0.5)));
+    let err = solve_cosserat(&r, Method::Shooting).expect_err("a wrong Hessian is refused");
+    assert!(err.to_string().contains("6 × 6 Hessian"), "{err}");
 }
