@@ -56,8 +56,7 @@ impl Strained {
         force: &Vector3<f64>,
         distributed: &Vector3<f64>,
     ) -> Result<Strained, StrainError> {
-        let nu = shear_strain(energy, s, kappa, force, &Vector3::z())?;
-        let jet = energy.strain_jet(s, kappa, &nu);
+        let (nu, jet) = shear_strain(energy, s, kappa, force, &Vector3::z())?;
         let indefinite = || StrainError::Indefinite {
             s,
             kappa: (*kappa).into(),

@@ -113,19 +113,21 @@ const MAX_HALVINGS: usize = 40;
 /// ν with W_ν(s, κ, ν) = N, by Newton on r(ν) = W_ν − N with Jacobian
 /// W_νν (Cholesky: refused unless positive definite), damped by halving
 /// until |r| decreases (Armijo with slope ¼), from `start` (ν = e3 where
-/// nothing better is known). Converged when a full step is below
-/// 1e-14 max(|ν|, 1); that step is applied, so ν is exact to a few ulps
-/// of the strain. Deterministic: the same arguments give the same bits.
+/// nothing better is known). Converged when the next full step is below
+/// 1e-14 max(|ν|, 1): ν is then exact to a few ulps of the strain, and is
+/// returned with its jet (the one that step was computed from, so the
+/// caller evaluates W no more). Deterministic: the same arguments give the
+/// same bits.
 pub fn shear_strain(
     energy: &dyn StrainEnergy,
     s: f64,
     kappa: &Vector3<f64>,
     force: &Vector3<f64>,
     start: &Vector3<f64>,
-) -> Result<Vector3<f64>, StrainError> {
+) -> Result<(Vector3<f64>, StrainJet), StrainError> {
     let residual_at = |nu: &Vector3<f64>| {
         let jet = energy.strain_jet(s, kappa, nu);
-        (jet.force() - force, jet.block(1, 1))
+        (jet.force() - force, jet)
     };
     let indefinite = |nu: &Vector3<f64>| StrainError::Indefinite {
         s,
@@ -139,12 +141,12 @@ pub fn shear_strain(
         if !r.iter().all(|v| v.is_finite()) {
             return Err(indefinite(&nu));
         }
-        let Some(chol) = j.cholesky() else {
+        let Some(chol) = j.block(1, 1).cholesky() else {
             return Err(indefinite(&nu));
         };
         let step = -chol.solve(&r);
         if step.norm() <= 1e-14 * nu.norm().max(1.0) {
-            return Ok(nu + step);
+            return Ok((nu, j));
         }
         let norm = r.norm();
         let mut lambda = 1.0;

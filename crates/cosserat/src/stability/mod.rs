@@ -198,9 +198,8 @@ pub fn strained_coefficients(
     body_force: &Vector3<f64>,
 ) -> Result<FormCoefficients, StabilityError> {
     let refused = |e: String| StabilityError::Unsupported(format!("shear-extension strain: {e}"));
-    let nu = shear_strain(strain, p.s, &p.curvature, body_force, &Vector3::z())
+    let (nu, jet) = shear_strain(strain, p.s, &p.curvature, body_force, &Vector3::z())
         .map_err(|e| refused(e.to_string()))?;
-    let jet = strain.strain_jet(p.s, &p.curvature, &nu);
     FormCoefficients::strained(&jet.hessian, &p.curvature, &jet.moment(), body_force, &nu)
         .ok_or_else(|| refused(format!("W_νν is not positive definite at s = {}", p.s)))
 }
