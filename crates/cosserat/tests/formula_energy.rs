@@ -305,7 +305,7 @@ fn formula_refusals_name_their_key() {
     let spec = EnergySpec {
         stiffness: stiffness(),
         intrinsic_curvature: Default::default(),
-        parameters: Default::default(),
+        parameters: std::collections::BTreeMap::default(),
         density: Some("B1*k1^2 + (v3 - 1)^2".to_owned()),
     };
     let e = catalog.build("formula", &spec).unwrap().unwrap();
@@ -409,8 +409,8 @@ fn claimed_evenness_is_proved_or_caught() {
         fn admits_planar_bending(&self) -> bool {
             false
         }
-        fn intrinsic_profiles(&self) -> Option<&[Profile; 3]> {
-            self.0.intrinsic_profiles()
+        fn profile_edits(&self) -> Option<&dyn cosserat::model::ProfileEdits> {
+            self.0.profile_edits()
         }
         fn even_components(&self) -> [bool; 3] {
             [true; 3]

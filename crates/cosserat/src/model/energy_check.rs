@@ -239,8 +239,7 @@ pub fn check_at(
 }
 
 fn intrinsic(energy: &dyn StoredEnergy, s: f64) -> Vector3<f64> {
-    energy
-        .intrinsic_profiles()
+    super::intrinsic_profiles(energy)
         .map_or_else(Vector3::zeros, |p| Vector3::from_fn(|i, _| p[i].value(s)))
 }
 
@@ -503,7 +502,7 @@ impl StrainSample<'_> {
                 hj,
             );
             let column: [f64; 6] = third.column(j).into();
-            let scale = max_abs(&column) + max_abs(&(h * v).as_slice()[..]) / (1e3 * hj);
+            let scale = max_abs(&column) + max_abs((h * v).as_slice()) / (1e3 * hj);
             self.compare(report, Property::StrainThird, &column, &fd, &bound, scale);
         }
         let per_length = 1.0 / (1e3 * self.hs);

@@ -13,6 +13,7 @@ mod frame;
 mod level;
 mod loads;
 mod profile;
+mod profile_edits;
 mod rod;
 mod shear;
 mod strain;
@@ -22,7 +23,7 @@ mod tangent;
 
 pub use autodiff::{lift, AutoDiff, Density};
 pub use catalog::{EnergyBuilder, EnergyCatalog, EnergySpec, EnergySpecError};
-pub use energy::{LinearElastic, ProfileKind, QuarticStiffening, StoredEnergy};
+pub use energy::{LinearElastic, QuarticStiffening, StoredEnergy};
 pub use error::ModelError;
 pub use formula::{
     Formula, FormulaEnergy, FormulaError, Variable as FormulaVariable,
@@ -32,6 +33,7 @@ pub use frame::Frame;
 pub use level::{ModelChoice, ModelLevel};
 pub use loads::DeadLoads;
 pub use profile::{Extremes, Knots, Profile, SplineKnots};
+pub use profile_edits::{intrinsic_profiles, ProfileEdits, ProfileKind};
 pub use rod::{Clamp, ResidualScales, Rod};
 pub use shear::Shearable;
 pub use strain::{assemble_blocks, shear_strain, stack, StrainEnergy, StrainError, StrainJet};

@@ -15,7 +15,7 @@ use std::sync::Arc;
 use nalgebra::{Matrix3, Vector3};
 
 use super::strain::{assemble_blocks, stack, StrainEnergy, StrainJet};
-use super::{ModelError, Profile, StoredEnergy};
+use super::{ModelError, Profile, ProfileEdits, ProfileKind, StoredEnergy};
 
 /// A bending energy W_b(s, κ) with the quadratic shear and extension
 /// energy ½ (ν − e3)ᵀ diag(S) (ν − e3). Built by the checked
@@ -111,22 +111,33 @@ impl StoredEnergy for Shearable {
         Some(self)
     }
 
-    fn with_intrinsic_scaled(&self, factor: f64) -> Option<Arc<dyn StoredEnergy>> {
-        let bending = self.bending.with_intrinsic_scaled(factor)?;
-        Some(self.with_bending(bending))
+    fn profile_edits(&self) -> Option<&dyn ProfileEdits> {
+        self.bending
+            .profile_edits()
+            .map(|_| self as &dyn ProfileEdits)
+    }
+}
+
+/// The bending energy's edits, the shear part kept. Reached only through
+/// [`StoredEnergy::profile_edits`], which gives it where the bending
+/// energy has edits.
+impl ProfileEdits for Shearable {
+    fn intrinsic_profiles(&self) -> &[Profile; 3] {
+        self.bending_edits().intrinsic_profiles()
     }
 
-    fn intrinsic_profiles(&self) -> Option<&[Profile; 3]> {
-        self.bending.intrinsic_profiles()
+    fn with_intrinsic_scaled(&self, factor: f64) -> Option<Arc<dyn StoredEnergy>> {
+        let bending = self.bending_edits().with_intrinsic_scaled(factor)?;
+        Some(self.with_bending(bending))
     }
 
     fn with_constant(
         &self,
-        profile: super::energy::ProfileKind,
+        profile: ProfileKind,
         i: usize,
         value: f64,
     ) -> Option<Arc<dyn StoredEnergy>> {
-        let bending = self.bending.with_constant(profile, i, value)?;
+        let bending = self.bending_edits().with_constant(profile, i, value)?;
         Some(self.with_bending(bending))
     }
 
@@ -135,7 +146,7 @@ impl StoredEnergy for Shearable {
         target: &dyn StoredEnergy,
         p: f64,
     ) -> Option<Arc<dyn StoredEnergy>> {
-        let bending = self.bending.with_intrinsic_towards(target, p)?;
+        let bending = self.bending_edits().with_intrinsic_towards(target, p)?;
         Some(self.with_bending(bending))
     }
 }
@@ -179,6 +190,14 @@ impl StrainEnergy for Shearable {
 }
 
 impl Shearable {
+    /// The bending energy's profile edits (present whenever these are
+    /// reached: [`StoredEnergy::profile_edits`] gives them only then).
+    fn bending_edits(&self) -> &dyn ProfileEdits {
+        self.bending
+            .profile_edits()
+            .expect("Shearable's edits are given only where its bending energy has them")
+    }
+
     /// The same shear part (checked when this one was built) on another
     /// bending energy.
     fn with_bending(&self, bending: Arc<dyn StoredEnergy>) -> Arc<dyn StoredEnergy> {

@@ -16,7 +16,10 @@ use super::expr::Expr;
 use super::{Formula, Variable};
 use crate::model::autodiff::{along, jet, lift, new_identity, second_order, Density};
 use crate::model::strain_autodiff::{strain_contraction, strain_jet_of};
-use crate::model::{Profile, ProfileKind, StoredEnergy, StrainDensity, StrainEnergy, StrainJet};
+use crate::model::{
+    intrinsic_profiles, Profile, ProfileEdits, ProfileKind, StoredEnergy, StrainDensity,
+    StrainEnergy, StrainJet,
+};
 
 /// W(s, κ) = formula(s, κ − κ⁰(s), B(s)), with the file's stiffness and
 /// intrinsic-curvature profiles.
@@ -259,8 +262,14 @@ impl StoredEnergy for FormulaEnergy {
         self.shears().then_some(self as &dyn StrainEnergy)
     }
 
-    fn intrinsic_profiles(&self) -> Option<&[Profile; 3]> {
-        Some(&self.kappa0)
+    fn profile_edits(&self) -> Option<&dyn ProfileEdits> {
+        Some(self)
+    }
+}
+
+impl ProfileEdits for FormulaEnergy {
+    fn intrinsic_profiles(&self) -> &[Profile; 3] {
+        &self.kappa0
     }
 
     fn with_intrinsic_scaled(&self, factor: f64) -> Option<Arc<dyn StoredEnergy>> {
@@ -293,7 +302,7 @@ impl StoredEnergy for FormulaEnergy {
         target: &dyn StoredEnergy,
         p: f64,
     ) -> Option<Arc<dyn StoredEnergy>> {
-        let other = target.intrinsic_profiles()?;
+        let other = intrinsic_profiles(target)?;
         let mut e = self.modified();
         for (slot, (mine, theirs)) in e.kappa0.iter_mut().zip(self.kappa0.iter().zip(other)) {
             *slot = mine.blend(theirs, p)?;
