@@ -191,7 +191,9 @@ fn coefficients_at(rod: &Rod, p: &RodSample) -> Result<FormCoefficients, Stabili
     strained_coefficients(strain, p, &body_force)
 }
 
-/// The general path of [`coefficients_at`].
+/// The coefficients at one sample of a general energy W(s, κ, ν): ν from
+/// W_ν = N by Newton, then [`FormCoefficients::strained`] with the 6 × 6
+/// Hessian there; refused with the reason where ν has no solution.
 pub fn strained_coefficients(
     strain: &dyn StrainEnergy,
     p: &RodSample,

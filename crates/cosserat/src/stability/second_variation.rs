@@ -139,7 +139,7 @@ impl FormCoefficients {
     /// The same for any energy W(s, κ, ν): `h` the 6 × 6 Hessian at the
     /// equilibrium strains (κ, ν), M = W_κ, N = W_ν (the body force). With
     /// X = H_κν H_νν⁻¹ and Hs = H_κκ − X H_νκ (module doc):
-    /// A = Hs, B = Hs[κ]× − ½[M]× + X[N]×, C = `[κ]×ᵀHs[κ]× + 2 sym([κ]×ᵀX[N]×)`
+    /// A = Hs, `B = Hs[κ]× − ½[M]× + X[N]×`, C = `[κ]×ᵀHs[κ]× + 2 sym([κ]×ᵀX[N]×)`
     /// `+ sym(Mκᵀ) − (M·κ)I − sym(Nνᵀ) + (N·ν)I − [N]×ᵀH_νν⁻¹[N]×`.
     /// None where H_νν is not positive definite (no minimizing η).
     pub fn strained(
