@@ -176,6 +176,8 @@ fn nonlinear_axial_law_stretches_as_its_closed_form() {
 /// (ν = e3 + S⁻¹N), on a spatial load, for every method and for the
 /// stability spectrum.
 #[test]
+// Many six-strain solves: seconds in release, minutes in a debug build.
+#[cfg_attr(debug_assertions, ignore)]
 fn general_path_reproduces_the_quadratic_shearable() {
     let (b, s) = ([3.0, 1.0, 2.0], [10.0, 6.0, 20.0]);
     let bending: Arc<dyn StoredEnergy> = Arc::new(LinearElastic::uniform(b, [0.0; 3]).unwrap());
@@ -258,6 +260,8 @@ fn coupled_energy_bends_a_circle_with_the_schur_stiffness() {
 /// *Stability of Structures*, Sec. 1.7). Found as the sign change of the
 /// lowest eigenvalue, and of the shooting Jacobian's determinant.
 #[test]
+// Many six-strain solves: seconds in release, minutes in a debug build.
+#[cfg_attr(debug_assertions, ignore)]
 fn stretch_dependent_column_buckles_at_its_closed_form() {
     let (b, beta, shear, s3) = (1.0, 3.0, 4.0, 20.0);
     let q = PI * PI / 4.0;
@@ -459,6 +463,8 @@ fn general_linearization_matches_differences() {
 /// tension (EA = 4, P = 3). The solve stops with the
 /// named failure of the strain's Newton, never a value.
 #[test]
+// Many six-strain solves: seconds in release, minutes in a debug build.
+#[cfg_attr(debug_assertions, ignore)]
 fn a_force_the_material_cannot_carry_is_a_named_failure() {
     #[derive(Debug)]
     struct Softening;
@@ -589,4 +595,58 @@ fn the_checker_covers_the_six_strains() {
     let r = rod(Arc::new(wrong), tip_force(Vector3::new(0.3, 0.0, 0.5)));
     let err = solve_cosserat(&r, Method::Shooting).expect_err("a wrong Hessian is refused");
     assert!(err.to_string().contains("6 × 6 Hessian"), "{err}");
+}
+
+/// Continuation in the load on the general path: the column with a
+/// stretch-dependent bending stiffness (as in
+/// `stretch_dependent_column_buckles_at_its_closed_form`, written as a
+/// formula in v) branches where the closed form says, located on the
+/// continuation's own augmented system.
+#[test]
+// Many six-strain solves: seconds in release, minutes in a debug build.
+#[cfg_attr(debug_assertions, ignore)]
+fn continuation_finds_the_stretch_dependent_column_branch_point() {
+    use cosserat::continuation::continuation;
+    let text = r#"
+[rod]
+length = 1.0
+[energy]
+kind = "formula"
+density = "0.5*(3*k1^2 + (1 + beta*(v3 - 1))*k2^2 + k3^2) + 0.5*S*(v1^2 + v2^2) + 0.5*S3*(v3 - 1)^2"
+parameters = { beta = 3.0, S = 4.0, S3 = 20.0 }
+stiffness = [1.0, 1.0, 1.0]
+[clamp]
+d1 = [1.0, 0.0, 0.0]
+d3 = [0.0, 0.0, 1.0]
+[loads]
+tip_force = [0.0, 0.0, -1.0]
+[continuation]
+parameter = "load_scale"
+start = 0.1
+bounds = [0.0, 2.0]
+step = 0.1
+max_step = 0.5
+elements = 16
+eigenvalues = 2
+measure = "tip_x"
+"#;
+    let (b, beta, shear, s3) = (1.0, 3.0, 4.0, 20.0);
+    let q = PI * PI / 4.0;
+    let (qa, qb, qc) = (1.0 / shear - 1.0 / s3, 1.0 + beta * q / s3, -b * q);
+    let critical = (-qb + (qb * qb - 4.0 * qa * qc).sqrt()) / (2.0 * qa);
+    let problem =
+        cosserat::input::Problem::from_str_with(text, &["continuation.switch_depth=0".into()])
+            .unwrap();
+    let (family, opts) = problem.continuation.clone().unwrap();
+    let diagram = continuation(&family, &opts, &mut |_, _| true).unwrap();
+    let found = diagram
+        .special_points
+        .iter()
+        .map(|p| p.point.parameter)
+        .min_by(|a, b| (a - critical).abs().total_cmp(&(b - critical).abs()))
+        .expect("a special point");
+    assert!(
+        (found - critical).abs() < 1e-8 * critical,
+        "{found} vs {critical}"
+    );
 }

@@ -45,7 +45,7 @@ const PLANE_TOLERANCE: f64 = 1e-12;
 
 impl ModelChoice {
     /// The least level that represents the scene exactly: Cosserat when the
-    /// energy has shear and extension stiffnesses; else planar when the
+    /// energy can shear or extend ([`crate::model::StoredEnergy::strain_energy`]); else planar when the
     /// energy admits planar bending about d2(0) and every load keeps the rod
     /// in the plane of d1(0), d3(0); Kirchhoff otherwise.
     pub fn for_rod(rod: &Rod) -> ModelChoice {
@@ -53,7 +53,7 @@ impl ModelChoice {
             return ModelChoice {
                 level: ModelLevel::Cosserat,
                 reason: "cosserat: the energy has shear and extension strains \
-                         (energy.shear)"
+                         (energy.shear, or a formula in v1, v2, v3)"
                     .into(),
             };
         }
