@@ -50,6 +50,11 @@ pub fn solve_failed(e: &cosserat::bvp::SolveError) -> ExitCode {
             NO_RESULT,
             "raise solver.max_intervals or loosen solver.collocation_tolerance",
         ),
+        E::ShearStrain { .. } => (
+            NO_RESULT,
+            "the energy cannot carry the force there (W_νν not positive definite, or no ν with \
+             W_ν = N): check its shear and extension terms, or lower the loads",
+        ),
     };
     fail(code, format!("{e}\n  what to do: {hint}"))
 }

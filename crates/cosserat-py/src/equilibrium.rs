@@ -32,6 +32,10 @@ pub fn solve_failure(e: &BvpError) -> Failure {
         BvpError::Collocation { .. } => {
             "raise solver.max_intervals or loosen solver.collocation_tolerance"
         }
+        BvpError::ShearStrain { .. } => {
+            "the energy cannot carry the force there (no shear-extension strain with \
+             W_ν = N): check its shear and extension terms, or lower the loads"
+        }
     };
     Failure::NoResult(format!("{e}; what to do: {hint}"))
 }

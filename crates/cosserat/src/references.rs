@@ -225,6 +225,28 @@ pub const FORMULAS: &[(&str, &str, &str)] = &[
     ),
     ("circle_chord", "m", "|r(L) − r(0)| = 2|sin(m/2)|/m"),
     (
+        "coupled_circle_couple",
+        "m, c, s3",
+        "the end couple M = m (B2 − c²/S3) (L = B2 = 1) that bends W = ½B2κ2² + ½S3(ν3 − 1)² + \
+         cκ2(ν3 − 1) into a circle of turn m: N = 0 gives ν3 − 1 = −cκ2/S3",
+    ),
+    (
+        "coupled_circle_tip_x",
+        "m, c, s3",
+        "(1 − c m/S3)(1 − cos m)/m: the circle of turn m stretched by ν3 = 1 − c m/S3",
+    ),
+    (
+        "coupled_circle_tip_z",
+        "m, c, s3",
+        "(1 − c m/S3) sin m / m: the circle of turn m stretched by ν3 = 1 − c m/S3",
+    ),
+    (
+        "stiffening_stretch",
+        "tension, ea, stiff",
+        "L(1 + e), e the real root of stiff e³ + ea e = tension (Cardano): a straight rod under \
+         tension with the axial law φ(e) = ½ ea e² + ¼ stiff e⁴",
+    ),
+    (
         "none",
         "",
         "no such value exists (e.g. no static critical load): the reference is `none`",
@@ -377,6 +399,14 @@ pub fn keller_section(s: f64) -> f64 {
 /// and length ([`keller_section`]).
 pub const KELLER_GAIN: f64 = 4.0 / 3.0;
 
+/// The real root of a x³ + b x = c (a, b > 0: one real root), by
+/// Cardano's formula.
+pub fn cardano_root(a: f64, b: f64, c: f64) -> f64 {
+    let (p, q) = (b / a, -c / a);
+    let disc = (q / 2.0).powi(2) + (p / 3.0).powi(3);
+    (-q / 2.0 + disc.sqrt()).cbrt() + (-q / 2.0 - disc.sqrt()).cbrt()
+}
+
 /// Evaluates the formula `name` with the point's parameters.
 pub fn evaluate(name: &str, params: &BTreeMap<String, f64>) -> Result<f64, String> {
     let k = || param(params, "k", name);
@@ -414,6 +444,20 @@ pub fn evaluate(name: &str, params: &BTreeMap<String, f64>) -> Result<f64, Strin
         "circle_chord" => {
             let m = m()?;
             2.0 * (m / 2.0).sin().abs() / m
+        }
+        "coupled_circle_couple" | "coupled_circle_tip_x" | "coupled_circle_tip_z" => {
+            let (m, c, s3) = (m()?, param(params, "c", name)?, param(params, "s3", name)?);
+            let stretch = 1.0 - c * m / s3;
+            match name {
+                "coupled_circle_couple" => m * (1.0 - c * c / s3),
+                "coupled_circle_tip_x" => stretch * (1.0 - m.cos()) / m,
+                _ => stretch * m.sin() / m,
+            }
+        }
+        "stiffening_stretch" => {
+            let tension = param(params, "tension", name)?;
+            let (ea, stiff) = (param(params, "ea", name)?, param(params, "stiff", name)?);
+            1.0 + cardano_root(stiff, ea, tension)
         }
         "none" => f64::NAN,
         "greenhill_clamped" => greenhill_clamped(param(params, "twist", name)?),

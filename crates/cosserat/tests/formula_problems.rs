@@ -299,3 +299,74 @@ fn a_formula_rod_is_continued_in_its_length_with_an_exact_derivative() {
         assert!(err < 1e-8, "L = {}: tip error {err:e}", pt.parameter);
     }
 }
+
+/// A formula in the shear-extension strains equal to the quadratic part
+/// that `energy.shear` adds, ½ (ν − e3)ᵀ diag(S) (ν − e3), reproduces the
+/// `energy.shear` solution (the explicit ν = e3 + S⁻¹N of the fast path)
+/// through the general path (ν from W_ν = N by Newton), tapered and
+/// curved, in 3-D, on every method.
+#[test]
+// Six solves on the general path: a second in release, long in debug.
+#[cfg_attr(debug_assertions, ignore)]
+fn shear_formula_reproduces_energy_shear_on_every_method() {
+    let quadratic = tapered(
+        r#"kind = "linear"
+shear = [10.0, 20.0, 30.0]"#,
+    );
+    let formula = tapered(
+        r#"kind = "formula"
+density = "0.5*(B1*k1^2 + B2*k2^2 + B3*k3^2) + 0.5*(S1*v1^2 + S2*v2^2 + S3*(v3 - 1)^2)"
+parameters = { S1 = 10.0, S2 = 20.0, S3 = 30.0 }"#,
+    );
+    for method in METHODS {
+        let (a, b) = (tip(&quadratic, method), tip(&formula, method));
+        assert!((a - b).amax() < 1e-12, "{method}: {a:?} vs {b:?}");
+    }
+}
+
+/// A stiffening axial law as a formula, φ(e) = ½ EA e² + ¼ c e⁴ in
+/// e = v3 − 1, under tension P: the tip moves to L (1 + e) with e the
+/// real root of c e³ + EA e = P (Cardano), on every method.
+#[test]
+fn stiffening_axial_formula_stretches_as_its_closed_form() {
+    let (ea, c, p): (f64, f64, f64) = (4.0, 30.0, 6.0);
+    let (pp, q) = (ea / c, -p / c);
+    let disc = (q / 2.0).powi(2) + (pp / 3.0).powi(3);
+    let e = (-q / 2.0 + disc.sqrt()).cbrt() + (-q / 2.0 - disc.sqrt()).cbrt();
+    let text = format!(
+        r#"
+[rod]
+length = 1.0
+[energy]
+kind = "formula"
+density = "0.5*(B1*k1^2 + B2*k2^2 + B3*k3^2) + 2.5*(v1^2 + v2^2) + 0.5*EA*(v3 - 1)^2 + 0.25*c*(v3 - 1)^4"
+parameters = {{ EA = {ea}, c = {c} }}
+stiffness = [1.0, 1.0, 2.0]
+[clamp]
+d1 = [1.0, 0.0, 0.0]
+d3 = [0.0, 0.0, 1.0]
+[loads]
+tip_force = [0.0, 0.0, {p}]
+"#
+    );
+    for method in METHODS {
+        let t = tip(&text, method);
+        assert!(
+            (t[2] - (1.0 + e)).abs() < 1e-10 && t.xy().norm() < 1e-12,
+            "{method}: {t:?} vs 1 + {e}"
+        );
+    }
+}
+
+/// `energy.shear` beside a formula that reads v1..v3 would count the
+/// shear energy twice: refused, naming the key.
+#[test]
+fn energy_shear_beside_a_formula_in_v_is_refused() {
+    let text = tapered(
+        r#"kind = "formula"
+density = "0.5*(B1*k1^2 + B2*k2^2 + B3*k3^2) + 5*(v1^2 + v2^2 + (v3 - 1)^2)"
+shear = [10.0, 20.0, 30.0]"#,
+    );
+    let err = Problem::from_str_with(&text, &[]).unwrap_err();
+    assert!(err.to_string().contains("energy.shear"), "{err}");
+}

@@ -264,6 +264,16 @@ pub enum SolveError {
     /// A rod the equations cannot represent (a singular energy Hessian).
     #[error("invalid rod: {0}")]
     Model(String),
+    /// The solve failed where the shear-extension strain of a general
+    /// energy W(s, κ, ν) had no solution of W_ν = N (the material cannot
+    /// carry the force there): the first such failure, then the solver's.
+    #[error("no shear-extension strain: {strain}; then {after}")]
+    ShearStrain {
+        /// Why Newton for ν stopped ([`crate::model::StrainError`]).
+        strain: String,
+        /// The solver's own failure.
+        after: Box<SolveError>,
+    },
 }
 
 /// The equations of a rod at a model level.
@@ -507,6 +517,19 @@ fn check_energy(rod: &Rod) -> Result<(), SolveError> {
                 h[(2, 2)]
             )));
         }
+        if let Some(strain) = rod.energy().strain_energy() {
+            let h = strain
+                .strain_jet(s, &kappa, &nalgebra::Vector3::z())
+                .hessian;
+            if !h.iter().all(|v| v.is_finite()) || h.cholesky().is_none() {
+                return Err(SolveError::Model(format!(
+                    "the 6 × 6 tangent stiffness of the {} energy in (κ, ν) is not positive \
+                     definite at s = {s} on the unstrained rod (material instability); check \
+                     the energy's shear and extension terms",
+                    rod.energy().name()
+                )));
+            }
+        }
     }
     Ok(())
 }
@@ -534,6 +557,23 @@ fn solve_at(
     stats: &mut IntegrationStats,
 ) -> Result<Solved, SolveError> {
     let eq = equations(rod, level);
+    attempt(eq.as_ref(), level, opts, warm, stats).map_err(|after| match eq.failure() {
+        Some(strain) => SolveError::ShearStrain {
+            strain,
+            after: Box::new(after),
+        },
+        None => after,
+    })
+}
+
+/// One Newton solve of `eq` ([`solve_at`]).
+fn attempt(
+    eq: &dyn RodEquations,
+    level: ModelLevel,
+    opts: &SolverOptions,
+    warm: Option<&Solved>,
+    stats: &mut IntegrationStats,
+) -> Result<Solved, SolveError> {
     let guess = |eq: &dyn RodEquations| {
         let mut u = match &opts.initial_guess {
             Some(g) => guess_for_level(g, eq, level)?,
@@ -559,14 +599,14 @@ fn solve_at(
         };
         let u = match warm {
             Some(_) => None,
-            None => Some(guess(eq.as_ref())?),
+            None => Some(guess(eq)?),
         };
         let fail = |failure| SolveError::Collocation {
             order: 2 * stages,
             failure,
         };
-        let sol = solve_collocation_from(eq.as_ref(), &copts, &opts.newton, warm, u.as_deref())
-            .map_err(fail)?;
+        let sol =
+            solve_collocation_from(eq, &copts, &opts.newton, warm, u.as_deref()).map_err(fail)?;
         if !copts.adapt && (sol.error_estimate.is_nan() || sol.error_estimate > copts.tolerance) {
             return Err(fail(CollocationError::CoarseMesh {
                 tolerance: copts.tolerance,
@@ -576,11 +616,11 @@ fn solve_at(
         }
         return Ok(Solved::Collocation(sol));
     }
-    let mut sys = ShootingSystem::new(eq.as_ref(), opts.method.segments(), opts.integration);
+    let mut sys = ShootingSystem::new(eq, opts.method.segments(), opts.integration);
     let x0 = if let Some(Solved::Shooting { x, .. }) = warm {
         x.clone()
     } else {
-        let u = guess(eq.as_ref())?;
+        let u = guess(eq)?;
         sys.initial_unknowns(&u)
     };
     let outcome = newton::solve(&mut sys, &x0, &opts.newton);

@@ -169,7 +169,7 @@ impl RodLens {
 
     /// The base energy with one constant profile set to p, everything else
     /// (the other profiles, the shear and extension part of a Cosserat rod)
-    /// kept ([`crate::model::StoredEnergy::with_constant`]).
+    /// kept ([`crate::model::ProfileEdits::with_constant`]).
     fn linear_with(&self, p: f64) -> Result<Arc<dyn StoredEnergy>, FamilyError> {
         let (kind, i) = match self.parameter {
             Parameter::Stiffness(i) => {
@@ -186,7 +186,8 @@ impl RodLens {
         };
         self.base
             .energy()
-            .with_constant(kind, i, p)
+            .profile_edits()
+            .and_then(|e| e.with_constant(kind, i, p))
             .ok_or(FamilyError::NotConstant(self.key()))
     }
 }
@@ -194,7 +195,7 @@ impl RodLens {
 /// The constant intrinsic curvature of an energy (None when it has no κ⁰
 /// profiles or one of them varies along the rod).
 fn constant_intrinsic(e: &dyn StoredEnergy) -> Option<Vector3<f64>> {
-    let profiles = e.intrinsic_profiles()?;
+    let profiles = crate::model::intrinsic_profiles(e)?;
     let mut k = Vector3::zeros();
     for (i, profile) in profiles.iter().enumerate() {
         match profile {
@@ -282,7 +283,8 @@ impl Lens for RodLens {
                 rod = rod.with_energy(
                     self.base
                         .energy()
-                        .with_intrinsic_scaled(p)
+                        .profile_edits()
+                        .and_then(|e| e.with_intrinsic_scaled(p))
                         .ok_or(FamilyError::NotConstant(self.key()))?,
                 );
             }
@@ -293,7 +295,10 @@ impl Lens for RodLens {
                 rod = rod.with_energy(
                     self.target
                         .as_ref()
-                        .and_then(|t| self.base.energy().with_intrinsic_towards(t.as_ref(), p))
+                        .and_then(|t| {
+                            let edits = self.base.energy().profile_edits()?;
+                            edits.with_intrinsic_towards(t.as_ref(), p)
+                        })
                         .ok_or(FamilyError::NotConstant(self.key()))?,
                 );
             }

@@ -17,14 +17,21 @@
 //! [`crate::model::Shearable`]): with the compliance c = S⁻¹ the strain is
 //! ν = e3 + c∘N, the tangent r' = ν_i d_i and the moment balance
 //! m' + r' × n = 0 reads M' = M × κ + N × ν. With c = 0 this is the
-//! Kirchhoff rod exactly.
+//! Kirchhoff rod exactly. A general energy W(s, κ, ν) ([`StrainEnergy`],
+//! any coupling) runs the same states with ν from W_ν = N and κ' from the
+//! 6 × 6 tangent stiffness (`strained.rs`); the quadratic energy of
+//! [`crate::model::Shearable`] keeps the explicit ν = e3 + S⁻¹N as a fast
+//! path, checked against the general one (tests/strain_energy.rs).
 
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
+use std::sync::{Arc, Mutex};
+
 use super::planar::straight_rod_clamp_moment;
+use super::strained::Strained;
 use super::tip::{condition_rates, conditions, rates_cover, TipRates, TipState};
 use super::{RodEquations, RodSample};
-use crate::model::{Rod, RodTangent, StoredEnergy, TipSupport};
+use crate::model::{Rod, RodTangent, StoredEnergy, StrainEnergy, StrainError, TipSupport};
 use crate::numerics::newton::{self, Convergence, Damping, Options, System};
 
 /// The 9-ODE Kirchhoff equations (12 with the position), or the Cosserat
@@ -34,6 +41,11 @@ pub struct KirchhoffEquations {
     rod: Rod,
     /// c = S⁻¹ (1/N): zero for the Kirchhoff rod.
     compliance: Vector3<f64>,
+    /// The general path: ν from W_ν(s, κ, ν) = N by Newton.
+    strained: bool,
+    /// The first failure of that Newton, kept for the solver to name
+    /// (the rates there are NaN, which no integrator accepts).
+    failure: Arc<Mutex<Option<StrainError>>>,
 }
 
 /// The state unpacked.
@@ -88,17 +100,67 @@ impl KirchhoffEquations {
         KirchhoffEquations {
             rod,
             compliance: Vector3::zeros(),
+            strained: false,
+            failure: Arc::default(),
         }
     }
 
     /// The Cosserat equations: shear and extension from the energy's
-    /// stiffnesses S (Kirchhoff when the energy has none).
+    /// stiffnesses S where it gives them (the explicit quadratic fast
+    /// path), else from its [`StrainEnergy`] (Kirchhoff when it has
+    /// neither).
     pub fn cosserat(rod: Rod) -> Self {
-        let compliance = rod
+        match rod.energy().shear_stiffness(0.0) {
+            Some(s) => KirchhoffEquations {
+                compliance: s.map(|v| 1.0 / v),
+                ..Self::new(rod)
+            },
+            None => Self::general(rod),
+        }
+    }
+
+    /// The Cosserat equations by the general path alone (ν by Newton from
+    /// W_ν = N, the 6 × 6 tangent stiffness), also for an energy with a
+    /// quadratic shear part: what the fast path is tested against.
+    /// Kirchhoff when the energy has no [`StrainEnergy`].
+    pub fn general(rod: Rod) -> Self {
+        let strained = rod.energy().strain_energy().is_some();
+        KirchhoffEquations {
+            strained,
+            ..Self::new(rod)
+        }
+    }
+
+    /// The energy in six strains (the general path only).
+    fn strain_energy(&self) -> &dyn StrainEnergy {
+        self.rod
             .energy()
-            .shear_stiffness(0.0)
-            .map_or_else(Vector3::zeros, |s| s.map(|v| 1.0 / v));
-        KirchhoffEquations { rod, compliance }
+            .strain_energy()
+            .expect("the general path is chosen only for an energy with strains")
+    }
+
+    /// The body force N and distributed force F (body components) at s.
+    fn body_forces(&self, s: f64, st: &State) -> (Vector3<f64>, Vector3<f64>) {
+        let n = self.rod.loads().internal_force(s, self.rod.length()) + st.reaction;
+        let f = self.rod.loads().distributed_force;
+        let body = |v: Vector3<f64>| Vector3::new(v.dot(&st.d1), v.dot(&st.d2), v.dot(&st.d3));
+        (body(n), body(f))
+    }
+
+    /// The general path's balance at s, its failure recorded.
+    fn strained_at(&self, s: f64, st: &State) -> Option<Strained> {
+        let (force, distributed) = self.body_forces(s, st);
+        match Strained::at(self.strain_energy(), s, &st.kappa, &force, &distributed) {
+            Ok(p) => Some(p),
+            Err(e) => {
+                let mut kept = self
+                    .failure
+                    .lock()
+                    .unwrap_or_else(std::sync::PoisonError::into_inner);
+                kept.get_or_insert(e);
+                None
+            }
+        }
     }
 
     fn balance(&self, s: f64, st: &State) -> Balance {
@@ -133,19 +195,47 @@ impl KirchhoffEquations {
     }
 
     fn write_rates(st: &State, b: &Balance, dy: &mut [f64]) {
+        Self::write_strained_rates(st, &b.nu, &b.rate, dy);
+    }
+
+    fn write_strained_rates(st: &State, nu: &Vector3<f64>, rate: &Vector3<f64>, dy: &mut [f64]) {
         let k = st.kappa;
         let dd1 = st.d2 * k[2] - st.d3 * k[1];
         let dd2 = st.d3 * k[0] - st.d1 * k[2];
-        let dr = st.d1 * b.nu[0] + st.d2 * b.nu[1] + st.d3 * b.nu[2];
+        let dr = st.d1 * nu[0] + st.d2 * nu[1] + st.d3 * nu[2];
         dy[0..3].copy_from_slice(dd1.as_slice());
         dy[3..6].copy_from_slice(dd2.as_slice());
-        dy[6..9].copy_from_slice(b.rate.as_slice());
+        dy[6..9].copy_from_slice(rate.as_slice());
         dy[9..12].copy_from_slice(dr.as_slice());
         dy[12..].fill(0.0);
     }
 }
 
 impl KirchhoffEquations {
+    /// The free tip's Jacobian with `h` = ∂M/∂κ at the tip (at fixed
+    /// directors): ∂(C·d3)/∂d1 = d2 × C, ∂(C·d3)/∂d2 = C × d1.
+    fn free_tip_jacobian(&self, st: &State, h: &Matrix3<f64>) -> DMatrix<f64> {
+        let c = self.rod.loads().tip_couple;
+        let mut g = DMatrix::zeros(3, self.dim());
+        for j in 0..3 {
+            g[(0, j)] = -c[j];
+            g[(1, 3 + j)] = -c[j];
+        }
+        let (a, b) = (st.d2.cross(&c), c.cross(&st.d1));
+        for j in 0..3 {
+            g[(2, j)] = -a[j];
+            g[(2, 3 + j)] = -b[j];
+            for i in 0..3 {
+                g[(i, 6 + j)] = h[(i, j)];
+            }
+        }
+        let unit = self.rod.residual_scales().moment;
+        for i in 0..3 {
+            g.row_mut(i).scale_mut(1.0 / unit[i]);
+        }
+        g
+    }
+
     /// The residuals and Jacobian of a supported tip ([`super::tip`]).
     fn supported_tip(&self, support: &TipSupport, y: &[f64]) -> (Vec<f64>, DMatrix<f64>) {
         let st = State::read(y);
@@ -153,12 +243,134 @@ impl KirchhoffEquations {
         let tip = TipState {
             d: [st.d1, st.d2, st.d3],
             r: Vector3::new(y[9], y[10], y[11]),
-            m: self.rod.energy().moment(l, &st.kappa),
-            h: self.rod.energy().stiffness(l, &st.kappa),
+            m: self.tip_moment(&st),
+            // The general path's Jacobian reads ∂g/∂M from the κ columns
+            // and applies the chain rule itself (strained_tip_jacobian).
+            h: if self.strained {
+                Matrix3::identity()
+            } else {
+                self.rod.energy().stiffness(l, &st.kappa)
+            },
             reaction: st.reaction,
             couple: &self.rod.loads().tip_couple,
         };
         conditions(support, &tip, &self.rod.residual_scales(), self.dim())
+    }
+
+    /// M(L): ∇W at the tip, W_κ(L, κ, ν) on the general path (NaN, the
+    /// failure recorded, where ν has no solution).
+    fn tip_moment(&self, st: &State) -> Vector3<f64> {
+        let l = self.rod.length();
+        if !self.strained {
+            return self.rod.energy().moment(l, &st.kappa);
+        }
+        self.strained_at(l, st)
+            .map_or_else(|| Vector3::from_element(f64::NAN), |p| p.moment())
+    }
+
+    /// ∂N(L)/∂y (3 × dim): N_i = n·d_i with n = n_loads + R, d3 = d1 × d2.
+    fn tip_force_jacobian(&self, st: &State) -> DMatrix<f64> {
+        let n = self
+            .rod
+            .loads()
+            .internal_force(self.rod.length(), self.rod.length())
+            + st.reaction;
+        let mut j = DMatrix::zeros(3, self.dim());
+        let (a, b) = (st.d2.cross(&n), n.cross(&st.d1));
+        for c in 0..3 {
+            j[(0, c)] = n[c];
+            j[(1, 3 + c)] = n[c];
+            j[(2, c)] = a[c];
+            j[(2, 3 + c)] = b[c];
+        }
+        if self.reacts() {
+            for (i, d) in [st.d1, st.d2, st.d3].iter().enumerate() {
+                for c in 0..3 {
+                    j[(i, 12 + c)] = d[c];
+                }
+            }
+        }
+        j
+    }
+
+    /// The tip Jacobian on the general path: M(L) = W_κ(κ, ν(κ, N)) moves
+    /// with κ by the Schur complement and with the frame and reaction
+    /// through N by H_κν H_νν⁻¹; the conditions' own Jacobian, built with
+    /// ∂M/∂κ = I, gives ∂g/∂M in its κ columns.
+    fn strained_tip_jacobian(&self, y: &[f64]) -> DMatrix<f64> {
+        let st = State::read(y);
+        let Some(p) = self.strained_at(self.rod.length(), &st) else {
+            return DMatrix::from_element(self.unknowns(), self.dim(), f64::NAN);
+        };
+        let mut j = match &self.rod.support() {
+            Some(support) => self.supported_tip(support, y).1,
+            None => self.free_tip_jacobian(&st, &Matrix3::identity()),
+        };
+        let g = j.columns(6, 3).into_owned();
+        let schur = p.moment_stiffness();
+        let schur = DMatrix::from_fn(3, 3, |r, c| schur[(r, c)]);
+        let x = p.moment_compliance();
+        let x = DMatrix::from_fn(3, 3, |r, c| x[(r, c)]);
+        j.columns_mut(6, 3).copy_from(&(&g * schur));
+        j += &g * x * self.tip_force_jacobian(&st);
+        j
+    }
+
+    /// f and its linearization on the general path (see `strained.rs`);
+    /// NaN everywhere, the failure recorded, where ν has no solution.
+    fn strained_linearized(
+        &self,
+        s: f64,
+        st: &State,
+        cols: usize,
+        phi: &[f64],
+        dy: &mut [f64],
+        dphi: &mut [f64],
+    ) {
+        let Some(p) = self.strained_at(s, st) else {
+            dy.fill(f64::NAN);
+            dphi.fill(f64::NAN);
+            return;
+        };
+        Self::write_strained_rates(st, &p.nu, &p.kappa_rate(), dy);
+        let k = st.kappa;
+        let third = p.third(self.strain_energy(), s, &k);
+        let n = self.rod.loads().internal_force(s, self.rod.length()) + st.reaction;
+        let f = self.rod.loads().distributed_force;
+        let dim = self.dim();
+        for c in 0..cols {
+            let v = &phi[dim * c..dim * (c + 1)];
+            let out = &mut dphi[dim * c..dim * (c + 1)];
+            let dreaction = if dim > 12 {
+                Vector3::new(v[12], v[13], v[14])
+            } else {
+                Vector3::zeros()
+            };
+            let dd1 = Vector3::new(v[0], v[1], v[2]);
+            let dd2 = Vector3::new(v[3], v[4], v[5]);
+            let dk = Vector3::new(v[6], v[7], v[8]);
+            let dd3 = dd1.cross(&st.d2) + st.d1.cross(&dd2);
+            let r1 = st.d2 * dk[2] + dd2 * k[2] - st.d3 * dk[1] - dd3 * k[1];
+            let r2 = st.d3 * dk[0] + dd3 * k[0] - st.d1 * dk[2] - dd1 * k[2];
+            let dn = Vector3::new(
+                n.dot(&dd1) + dreaction.dot(&st.d1),
+                n.dot(&dd2) + dreaction.dot(&st.d2),
+                n.dot(&dd3) + dreaction.dot(&st.d3),
+            );
+            let df = Vector3::new(f.dot(&dd1), f.dot(&dd2), f.dot(&dd3));
+            let (rk, dnu) = p.linearized(&third, &k, &dk, &dn, &df);
+            let dr = dd1 * p.nu[0]
+                + dd2 * p.nu[1]
+                + dd3 * p.nu[2]
+                + st.d1 * dnu[0]
+                + st.d2 * dnu[1]
+                + st.d3 * dnu[2];
+            out[0..3].copy_from_slice(r1.as_slice());
+            out[3..6].copy_from_slice(r2.as_slice());
+            out[6..9].copy_from_slice(rk.as_slice());
+            out[9..12].copy_from_slice(dr.as_slice());
+            out[12..].fill(0.0);
+        }
     }
 }
 
@@ -203,6 +415,13 @@ impl RodEquations for KirchhoffEquations {
 
     fn rhs(&self, s: f64, y: &[f64], dy: &mut [f64]) {
         let st = State::read(y);
+        if self.strained {
+            match self.strained_at(s, &st) {
+                Some(p) => Self::write_strained_rates(&st, &p.nu, &p.kappa_rate(), dy),
+                None => dy.fill(f64::NAN),
+            }
+            return;
+        }
         let b = self.balance(s, &st);
         Self::write_rates(&st, &b, dy);
     }
@@ -222,6 +441,10 @@ impl RodEquations for KirchhoffEquations {
         dphi: &mut [f64],
     ) {
         let st = State::read(y);
+        if self.strained {
+            self.strained_linearized(s, &st, cols, phi, dy, dphi);
+            return;
+        }
         let b = self.balance(s, &st);
         Self::write_rates(&st, &b, dy);
         let body_n = Vector3::new(b.n.dot(&st.d1), b.n.dot(&st.d2), b.n.dot(&st.d3));
@@ -271,7 +494,7 @@ impl RodEquations for KirchhoffEquations {
             return;
         }
         let st = State::read(y);
-        let m = self.rod.energy().moment(self.rod.length(), &st.kappa);
+        let m = self.tip_moment(&st);
         let c = self.rod.loads().tip_couple;
         let unit = self.rod.residual_scales().moment;
         r[0] = (m[0] - c.dot(&st.d1)) / unit[0];
@@ -281,30 +504,15 @@ impl RodEquations for KirchhoffEquations {
 
     /// ∂/∂κ = H(L); ∂(C·d3)/∂d1 = d2 × C, ∂(C·d3)/∂d2 = C × d1.
     fn tip_residual_jacobian(&self, y: &[f64]) -> DMatrix<f64> {
+        if self.strained {
+            return self.strained_tip_jacobian(y);
+        }
         if let Some(support) = &self.rod.support() {
             return self.supported_tip(support, y).1;
         }
         let st = State::read(y);
-        let c = self.rod.loads().tip_couple;
         let h = self.rod.energy().stiffness(self.rod.length(), &st.kappa);
-        let mut g = DMatrix::zeros(3, 12);
-        for j in 0..3 {
-            g[(0, j)] = -c[j];
-            g[(1, 3 + j)] = -c[j];
-        }
-        let (a, b) = (st.d2.cross(&c), c.cross(&st.d1));
-        for j in 0..3 {
-            g[(2, j)] = -a[j];
-            g[(2, 3 + j)] = -b[j];
-            for i in 0..3 {
-                g[(i, 6 + j)] = h[(i, j)];
-            }
-        }
-        let unit = self.rod.residual_scales().moment;
-        for i in 0..3 {
-            g.row_mut(i).scale_mut(1.0 / unit[i]);
-        }
-        g
+        self.free_tip_jacobian(&st, &h)
     }
 
     /// Gram–Schmidt on (d1, d2): an O(tolerance) correction after each step
@@ -355,6 +563,14 @@ impl RodEquations for KirchhoffEquations {
         u
     }
 
+    fn failure(&self) -> Option<String> {
+        let kept = self
+            .failure
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        kept.as_ref().map(ToString::to_string)
+    }
+
     fn unknowns_of(&self, y0: &[f64]) -> Vec<f64> {
         let mut u = y0[6..9].to_vec();
         u.extend_from_slice(&y0[12..]);
@@ -368,7 +584,12 @@ impl RodEquations for KirchhoffEquations {
             position: Vector3::new(y[9], y[10], y[11]),
             directors: [st.d1, st.d2, st.d3],
             curvature: st.kappa,
-            moment: self.rod.energy().moment(s, &st.kappa),
+            moment: if self.strained {
+                self.strained_at(s, &st)
+                    .map_or_else(|| Vector3::from_element(f64::NAN), |p| p.moment())
+            } else {
+                self.rod.energy().moment(s, &st.kappa)
+            },
             force: self.rod.loads().internal_force(s, self.rod.length()) + st.reaction,
         }
     }
@@ -394,7 +615,10 @@ impl RodEquations for KirchhoffEquations {
     /// A tangent whose energy rates are exact for this rod, and a support
     /// whose motion the support conditions' rates (`tip.rs`) cover.
     fn differentiates(&self, t: &RodTangent) -> bool {
-        t.fits(&self.rod)
+        // The general path's p-derivatives are not written: continuation
+        // differentiates it by differences, and says so.
+        !self.strained
+            && t.fits(&self.rod)
             && self
                 .rod
                 .support()

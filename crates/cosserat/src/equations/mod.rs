@@ -9,6 +9,7 @@
 
 mod kirchhoff;
 mod planar;
+mod strained;
 mod tip;
 
 pub use kirchhoff::KirchhoffEquations;
@@ -77,6 +78,13 @@ pub trait RodEquations: Send + Sync {
     /// the support holds no position (no reaction unknowns).
     fn set_reaction(&self, _u: &mut [f64], _r: &nalgebra::Vector3<f64>) -> bool {
         false
+    }
+    /// Why an evaluation had no value (the shear-extension strain of a
+    /// general energy without a solution of W_ν = N): the rates there were
+    /// NaN, and the solver names this failure where it stops. None when
+    /// every evaluation had a value.
+    fn failure(&self) -> Option<String> {
+        None
     }
     /// The free values read back from a state at s = 0.
     fn unknowns_of(&self, y0: &[f64]) -> Vec<f64>;

@@ -15,6 +15,7 @@
 use nalgebra::{Matrix3, Vector3};
 
 use super::profile::Profile;
+use super::profile_edits::{intrinsic_profiles, ProfileEdits, ProfileKind};
 use super::ModelError;
 
 /// A stored energy density per unit reference length, W(s, κ) ≥ 0, C² in κ
@@ -38,7 +39,7 @@ pub trait StoredEnergy: std::fmt::Debug + Send + Sync {
     /// energy then admits planar equilibria bent about d2 (planar model).
     fn admits_planar_bending(&self) -> bool;
     /// The strain components i in which W is claimed even about the
-    /// intrinsic curvature ([`StoredEnergy::intrinsic_profiles`], zero for
+    /// intrinsic curvature ([`super::ProfileEdits::intrinsic_profiles`], zero for
     /// an energy without them): W(s, κ⁰ + u) = W(s, κ⁰ + R_i u), R_i flipping
     /// the sign of u_i (a cross-section symmetric about a principal axis).
     /// Checked by [`super::energy_check`]; none claimed by default.
@@ -75,53 +76,20 @@ pub trait StoredEnergy: std::fmt::Debug + Send + Sync {
     fn shear_stiffness(&self, _s: f64) -> Option<Vector3<f64>> {
         None
     }
-    /// The same material with its intrinsic curvature κ⁰(s) multiplied by
-    /// `factor`, for energies that have one as a separate profile (None
-    /// otherwise): the control path of a designed arm raises κ⁰ with the
-    /// load (paper Sec. 5).
-    fn with_intrinsic_scaled(&self, _factor: f64) -> Option<std::sync::Arc<dyn StoredEnergy>> {
+    /// The energy in all six strains, W(s, κ, ν), for an energy that can
+    /// shear or extend (None: an unshearable, inextensible rod, whose
+    /// equations are the Kirchhoff or planar ones). Where both this and
+    /// [`StoredEnergy::shear_stiffness`] are given they describe the same
+    /// W, and the equations may take the quadratic fast path.
+    fn strain_energy(&self) -> Option<&dyn super::StrainEnergy> {
         None
     }
-    /// The intrinsic curvature profiles, for energies that have them.
-    fn intrinsic_profiles(&self) -> Option<&[Profile; 3]> {
+    /// The edits of the energy's separate profiles (κ⁰, constant B_i),
+    /// for energies given by such profiles: what continuation lenses and
+    /// the arm's control paths change ([`super::ProfileEdits`]).
+    fn profile_edits(&self) -> Option<&dyn ProfileEdits> {
         None
     }
-    /// The same material with one constant profile set to `value`: the
-    /// stiffness B_i or the intrinsic curvature κ⁰_i, for energies that
-    /// have it as a separate profile and where that profile is a constant
-    /// (None otherwise: replacing a varying profile by a number would
-    /// change the rod silently), and None when the material's own checked
-    /// constructor refuses the value (a non-finite number, a non-positive
-    /// stiffness). Every other part of the material (the
-    /// other profiles, a shear and extension part) is kept. Continuation
-    /// in `energy.stiffness[i]` or `energy.intrinsic_curvature[i]`.
-    fn with_constant(
-        &self,
-        _profile: ProfileKind,
-        _i: usize,
-        _value: f64,
-    ) -> Option<std::sync::Arc<dyn StoredEnergy>> {
-        None
-    }
-    /// The same material with κ⁰ = (1 − p) κ⁰_self + p κ⁰_target (None
-    /// when either has no κ⁰ profiles or they do not blend): a control
-    /// moving κ⁰ from one profile to another while the load is applied.
-    fn with_intrinsic_towards(
-        &self,
-        _target: &dyn StoredEnergy,
-        _p: f64,
-    ) -> Option<std::sync::Arc<dyn StoredEnergy>> {
-        None
-    }
-}
-
-/// Which profile of an energy [`StoredEnergy::with_constant`] sets.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ProfileKind {
-    /// The stiffness B_i.
-    Stiffness,
-    /// The intrinsic curvature κ⁰_i.
-    IntrinsicCurvature,
 }
 
 /// The linear-elastic energy with intrinsic curvature,
@@ -290,8 +258,14 @@ impl StoredEnergy for LinearElastic {
         LinearElastic::is_uniform(self)
     }
 
-    fn intrinsic_profiles(&self) -> Option<&[Profile; 3]> {
-        Some(&self.intrinsic_curvature)
+    fn profile_edits(&self) -> Option<&dyn ProfileEdits> {
+        Some(self)
+    }
+}
+
+impl ProfileEdits for LinearElastic {
+    fn intrinsic_profiles(&self) -> &[Profile; 3] {
+        &self.intrinsic_curvature
     }
 
     fn with_intrinsic_towards(
@@ -299,7 +273,7 @@ impl StoredEnergy for LinearElastic {
         target: &dyn StoredEnergy,
         p: f64,
     ) -> Option<std::sync::Arc<dyn StoredEnergy>> {
-        let to = target.intrinsic_profiles()?;
+        let to = intrinsic_profiles(target)?;
         let [a, b, c] = &self.intrinsic_curvature;
         let blended = [
             a.blend(&to[0], p)?,
@@ -337,6 +311,35 @@ impl StoredEnergy for LinearElastic {
         Some(std::sync::Arc::new(
             LinearElastic::new(stiffness, kappa0).ok()?,
         ))
+    }
+}
+
+/// The quartic energy's κ⁰ is read (continuation towards it, the
+/// derivative checker); its profiles are not edited (no lens needs them).
+impl ProfileEdits for QuarticStiffening {
+    fn intrinsic_profiles(&self) -> &[Profile; 3] {
+        self.linear.intrinsic_curvature()
+    }
+
+    fn with_intrinsic_scaled(&self, _factor: f64) -> Option<std::sync::Arc<dyn StoredEnergy>> {
+        None
+    }
+
+    fn with_constant(
+        &self,
+        _profile: ProfileKind,
+        _i: usize,
+        _value: f64,
+    ) -> Option<std::sync::Arc<dyn StoredEnergy>> {
+        None
+    }
+
+    fn with_intrinsic_towards(
+        &self,
+        _target: &dyn StoredEnergy,
+        _p: f64,
+    ) -> Option<std::sync::Arc<dyn StoredEnergy>> {
+        None
     }
 }
 
@@ -434,8 +437,8 @@ impl StoredEnergy for QuarticStiffening {
         [true; 3]
     }
 
-    fn intrinsic_profiles(&self) -> Option<&[Profile; 3]> {
-        Some(self.linear.intrinsic_curvature())
+    fn profile_edits(&self) -> Option<&dyn ProfileEdits> {
+        Some(self)
     }
 
     fn name(&self) -> &'static str {
@@ -499,8 +502,8 @@ mod tests {
             ));
         }
         // A refused value through with_constant is None, never a rod.
-        assert!(e.with_constant(ProfileKind::Stiffness, 0, -1.0).is_none());
-        assert!(e.with_constant(ProfileKind::Stiffness, 0, 4.0).is_some());
+        assert!(ProfileEdits::with_constant(&e, ProfileKind::Stiffness, 0, -1.0).is_none());
+        assert!(ProfileEdits::with_constant(&e, ProfileKind::Stiffness, 0, 4.0).is_some());
     }
 
     const H: f64 = 1e-6;

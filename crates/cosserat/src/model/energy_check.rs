@@ -15,10 +15,17 @@
 //! Also checked: H symmetric, H positive definite (where it is not, the
 //! material itself is unstable there — a material instability, not a
 //! structural one), and the planar claim (M1 = M3 = 0 on κ1 = κ3 = 0).
+//!
+//! An energy in all six strains ([`StoredEnergy::strain_energy`]) has the
+//! same checks in z = (κ, ν) at strains ν = e3 + 0.05 d around the
+//! unstrained state: ∇W = (m, N) against W, each column of the 6 × 6
+//! Hessian (the coupling blocks H_κν included) against ∇W, ∂(H v)/∂z
+//! against H v, the s-rates, H symmetric and positive definite (strong
+//! ellipticity: no material instability in shear and extension either).
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
-use super::{Rod, StoredEnergy};
+use super::{stack, Rod, StoredEnergy, StrainEnergy};
 
 /// A typical curvature of a problem (1/m), the scale of the strains the
 /// checks sample: 1/L, or the curvature the loads' moment scale gives the
@@ -59,6 +66,18 @@ pub enum Property {
     PlanarBending,
     /// W even in a strain component about κ⁰, claimed by `even_components`.
     Evenness,
+    /// ∇W = (W_κ, W_ν) of an energy in six strains.
+    StrainGradient,
+    /// The 6 × 6 Hessian, coupling blocks included.
+    StrainHessian,
+    /// ∂(H v)/∂z in six strains.
+    StrainThird,
+    /// ∂s∇W and ∂sH in six strains.
+    StrainRates,
+    /// The 6 × 6 Hessian symmetric.
+    StrainSymmetry,
+    /// The 6 × 6 Hessian positive definite (material stability).
+    StrainConvexity,
 }
 
 impl Property {
@@ -74,6 +93,12 @@ impl Property {
             Property::Convexity => "positive definite H",
             Property::PlanarBending => "planar bending (M1 = M3 = 0 on κ1 = κ3 = 0)",
             Property::Evenness => "claimed evenness W(κ⁰ + u) = W(κ⁰ + R_i u)",
+            Property::StrainGradient => "gradient (W_κ, W_ν) in six strains",
+            Property::StrainHessian => "6 × 6 Hessian in (κ, ν)",
+            Property::StrainThird => "third derivative ∂(Hv)/∂(κ, ν)",
+            Property::StrainRates => "s-rates of ∇W and H in six strains",
+            Property::StrainSymmetry => "symmetry of the 6 × 6 Hessian",
+            Property::StrainConvexity => "positive definite 6 × 6 Hessian",
         }
     }
 }
@@ -87,6 +112,8 @@ pub struct Finding {
     pub s: f64,
     /// Where: strains κ.
     pub kappa: Vector3<f64>,
+    /// Where: strains ν (e3 for the checks in κ alone).
+    pub nu: Vector3<f64>,
     /// The largest difference from the reference, relative to the scale.
     pub error: f64,
     /// Whether the sample could not be decided (a non-smooth energy).
@@ -130,13 +157,18 @@ impl std::fmt::Display for EnergyCheck {
         for x in &self.findings {
             writeln!(
                 f,
-                "  {} {} at s = {:.6}, κ = ({:.4e}, {:.4e}, {:.4e}): off by {:.2e} relative",
+                "  {} {} at s = {:.6}, κ = ({:.4e}, {:.4e}, {:.4e}){}: off by {:.2e} relative",
                 if x.undecided { "undecided" } else { "FAILED" },
                 x.property.name(),
                 x.s,
                 x.kappa[0],
                 x.kappa[1],
                 x.kappa[2],
+                if x.nu == Vector3::z() {
+                    String::new()
+                } else {
+                    format!(", ν = ({:.4e}, {:.4e}, {:.4e})", x.nu[0], x.nu[1], x.nu[2])
+                },
                 x.error
             )?;
         }
@@ -180,22 +212,34 @@ pub fn check_at(
         findings: Vec::new(),
         worst_passed: 0.0,
     };
-    for &(s, kappa) in samples {
+    for (n, &(s, kappa)) in samples.iter().enumerate() {
+        let hk = 1e-3 * scale.max(kappa.amax()).max(1e-300);
         Sample {
             energy,
             s,
             kappa,
-            hk: 1e-3 * scale.max(kappa.amax()).max(1e-300),
+            hk,
             hs: 1e-3 * length,
         }
         .check(&mut report);
+        if let Some(strain) = energy.strain_energy() {
+            let nu = Vector3::z() + 0.05 * Vector3::from(DIRECTIONS[(n + 2) % 5]);
+            StrainSample {
+                energy: strain,
+                s,
+                kappa,
+                nu,
+                steps: Vector6::new(hk, hk, hk, 5e-5, 5e-5, 5e-5),
+                hs: 1e-3 * length,
+            }
+            .check(&mut report);
+        }
     }
     report
 }
 
 fn intrinsic(energy: &dyn StoredEnergy, s: f64) -> Vector3<f64> {
-    energy
-        .intrinsic_profiles()
+    super::intrinsic_profiles(energy)
         .map_or_else(Vector3::zeros, |p| Vector3::from_fn(|i, _| p[i].value(s)))
 }
 
@@ -242,6 +286,33 @@ fn derivative_in_s<const N: usize>(f: impl Fn(f64) -> [f64; N], h: f64) -> ([f64
         }
     }
     (central, bound)
+}
+
+/// An exact derivative against its difference `reference` with error
+/// `bound`: passed (None, the worst passed difference kept), or (relative
+/// error, undecided) — undecided where the bound exceeds 1e-4 of the
+/// scale (a kink), failed where off by more than 100 bounds + 1e-9 scale.
+fn judge(
+    report: &mut EnergyCheck,
+    exact: &[f64],
+    reference: &[f64],
+    bound: &[f64],
+    scale: f64,
+) -> Option<(f64, bool)> {
+    let scale = scale.max(f64::MIN_POSITIVE);
+    let mut error: f64 = 0.0;
+    let mut undecided = false;
+    for ((a, b), e) in exact.iter().zip(reference).zip(bound) {
+        let off = (a - b).abs();
+        if *e > 1e-4 * scale {
+            undecided = true;
+        } else if off > 100.0 * e + 1e-9 * scale {
+            error = error.max(off / scale);
+        } else {
+            report.worst_passed = report.worst_passed.max(off / scale);
+        }
+    }
+    (undecided || error > 0.0).then_some((error, undecided && error == 0.0))
 }
 
 fn max_abs(x: &[f64]) -> f64 {
@@ -309,26 +380,14 @@ impl Sample<'_> {
         bound: &[f64],
         scale: f64,
     ) {
-        let scale = scale.max(f64::MIN_POSITIVE);
-        let mut error: f64 = 0.0;
-        let mut undecided = false;
-        for ((a, b), e) in exact.iter().zip(reference).zip(bound) {
-            let off = (a - b).abs();
-            if *e > 1e-4 * scale {
-                undecided = true;
-            } else if off > 100.0 * e + 1e-9 * scale {
-                error = error.max(off / scale);
-            } else {
-                report.worst_passed = report.worst_passed.max(off / scale);
-            }
-        }
-        if undecided || error > 0.0 {
+        if let Some((error, undecided)) = judge(report, exact, reference, bound, scale) {
             report.findings.push(Finding {
                 property,
                 s: self.s,
                 kappa: self.kappa,
+                nu: Vector3::z(),
                 error,
-                undecided: undecided && error == 0.0,
+                undecided,
             });
         }
     }
@@ -339,6 +398,7 @@ impl Sample<'_> {
                 property,
                 s: self.s,
                 kappa: self.kappa,
+                nu: Vector3::z(),
                 error,
                 undecided: false,
             });
@@ -368,6 +428,129 @@ impl Sample<'_> {
             if off > 1e-12 {
                 finding(Property::PlanarBending, off);
             }
+        }
+    }
+}
+
+/// One (s, κ, ν) of an energy in six strains, its steps in z = (κ, ν)
+/// and in s.
+struct StrainSample<'e> {
+    energy: &'e dyn StrainEnergy,
+    s: f64,
+    kappa: Vector3<f64>,
+    nu: Vector3<f64>,
+    steps: Vector6<f64>,
+    hs: f64,
+}
+
+fn flat6(m: &Matrix6<f64>) -> [f64; 36] {
+    std::array::from_fn(|i| m[(i % 6, i / 6)])
+}
+
+impl StrainSample<'_> {
+    /// z + t e_j split back into (κ, ν).
+    fn shifted(&self, j: usize, t: f64) -> (Vector3<f64>, Vector3<f64>) {
+        let mut z = stack(&self.kappa, &self.nu);
+        z[j] += t;
+        (
+            z.fixed_rows::<3>(0).into_owned(),
+            z.fixed_rows::<3>(3).into_owned(),
+        )
+    }
+
+    fn check(&self, report: &mut EnergyCheck) {
+        let (e, s, k, n) = (self.energy, self.s, &self.kappa, &self.nu);
+        let jet = e.strain_jet(s, k, n);
+        let (g, h) = (jet.gradient, jet.hessian);
+        // A direction of typical size in every strain (steps × 10³).
+        let v = Vector6::from_fn(|i, _| DIRECTIONS[(i + 1) % 5][i % 3] * self.steps[i] * 1e3);
+        let third = e.strain_hessian_derivative(s, k, n, &v);
+        for j in 0..6 {
+            let hj = self.steps[j];
+            let at = |t: f64| self.shifted(j, t);
+            let (fd, bound) = derivative(
+                |t| {
+                    let (kk, nn) = at(t);
+                    [e.strain_density(s, &kk, &nn)]
+                },
+                hj,
+            );
+            let scale = g[j].abs() + h[(j, j)].abs() * hj * 1e3;
+            self.compare(
+                report,
+                Property::StrainGradient,
+                &[g[j]],
+                &fd,
+                &bound,
+                scale,
+            );
+            let (fd, bound) = derivative(
+                |t| {
+                    let (kk, nn) = at(t);
+                    e.strain_jet(s, &kk, &nn).gradient.into()
+                },
+                hj,
+            );
+            let column: [f64; 6] = h.column(j).into();
+            let scale = max_abs(&column) + h[(j, j)].abs();
+            self.compare(report, Property::StrainHessian, &column, &fd, &bound, scale);
+            let (fd, bound) = derivative(
+                |t| {
+                    let (kk, nn) = at(t);
+                    (e.strain_jet(s, &kk, &nn).hessian * v).into()
+                },
+                hj,
+            );
+            let column: [f64; 6] = third.column(j).into();
+            let scale = max_abs(&column) + max_abs((h * v).as_slice()) / (1e3 * hj);
+            self.compare(report, Property::StrainThird, &column, &fd, &bound, scale);
+        }
+        let per_length = 1.0 / (1e3 * self.hs);
+        let (fd, bound) = derivative_in_s(|t| e.strain_jet(s + t, k, n).gradient.into(), self.hs);
+        let rate: [f64; 6] = jet.gradient_rate.into();
+        let scale = max_abs(&rate) + max_abs(g.as_slice()) * per_length + h.amax() * 1e-3;
+        self.compare(report, Property::StrainRates, &rate, &fd, &bound, scale);
+        let (fd, bound) = derivative_in_s(|t| flat6(&e.strain_jet(s + t, k, n).hessian), self.hs);
+        let rate = flat6(&jet.hessian_rate);
+        let scale = max_abs(&rate) + h.amax() * per_length;
+        self.compare(report, Property::StrainRates, &rate, &fd, &bound, scale);
+        let asymmetry = (h - h.transpose()).amax() / h.amax().max(f64::MIN_POSITIVE);
+        if asymmetry > 1e-12 {
+            self.record(report, Property::StrainSymmetry, asymmetry, false);
+        }
+        if h.cholesky().is_none() {
+            self.record(
+                report,
+                Property::StrainConvexity,
+                h.symmetric_eigenvalues().min(),
+                false,
+            );
+        }
+    }
+
+    fn record(&self, report: &mut EnergyCheck, property: Property, error: f64, undecided: bool) {
+        report.findings.push(Finding {
+            property,
+            s: self.s,
+            kappa: self.kappa,
+            nu: self.nu,
+            error,
+            undecided,
+        });
+    }
+
+    /// As [`Sample::compare`].
+    fn compare(
+        &self,
+        report: &mut EnergyCheck,
+        property: Property,
+        exact: &[f64],
+        reference: &[f64],
+        bound: &[f64],
+        scale: f64,
+    ) {
+        if let Some((error, undecided)) = judge(report, exact, reference, bound, scale) {
+            self.record(report, property, error, undecided);
         }
     }
 }

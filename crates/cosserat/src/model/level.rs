@@ -45,15 +45,15 @@ const PLANE_TOLERANCE: f64 = 1e-12;
 
 impl ModelChoice {
     /// The least level that represents the scene exactly: Cosserat when the
-    /// energy has shear and extension stiffnesses; else planar when the
+    /// energy can shear or extend ([`crate::model::StoredEnergy::strain_energy`]); else planar when the
     /// energy admits planar bending about d2(0) and every load keeps the rod
     /// in the plane of d1(0), d3(0); Kirchhoff otherwise.
     pub fn for_rod(rod: &Rod) -> ModelChoice {
-        if rod.energy().shear_stiffness(0.0).is_some() {
+        if rod.energy().strain_energy().is_some() {
             return ModelChoice {
                 level: ModelLevel::Cosserat,
-                reason: "cosserat: the energy has finite shear and extension stiffnesses \
-                         (energy.shear)"
+                reason: "cosserat: the energy has shear and extension strains \
+                         (energy.shear, or a formula in v1, v2, v3)"
                     .into(),
             };
         }
@@ -76,7 +76,7 @@ impl ModelChoice {
     /// extension stiffnesses, and a shearable rod needs the Cosserat level
     /// (drop the shear part of the energy for the Kirchhoff limit).
     pub fn forced(rod: &Rod, level: ModelLevel) -> Result<ModelChoice, String> {
-        let shearable = rod.energy().shear_stiffness(0.0).is_some();
+        let shearable = rod.energy().strain_energy().is_some();
         match (level, planar_obstruction(rod)) {
             (ModelLevel::Cosserat, _) if !shearable => Err(
                 "the Cosserat level needs shear and extension stiffnesses (energy.shear)".into(),

@@ -13,14 +13,17 @@ mod frame;
 mod level;
 mod loads;
 mod profile;
+mod profile_edits;
 mod rod;
 mod shear;
+mod strain;
+mod strain_autodiff;
 mod support;
 mod tangent;
 
 pub use autodiff::{lift, AutoDiff, Density};
 pub use catalog::{EnergyBuilder, EnergyCatalog, EnergySpec, EnergySpecError};
-pub use energy::{LinearElastic, ProfileKind, QuarticStiffening, StoredEnergy};
+pub use energy::{LinearElastic, QuarticStiffening, StoredEnergy};
 pub use error::ModelError;
 pub use formula::{
     Formula, FormulaEnergy, FormulaError, Variable as FormulaVariable,
@@ -30,7 +33,10 @@ pub use frame::Frame;
 pub use level::{ModelChoice, ModelLevel};
 pub use loads::DeadLoads;
 pub use profile::{Extremes, Knots, Profile, SplineKnots};
+pub use profile_edits::{intrinsic_profiles, ProfileEdits, ProfileKind};
 pub use rod::{Clamp, ResidualScales, Rod};
 pub use shear::Shearable;
+pub use strain::{assemble_blocks, shear_strain, stack, StrainEnergy, StrainError, StrainJet};
+pub use strain_autodiff::{StrainAutoDiff, StrainDensity};
 pub use support::{across, Freedom, TipSupport};
 pub use tangent::{EnergyRate, RodTangent};

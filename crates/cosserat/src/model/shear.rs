@@ -14,7 +14,8 @@ use std::sync::Arc;
 
 use nalgebra::{Matrix3, Vector3};
 
-use super::{ModelError, Profile, StoredEnergy};
+use super::strain::{assemble_blocks, stack, StrainEnergy, StrainJet};
+use super::{ModelError, Profile, ProfileEdits, ProfileKind, StoredEnergy};
 
 /// A bending energy W_b(s, κ) with the quadratic shear and extension
 /// energy ½ (ν − e3)ᵀ diag(S) (ν − e3). Built by the checked
@@ -106,22 +107,37 @@ impl StoredEnergy for Shearable {
         Some(self.shear)
     }
 
-    fn with_intrinsic_scaled(&self, factor: f64) -> Option<Arc<dyn StoredEnergy>> {
-        let bending = self.bending.with_intrinsic_scaled(factor)?;
-        Some(self.with_bending(bending))
+    fn strain_energy(&self) -> Option<&dyn StrainEnergy> {
+        Some(self)
     }
 
-    fn intrinsic_profiles(&self) -> Option<&[Profile; 3]> {
-        self.bending.intrinsic_profiles()
+    fn profile_edits(&self) -> Option<&dyn ProfileEdits> {
+        self.bending
+            .profile_edits()
+            .map(|_| self as &dyn ProfileEdits)
+    }
+}
+
+/// The bending energy's edits, the shear part kept. Reached only through
+/// [`StoredEnergy::profile_edits`], which gives it where the bending
+/// energy has edits.
+impl ProfileEdits for Shearable {
+    fn intrinsic_profiles(&self) -> &[Profile; 3] {
+        self.bending_edits().intrinsic_profiles()
+    }
+
+    fn with_intrinsic_scaled(&self, factor: f64) -> Option<Arc<dyn StoredEnergy>> {
+        let bending = self.bending_edits().with_intrinsic_scaled(factor)?;
+        Some(self.with_bending(bending))
     }
 
     fn with_constant(
         &self,
-        profile: super::energy::ProfileKind,
+        profile: ProfileKind,
         i: usize,
         value: f64,
     ) -> Option<Arc<dyn StoredEnergy>> {
-        let bending = self.bending.with_constant(profile, i, value)?;
+        let bending = self.bending_edits().with_constant(profile, i, value)?;
         Some(self.with_bending(bending))
     }
 
@@ -130,12 +146,58 @@ impl StoredEnergy for Shearable {
         target: &dyn StoredEnergy,
         p: f64,
     ) -> Option<Arc<dyn StoredEnergy>> {
-        let bending = self.bending.with_intrinsic_towards(target, p)?;
+        let bending = self.bending_edits().with_intrinsic_towards(target, p)?;
         Some(self.with_bending(bending))
     }
 }
 
+/// W = W_b(s, κ) + ½ (ν − e3)ᵀ S (ν − e3): H = diag(H_b, S), no coupling,
+/// the third derivative that of W_b alone.
+impl StrainEnergy for Shearable {
+    fn strain_density(&self, s: f64, kappa: &Vector3<f64>, nu: &Vector3<f64>) -> f64 {
+        let e = nu - Vector3::z();
+        self.bending.density(s, kappa) + 0.5 * self.shear.component_mul(&e).dot(&e)
+    }
+
+    fn strain_jet(&self, s: f64, kappa: &Vector3<f64>, nu: &Vector3<f64>) -> StrainJet {
+        let b = &self.bending;
+        let zero = Matrix3::zeros();
+        let force = self.shear.component_mul(&(nu - Vector3::z()));
+        StrainJet {
+            gradient: stack(&b.moment(s, kappa), &force),
+            hessian: assemble_blocks(
+                &b.stiffness(s, kappa),
+                &zero,
+                &Matrix3::from_diagonal(&self.shear),
+            ),
+            gradient_rate: stack(&b.moment_rate(s, kappa), &Vector3::zeros()),
+            hessian_rate: assemble_blocks(&b.stiffness_rate(s, kappa), &zero, &zero),
+        }
+    }
+
+    fn strain_hessian_derivative(
+        &self,
+        s: f64,
+        kappa: &Vector3<f64>,
+        _nu: &Vector3<f64>,
+        v: &nalgebra::Vector6<f64>,
+    ) -> nalgebra::Matrix6<f64> {
+        let vk = Vector3::new(v[0], v[1], v[2]);
+        let t = self.bending.stiffness_derivative(s, kappa, &vk);
+        let zero = Matrix3::zeros();
+        assemble_blocks(&t, &zero, &zero)
+    }
+}
+
 impl Shearable {
+    /// The bending energy's profile edits (present whenever these are
+    /// reached: [`StoredEnergy::profile_edits`] gives them only then).
+    fn bending_edits(&self) -> &dyn ProfileEdits {
+        self.bending
+            .profile_edits()
+            .expect("Shearable's edits are given only where its bending energy has them")
+    }
+
     /// The same shear part (checked when this one was built) on another
     /// bending energy.
     fn with_bending(&self, bending: Arc<dyn StoredEnergy>) -> Arc<dyn StoredEnergy> {

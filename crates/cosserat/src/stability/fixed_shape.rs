@@ -153,7 +153,7 @@ pub fn critical_load(
             "a fixed-shape scene takes forces only".into(),
         ));
     }
-    if rod.clamp().hinge || rod.support().is_some() || rod.energy().shear_stiffness(0.0).is_some() {
+    if rod.clamp().hinge || rod.support().is_some() || rod.energy().strain_energy().is_some() {
         return Err(StabilityError::FixedShape(
             "a fixed shape is a clamped, free-tipped Kirchhoff cantilever (paper Sec. 3); \
              remove clamp.hinge, [support] and energy.shear"

@@ -12,11 +12,11 @@ mod second_variation;
 pub use fixed_shape::{critical_load, CriticalLoad, FixedShape};
 pub use second_variation::{Block, FiniteElements, FormCoefficients};
 
-use nalgebra::Vector3;
+use nalgebra::{Matrix3, Vector3};
 
 use crate::bvp::{Equilibrium, SolveError, SolverOptions};
 use crate::equations::RodSample;
-use crate::model::{Freedom, ModelLevel, Rod};
+use crate::model::{shear_strain, Freedom, ModelLevel, Rod, StrainEnergy};
 use constrained::{count_below_constrained, lowest_eigenpairs_constrained, Constraints};
 use eigen::{EigenError, Inertia, UndecidedInertia};
 
@@ -141,20 +141,69 @@ pub struct Stability {
 
 /// The quadratic-form coefficients at equilibrium samples (with the shear
 /// and extension terms when the energy has them: the Cosserat level).
+/// Entries are NaN where a general energy's strain ν has no solution
+/// of W_ν = N ([`try_coefficients`] names the failure instead).
 pub fn coefficients(rod: &Rod, samples: &[RodSample]) -> Vec<FormCoefficients> {
     samples
         .iter()
         .map(|p| {
-            let frame = nalgebra::Matrix3::from_columns(&p.directors);
-            let body_force = frame.transpose() * p.force;
-            let h = rod.energy().stiffness(p.s, &p.curvature);
-            let compliance = rod
-                .energy()
-                .shear_stiffness(p.s)
-                .map_or_else(Vector3::zeros, |s| s.map(|v| 1.0 / v));
-            FormCoefficients::sheared(&h, &p.curvature, &p.moment, &body_force, &compliance)
+            coefficients_at(rod, p).unwrap_or(FormCoefficients {
+                a: Matrix3::from_element(f64::NAN),
+                b: Matrix3::from_element(f64::NAN),
+                c: Matrix3::from_element(f64::NAN),
+            })
         })
         .collect()
+}
+
+/// [`coefficients`], refused with the reason where the shear-extension
+/// strain of a general energy has no solution at a sample.
+pub fn try_coefficients(
+    rod: &Rod,
+    samples: &[RodSample],
+) -> Result<Vec<FormCoefficients>, StabilityError> {
+    samples.iter().map(|p| coefficients_at(rod, p)).collect()
+}
+
+/// The coefficients at one sample: the quadratic shear part's explicit
+/// strain where the energy gives S, else (a general W(s, κ, ν)) ν from
+/// W_ν = N by Newton and the 6 × 6 Hessian ([`FormCoefficients::strained`]).
+fn coefficients_at(rod: &Rod, p: &RodSample) -> Result<FormCoefficients, StabilityError> {
+    let frame = Matrix3::from_columns(&p.directors);
+    let body_force = frame.transpose() * p.force;
+    let energy = rod.energy();
+    let general = energy
+        .strain_energy()
+        .filter(|_| energy.shear_stiffness(p.s).is_none());
+    let Some(strain) = general else {
+        let h = energy.stiffness(p.s, &p.curvature);
+        let compliance = energy
+            .shear_stiffness(p.s)
+            .map_or_else(Vector3::zeros, |s| s.map(|v| 1.0 / v));
+        return Ok(FormCoefficients::sheared(
+            &h,
+            &p.curvature,
+            &p.moment,
+            &body_force,
+            &compliance,
+        ));
+    };
+    strained_coefficients(strain, p, &body_force)
+}
+
+/// The coefficients at one sample of a general energy W(s, κ, ν): ν from
+/// W_ν = N by Newton, then [`FormCoefficients::strained`] with the 6 × 6
+/// Hessian there; refused with the reason where ν has no solution.
+pub fn strained_coefficients(
+    strain: &dyn StrainEnergy,
+    p: &RodSample,
+    body_force: &Vector3<f64>,
+) -> Result<FormCoefficients, StabilityError> {
+    let refused = |e: String| StabilityError::Unsupported(format!("shear-extension strain: {e}"));
+    let (nu, jet) = shear_strain(strain, p.s, &p.curvature, body_force, &Vector3::z())
+        .map_err(|e| refused(e.to_string()))?;
+    FormCoefficients::strained(&jet.hessian, &p.curvature, &jet.moment(), body_force, &nu)
+        .ok_or_else(|| refused(format!("W_νν is not positive definite at s = {}", p.s)))
 }
 
 /// The spectrum and inertia of K for one block, on the null space of the
@@ -203,7 +252,7 @@ pub fn check_conservative(rod: &Rod) -> Result<(), StabilityError> {
                 .into(),
         ));
     }
-    let shear = rod.energy().shear_stiffness(0.0).is_some();
+    let shear = rod.energy().strain_energy().is_some();
     if shear && rod.support().as_ref().is_some_and(|s| s.holds_position()) {
         return Err(StabilityError::Unsupported(
             "the stability of a shearable rod with a held tip position is not implemented \
@@ -243,7 +292,7 @@ pub fn analyze(
     points.push(rod.length());
     let mut samples = eq.resample(rod, solver, &points)?;
     let tip = samples.pop().expect("the tip sample");
-    let coeffs = coefficients(rod, &samples);
+    let coeffs = try_coefficients(rod, &samples)?;
     let blocks = match eq.model.level {
         ModelLevel::Planar => vec![Block::InPlane, Block::OutOfPlane],
         ModelLevel::Kirchhoff | ModelLevel::Cosserat => vec![Block::Full],

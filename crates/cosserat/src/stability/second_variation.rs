@@ -36,6 +36,29 @@
 //! this gives B (π/2L)² = P (1 − P/S3) + P²/S1: Haringx's critical load when
 //! S3 → ∞ (tests/cosserat.rs).
 //!
+//! # Any energy W(s, κ, ν)
+//!
+//! With the 6 × 6 Hessian H = [[H_κκ, H_κν], [H_νκ, H_νν]] at the
+//! equilibrium strains (κ, ν), ν_ε = ν + εη + ε²ν₂ and κ_ε as above, the
+//! second-order terms of W are ½ (a, η)ᵀ H (a, η) + M·κ₂ + N·ν₂ with
+//! a = ω' + κ×ω and κ₂ = ½ ω×(ω×κ) − ½ ω×ω' (M = W_κ, N = W_ν). Those of
+//! −n·r' = −N·(exp(εω̂) ν_ε) are −N·ν₂ − N·(ω×η) − ½ N·(ω×(ω×ν)), so ν₂
+//! cancels and, with p = N × ω (N·(ω×η) = η·(N×ω)),
+//!
+//!   δ²V = ∫ aᵀH_κκa + 2aᵀH_κνη + ηᵀH_ννη − 2pᵀη + M·(ω×(ω×κ))
+//!           − M·(ω×ω') − N·(ω×(ω×ν)) ds.
+//!
+//! η enters without derivatives; minimized pointwise (H_νν positive
+//! definite), η = H_νν⁻¹ (p − H_νκ a), which leaves
+//!
+//!   aᵀ (H_κκ − H_κν H_νν⁻¹ H_νκ) a + 2 aᵀ H_κν H_νν⁻¹ p − pᵀ H_νν⁻¹ p
+//!
+//! in place of the first four terms: the Schur complement where H stood,
+//! a cross term between a = ω' + κ×ω and p = N×ω, and −pᵀH_νν⁻¹p. With
+//! H_κν = 0 and H_νν = S this is the quadratic case above
+//! ([`FormCoefficients::strained`]; tests/strain_energy.rs checks the two
+//! agree and the form against differences of the exact potential).
+//!
 //! For the linear energy at a planar equilibrium (κ = κ2 e2, M = M2 e2,
 //! N = (F cos φ, 0, F sin φ)) and ω = (ψ, ζ, χ) this is the paper's (45):
 //! B1(ψ' + κ2χ)² + B2ζ'² + B3(χ' − κ2ψ)² + F(−ψχ cos φ + (ζ² + ψ²) sin φ)
@@ -111,6 +134,41 @@ impl FormCoefficients {
                 + id * force.dot(&nu)
                 - nx.transpose() * Matrix3::from_diagonal(compliance) * nx,
         }
+    }
+
+    /// The same for any energy W(s, κ, ν): `h` the 6 × 6 Hessian at the
+    /// equilibrium strains (κ, ν), M = W_κ, N = W_ν (the body force). With
+    /// X = H_κν H_νν⁻¹ and Hs = H_κκ − X H_νκ (module doc):
+    /// A = Hs, `B = Hs[κ]× − ½[M]× + X[N]×`, C = `[κ]×ᵀHs[κ]× + 2 sym([κ]×ᵀX[N]×)`
+    /// `+ sym(Mκᵀ) − (M·κ)I − sym(Nνᵀ) + (N·ν)I − [N]×ᵀH_νν⁻¹[N]×`.
+    /// None where H_νν is not positive definite (no minimizing η).
+    pub fn strained(
+        h: &nalgebra::Matrix6<f64>,
+        kappa: &Vector3<f64>,
+        moment: &Vector3<f64>,
+        force: &Vector3<f64>,
+        nu: &Vector3<f64>,
+    ) -> Option<Self> {
+        let block =
+            |r: usize, c: usize| -> Matrix3<f64> { h.fixed_view::<3, 3>(r, c).into_owned() };
+        let (kk, kn, nn) = (block(0, 0), block(0, 3), block(3, 3));
+        let nn_inv = nn.cholesky()?.inverse();
+        let x = kn * nn_inv;
+        let hs = kk - x * kn.transpose();
+        let k = kappa.cross_matrix();
+        let nx = force.cross_matrix();
+        let id = Matrix3::identity();
+        Some(FormCoefficients {
+            a: sym(hs),
+            b: hs * k - moment.cross_matrix() * 0.5 + x * nx,
+            c: sym(k.transpose() * hs * k)
+                + sym(k.transpose() * x * nx) * 2.0
+                + sym(moment * kappa.transpose())
+                - id * moment.dot(kappa)
+                - sym(force * nu.transpose())
+                + id * force.dot(nu)
+                - sym(nx.transpose() * nn_inv * nx),
+        })
     }
 
     /// The quadratic form at (ω, ω').

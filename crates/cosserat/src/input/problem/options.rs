@@ -188,7 +188,7 @@ fn check_measures(
             ),
         ));
     }
-    let shearable = rod.energy().shear_stiffness(0.0).is_some();
+    let shearable = rod.energy().strain_energy().is_some();
     for energy in [Measure::StoredEnergy, Measure::TotalPotentialEnergy] {
         if opts.measures.contains(&energy) && shearable {
             return Err(invalid(

@@ -89,6 +89,15 @@ pub(super) fn build_rod(file: &ProblemFile, catalog: &EnergyCatalog) -> Result<R
     }
     let mut energy = build_energy(&file.energy, length, catalog)?;
     if let Some(shear) = file.energy.shear {
+        if energy.strain_energy().is_some() {
+            return Err(invalid(
+                "energy.shear",
+                "the energy already reads the shear-extension strains v1, v2, v3 (its own \
+                 W(s, k, v)); write the shear and extension terms in the formula, or drop \
+                 v1..v3 from it"
+                    .to_owned(),
+            ));
+        }
         // A level forced below Cosserat takes the unshearable limit.
         if !matches!(
             file.solver.model.as_str(),

@@ -8,14 +8,18 @@
 
 use std::sync::Arc;
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 use num_dual::DualNum;
 
 use super::derivative::{CURVATURE_RATE, DIRECTION, PAIRS, SLOTS, STIFFNESS_RATE};
 use super::expr::Expr;
 use super::{Formula, Variable};
 use crate::model::autodiff::{along, jet, lift, new_identity, second_order, Density};
-use crate::model::{Profile, ProfileKind, StoredEnergy};
+use crate::model::strain_autodiff::{strain_contraction, strain_jet_of};
+use crate::model::{
+    intrinsic_profiles, Profile, ProfileEdits, ProfileKind, StoredEnergy, StrainDensity,
+    StrainEnergy, StrainJet,
+};
 
 /// W(s, κ) = formula(s, κ − κ⁰(s), B(s)), with the file's stiffness and
 /// intrinsic-curvature profiles.
@@ -33,21 +37,17 @@ pub struct FormulaEnergy {
 pub struct FormulaEnergyError(pub String);
 
 impl FormulaEnergy {
-    /// The energy of `formula` over the profiles; refused when the formula
-    /// reads the shear-extension strains `v1, v2, v3` (a quadratic shear
-    /// and extension part is added by `energy.shear`).
+    /// The energy of `formula` over the profiles. A formula that reads the
+    /// shear-extension strains `v1, v2, v3` (ν itself: v3 = 1 unstrained,
+    /// so an extension energy is written in `v3 - 1`) is a Cosserat energy
+    /// W(s, κ, ν) ([`StoredEnergy::strain_energy`]); one that does not is
+    /// the bending and twisting energy W(s, κ). Never refused today; the
+    /// `Result` keeps the constructor checked for future conditions.
     pub fn new(
         formula: Formula,
         stiffness: [Profile; 3],
         kappa0: [Profile; 3],
     ) -> Result<Self, FormulaEnergyError> {
-        if (0..3).any(|i| formula.reads(Variable::ShearExtension(i))) {
-            return Err(FormulaEnergyError(
-                "reads v1, v2 or v3: a formula is, for now, the bending and twisting energy \
-                 W(s, k); give a quadratic shear and extension part with energy.shear"
-                    .into(),
-            ));
-        }
         Ok(FormulaEnergy {
             formula: Arc::new(formula),
             stiffness,
@@ -101,13 +101,27 @@ impl FormulaEnergy {
     }
 }
 
-impl Density for FormulaEnergy {
-    /// The formula at s, with k = κ − κ⁰(s), v = e3 and B(s).
-    fn density<D: DualNum<Primitive = f64> + Copy>(&self, s: D, kappa: [D; 3]) -> D {
+impl FormulaEnergy {
+    /// Whether the formula reads v1, v2 or v3: a Cosserat energy.
+    fn shears(&self) -> bool {
+        (0..3).any(|i| self.formula.reads(Variable::ShearExtension(i)))
+    }
+}
+
+impl StrainDensity for FormulaEnergy {
+    /// The formula at s, with k = κ − κ⁰(s), v = ν and B(s).
+    fn strain_density<D: DualNum<Primitive = f64> + Copy>(
+        &self,
+        s: D,
+        kappa: [D; 3],
+        nu: [D; 3],
+    ) -> D {
         let at = s.re();
         let mut x = [D::from(0.0); 10];
         x[Variable::ArcLength.slot()] = s;
-        x[Variable::ShearExtension(2).slot()] = D::from(1.0);
+        for i in 0..3 {
+            x[Variable::ShearExtension(i).slot()] = nu[i];
+        }
         for i in 0..3 {
             let k0 = &self.kappa0[i];
             x[Variable::Curvature(i).slot()] = kappa[i] - lift(s, k0.value(at), k0.derivative(at));
@@ -120,17 +134,60 @@ impl Density for FormulaEnergy {
     fn name(&self) -> &'static str {
         "formula"
     }
+}
+
+/// The derivatives in all six strains by automatic differentiation (the
+/// symbolic trees cover the κ-derivatives at ν = e3 only).
+impl StrainEnergy for FormulaEnergy {
+    fn strain_density(&self, s: f64, kappa: &Vector3<f64>, nu: &Vector3<f64>) -> f64 {
+        StrainDensity::strain_density(
+            self,
+            s,
+            [kappa[0], kappa[1], kappa[2]],
+            [nu[0], nu[1], nu[2]],
+        )
+    }
+
+    fn strain_jet(&self, s: f64, kappa: &Vector3<f64>, nu: &Vector3<f64>) -> StrainJet {
+        strain_jet_of(self, s, kappa, nu)
+    }
+
+    fn strain_hessian_derivative(
+        &self,
+        s: f64,
+        kappa: &Vector3<f64>,
+        nu: &Vector3<f64>,
+        v: &Vector6<f64>,
+    ) -> Matrix6<f64> {
+        strain_contraction(self, s, kappa, nu, v)
+    }
+}
+
+impl Density for FormulaEnergy {
+    /// The formula at s, with k = κ − κ⁰(s), v = e3 and B(s).
+    fn density<D: DualNum<Primitive = f64> + Copy>(&self, s: D, kappa: [D; 3]) -> D {
+        let e3 = [D::from(0.0), D::from(0.0), D::from(1.0)];
+        StrainDensity::strain_density(self, s, kappa, e3)
+    }
+
+    fn name(&self) -> &'static str {
+        "formula"
+    }
 
     /// Proved from the formula's structure: W even under (k1, k3) →
     /// (−k1, −k3) and κ⁰₁ = κ⁰₃ = 0 give M1 = M3 = 0 on κ1 = κ3 = 0
     /// (R∇W(Rκ) = ∇W(κ) with R the sign change). Not proved: the rod runs
-    /// the three-dimensional equations.
+    /// the three-dimensional equations. A formula in ν is proved even
+    /// under the whole planar reflection (k1, k3, v2) → (−k1, −k3, −v2):
+    /// a rod bending in the d1–d3 plane has out-of-plane shear ν2, and the
+    /// reflection about that plane flips it with the out-of-plane turns
+    /// (then m1 = m3 = N2 = 0 on κ1 = κ3 = ν2 = 0).
     fn admits_planar_bending(&self) -> bool {
-        self.kappa0[0].is_zero()
-            && self.kappa0[2].is_zero()
-            && self
-                .formula
-                .is_even_in(&[Variable::Curvature(0), Variable::Curvature(2)])
+        let mut flipped = vec![Variable::Curvature(0), Variable::Curvature(2)];
+        if self.shears() {
+            flipped.push(Variable::ShearExtension(1));
+        }
+        self.kappa0[0].is_zero() && self.kappa0[2].is_zero() && self.formula.is_even_in(&flipped)
     }
 }
 
@@ -200,8 +257,19 @@ impl StoredEnergy for FormulaEnergy {
         "formula"
     }
 
-    fn intrinsic_profiles(&self) -> Option<&[Profile; 3]> {
-        Some(&self.kappa0)
+    /// The formula's own W(s, κ, ν) when it reads v1, v2 or v3.
+    fn strain_energy(&self) -> Option<&dyn StrainEnergy> {
+        self.shears().then_some(self as &dyn StrainEnergy)
+    }
+
+    fn profile_edits(&self) -> Option<&dyn ProfileEdits> {
+        Some(self)
+    }
+}
+
+impl ProfileEdits for FormulaEnergy {
+    fn intrinsic_profiles(&self) -> &[Profile; 3] {
+        &self.kappa0
     }
 
     fn with_intrinsic_scaled(&self, factor: f64) -> Option<Arc<dyn StoredEnergy>> {
@@ -234,7 +302,7 @@ impl StoredEnergy for FormulaEnergy {
         target: &dyn StoredEnergy,
         p: f64,
     ) -> Option<Arc<dyn StoredEnergy>> {
-        let other = target.intrinsic_profiles()?;
+        let other = intrinsic_profiles(target)?;
         let mut e = self.modified();
         for (slot, (mine, theirs)) in e.kappa0.iter_mut().zip(self.kappa0.iter().zip(other)) {
             *slot = mine.blend(theirs, p)?;
