@@ -30,6 +30,7 @@ pub mod fig5;
 mod resolve;
 mod sampling;
 pub mod scene;
+pub mod spatial;
 
 pub use control_path::{
     control_path, control_path_until, loading_path_in, loading_path_until, shape_holding_path,
@@ -38,6 +39,7 @@ pub use control_path::{
 pub use fig5::{ClosestStraight, ReachMap};
 pub use resolve::{MeshStudy, Resolution, Verdict, MAX_ELEMENTS, REACH_TOLERANCE};
 pub use scene::{ArmScene, ArmWeight};
+pub use spatial::{PathVerdict, SpatialArm, SpatialDesign, SpatialOptimum};
 
 mod warm_start;
 
