@@ -77,6 +77,9 @@ pub fn run_optimize(run: &OptimizeRun) -> ExitCode {
             format!("{}: arm: the problem has no [arm] table", path.display()),
         );
     };
+    if let Some(spatial) = &problem.arm_spatial {
+        return crate::optimize_spatial::run_spatial(run, &problem, spatial, search, scene);
+    }
     let progress = match start_from(run, &problem, arm, scene) {
         Ok(p) => p,
         Err(code) => return code,

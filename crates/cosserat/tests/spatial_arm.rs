@@ -178,6 +178,7 @@ fn planar_designs_have_the_planar_reach() {
             bend_bounds: vec![],
             twist_bounds: vec![],
             roll_bounds: None,
+            directions: vec![],
         };
         let p = [1.1, -0.7, 0.2];
         let a = planar.design(&p).unwrap();
@@ -205,6 +206,7 @@ fn planar_optimum_is_recovered() {
         bend_bounds: vec![],
         twist_bounds: vec![],
         roll_bounds: None,
+        directions: vec![],
     };
     let s = arm
         .optimize(&ArmScene::default(), &opts, &|| false)

@@ -8,7 +8,7 @@ use crate::bvp::SolverOptions;
 use crate::continuation::{ContinuationOptions, Family};
 use crate::model::{ModelChoice, Rod};
 use crate::stability::{FixedShape, StabilityOptions};
-use crate::study::arm::{ArmProblem, ArmScene, SearchOptions};
+use crate::study::arm::{ArmProblem, ArmScene, SearchOptions, SpatialArm};
 use crate::study::sweep::Sweep;
 
 /// A curve of singular points to follow: the two parameters, the second's
@@ -48,6 +48,8 @@ pub struct Problem {
     pub arm: Option<(ArmProblem, SearchOptions, bool)>,
     /// The arm's loads and actuator limit, and the size of its reach map.
     pub arm_scene: Option<(ArmScene, usize)>,
+    /// `[arm] spatial = true`: the spatial arm (its planar part is `arm`).
+    pub arm_spatial: Option<SpatialArm>,
     /// The grid of a `[sweep]` table.
     pub sweep: Option<Sweep>,
     /// The keys of the later stages of a chained continuation

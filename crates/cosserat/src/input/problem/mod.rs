@@ -156,6 +156,18 @@ impl Problem {
             .as_ref()
             .map(|a| a.scene(&rod).map(|s| (s, a.map_samples)))
             .transpose()?;
+        let arm_spatial = match (&file.arm, &arm, &arm_scene) {
+            (Some(section), Some((planar, _, _)), Some((scene, _))) => {
+                section.spatial_arm(planar, scene)?
+            }
+            _ => None,
+        };
+        if arm_spatial.is_some() && file.sweep.is_some() {
+            return Err(invalid(
+                "arm.spatial",
+                "a sweep runs planar arms only; remove [sweep] or arm.spatial",
+            ));
+        }
         let sweep = file.sweep.as_ref().map(SweepSection::build).transpose()?;
         let problem = Problem {
             rod,
@@ -168,6 +180,7 @@ impl Problem {
             curve,
             arm,
             arm_scene,
+            arm_spatial,
             sweep,
             stage_keys: vec![],
         };

@@ -60,6 +60,9 @@ pub struct SpatialArm {
     pub twist_bounds: Vec<(f64, f64)>,
     /// Bounds of the roll ψ (rad) about the chord (None: ψ = 0).
     pub roll_bounds: Option<(f64, f64)>,
+    /// Directions α (rad) at which to compare the planar and spatial
+    /// optima (`arm.directions`; empty: none).
+    pub directions: Vec<f64>,
 }
 
 /// One evaluated spatial design.
@@ -204,6 +207,13 @@ impl SpatialArm {
         rod.with_clamp(clamp).ok()
     }
 
+    /// This problem in the direction `alpha` (rad).
+    pub fn towards(&self, alpha: f64) -> SpatialArm {
+        let mut a = self.clone();
+        a.planar.alpha = alpha;
+        a
+    }
+
     /// R̂ and γ_crit of the design vector `p`; None when the shape is stable
     /// under any load, its chord vanishes or lies along e2 (no clamp
     /// rotation defined), or its quadrature fails.
@@ -254,6 +264,27 @@ impl SpatialArm {
         opts: &SearchOptions,
         stop: &dyn Fn() -> bool,
     ) -> (Option<SpatialDesign>, usize) {
+        self.search_seeded(scene, opts, &[], stop)
+    }
+
+    /// The planar design c2..cM embedded in this box: κ̄1 = κ̄3 = 0, ψ = 0,
+    /// projected into the bounds (a seed for [`Self::search_seeded`]).
+    pub fn embedded(&self, planar: &[f64]) -> Vec<f64> {
+        let mut p = planar.to_vec();
+        p.resize(self.bounds().len(), 0.0);
+        self.project(&p)
+    }
+
+    /// As [`Self::search_on_mesh`], with `seeds` (design vectors, e.g. the
+    /// planar optimum [`Self::embedded`]) polished too: the spatial search
+    /// then cannot report less than the planar optimum it was given.
+    pub fn search_seeded(
+        &self,
+        scene: &ArmScene,
+        opts: &SearchOptions,
+        seeds: &[Vec<f64>],
+        stop: &dyn Fn() -> bool,
+    ) -> (Option<SpatialDesign>, usize) {
         let keep = opts.starts.max(1);
         let mut leaders: Vec<(f64, Vec<f64>)> = vec![];
         let mut evaluations = 0;
@@ -271,7 +302,12 @@ impl SpatialArm {
         }
         let mut best: Option<SpatialDesign> =
             leaders.first().and_then(|(_, p)| self.design_in(scene, p));
-        for (_, start) in leaders.iter().take(opts.starts) {
+        let starts = leaders
+            .iter()
+            .take(opts.starts)
+            .map(|(_, p)| p)
+            .chain(seeds);
+        for start in starts {
             if stop() {
                 break;
             }
@@ -330,7 +366,7 @@ impl SpatialArm {
     }
 
     /// This problem on `elements` elements.
-    fn on_mesh(&self, elements: usize) -> SpatialArm {
+    pub fn on_mesh(&self, elements: usize) -> SpatialArm {
         let mut a = self.clone();
         a.planar.stability = a
             .planar
@@ -372,7 +408,18 @@ impl SpatialArm {
         opts: &SearchOptions,
         stop: &dyn Fn() -> bool,
     ) -> Option<SpatialOptimum> {
-        let (design, evaluations) = self.search_on_mesh(scene, opts, stop);
+        self.optimize_seeded(scene, opts, &[], stop)
+    }
+
+    /// As [`Self::optimize`], with `seeds` polished too.
+    pub fn optimize_seeded(
+        &self,
+        scene: &ArmScene,
+        opts: &SearchOptions,
+        seeds: &[Vec<f64>],
+        stop: &dyn Fn() -> bool,
+    ) -> Option<SpatialOptimum> {
+        let (design, evaluations) = self.search_seeded(scene, opts, seeds, stop);
         let design = design?;
         let resolution = self.mesh_check(scene, &design);
         self.finish(scene, design, resolution, evaluations + 2)
