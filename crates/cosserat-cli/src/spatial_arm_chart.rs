@@ -102,7 +102,7 @@ impl SpatialChart<'_> {
         DB::ErrorType: 'static,
     {
         let area = area.titled(
-            "c) R* against α: planar (●) and spatial (■)",
+            "c) R* against α: planar (●, solid) and spatial (✕, dashed)",
             ("sans-serif", crate::chart_style::TITLE_FONT),
         )?;
         let d = self.directions;
@@ -131,7 +131,7 @@ impl SpatialChart<'_> {
         chart.draw_series(
             spatial
                 .iter()
-                .map(|p| Rectangle::new([(p.0, p.1), (p.0, p.1)], colour(1).stroke_width(10))),
+                .map(|p| Cross::new(*p, 7, colour(1).stroke_width(3))),
         )?;
         frame(chart.plotting_area())
     }

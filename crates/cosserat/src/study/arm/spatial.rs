@@ -543,9 +543,22 @@ fn path_verdict(d: &Diagram, optimum: &SpatialOptimum, scene: &ArmScene) -> Path
         return PathVerdict::Undecided("an empty branch".into());
     };
     if last.parameter < 1.0 - 1e-6 {
+        let top = branch
+            .points
+            .iter()
+            .map(|p| p.parameter)
+            .fold(f64::NEG_INFINITY, f64::max);
+        let reason = if top > last.parameter {
+            format!(
+                "the path turns back at λ = {top:.4} (a fold) and ends at λ = {:.4}",
+                last.parameter
+            )
+        } else {
+            format!("the path ended at λ = {:.4}", last.parameter)
+        };
         return PathVerdict::Misses {
-            parameter: last.parameter,
-            reason: format!("the path ended ({:?})", d.stop_reason),
+            parameter: top,
+            reason,
         };
     }
     let scale = scene.length(optimum.design.gamma);
