@@ -17,7 +17,8 @@ use cosserat::continuation::RunState;
 use cosserat::input::Problem;
 use cosserat::output::target::replace_atomically;
 use cosserat::study::arm::{
-    ArmOptimum, ArmScene, PathVerdict, Resolution, SearchOptions, SpatialArm, SpatialOptimum,
+    ArmOptimum, ArmScene, DirectionComparison, PathVerdict, Resolution, SearchOptions, SpatialArm,
+    SpatialOptimum,
 };
 
 /// Runs the spatial study of `problem` as `run` asks.
@@ -50,23 +51,17 @@ pub fn run_spatial(
     report(planar.as_ref(), &opt, t.elapsed().as_secs_f64());
     let (diagram, verdict) = arm.loading_path(scene, &opt, stop);
     println!("loading   {}", describe(&verdict));
-    let mut directions: Vec<DirectionReach> = vec![];
+    let mut compared = vec![];
     for alpha in &arm.directions {
-        let (p, s) = optimum_pair(&arm.towards(*alpha), search, scene, stop);
-        if signals::requested() {
+        let Some(c) = compare(&arm.towards(*alpha), search, scene, stop) else {
             return fail(INTERRUPTED, "interrupted: nothing written");
-        }
-        let p = p.map_or(f64::NAN, |p| p.design.reach);
-        let (sr, err) = s.map_or((f64::NAN, String::new()), |s| {
-            (s.design.reach, mesh_error(&s.resolution))
-        });
-        println!(
-            "direction α = {:>6.1}°: planar R* = {p:.6}, spatial R* = {sr:.6} ({err}); gain {:+.3} %",
-            alpha.to_degrees(),
-            100.0 * (sr / p - 1.0)
-        );
-        directions.push((alpha.to_degrees(), p, sr));
+        };
+        compared.push(c);
     }
+    let directions: Vec<DirectionReach> = compared
+        .iter()
+        .map(|c| (c.alpha.to_degrees(), c.planar.0, c.spatial.0))
+        .collect();
     signals::set_mode(signals::Mode::Immediate);
     if let Some(out) = &run.loading_path {
         if let Some(d) = &diagram {
@@ -78,11 +73,15 @@ pub fn run_spatial(
         }
     }
     if let Some(out) = &run.output {
+        let study = cosserat::output::SpatialStudy {
+            optimum: &opt,
+            verdict: Some(&verdict),
+            directions: &compared,
+        };
         let written = cosserat::output::write_spatial_arm(
             out,
             &problem.text,
-            &opt,
-            Some(&verdict),
+            &study,
             RunState::Completed,
             true,
         );
@@ -103,6 +102,61 @@ pub fn run_spatial(
         println!("plotted   {}", out.display());
     }
     ExitCode::SUCCESS
+}
+
+/// The planar and spatial optima in the direction of `arm`, with their
+/// Richardson errors and the spatial optimum's loading path; None when
+/// interrupted.
+fn compare(
+    arm: &SpatialArm,
+    search: &SearchOptions,
+    scene: &ArmScene,
+    stop: &dyn Fn() -> bool,
+) -> Option<DirectionComparison> {
+    let (p, s) = optimum_pair(arm, search, scene, stop);
+    if signals::requested() {
+        return None;
+    }
+    let error = |r: &Resolution| r.study.error().unwrap_or(f64::NAN);
+    let planar = p.as_ref().map_or((f64::NAN, f64::NAN), |p| {
+        (
+            p.design.reach,
+            p.resolution.as_ref().map_or(f64::NAN, error),
+        )
+    });
+    let (spatial, verdict) = match &s {
+        Some(s) => (
+            (s.design.reach, error(&s.resolution)),
+            arm.loading_path(scene, s, stop).1,
+        ),
+        None => (
+            (f64::NAN, f64::NAN),
+            PathVerdict::Undecided("no spatial optimum".into()),
+        ),
+    };
+    if signals::requested() {
+        return None;
+    }
+    let extrapolated = |(r, e): (f64, f64)| r - e;
+    println!(
+        "direction α = {:>6.1}°: planar R* = {:.6} (error {:+.1e}), spatial R* = {:.6} ({}); \
+         gain {:+.3} % (extrapolated {:+.3} %); loading {}",
+        arm.planar.alpha.to_degrees(),
+        planar.0,
+        planar.1,
+        spatial.0,
+        s.as_ref()
+            .map_or(String::new(), |s| mesh_error(&s.resolution)),
+        100.0 * (spatial.0 / planar.0 - 1.0),
+        100.0 * (extrapolated(spatial) / extrapolated(planar) - 1.0),
+        verdict.name()
+    );
+    Some(DirectionComparison {
+        alpha: arm.planar.alpha,
+        planar,
+        spatial,
+        verdict,
+    })
 }
 
 /// The flags of planar studies only.

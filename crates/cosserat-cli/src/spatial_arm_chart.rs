@@ -52,8 +52,8 @@ impl Figure for SpatialChart<'_> {
             ),
             ("b) top view", "ŷ √(B₂/F)"),
         ];
-        self.projection(&areas[0], views[0], &side, o)?;
-        self.projection(&areas[1], views[1], &top, o)?;
+        projection(&areas[0], views[0], &side, o)?;
+        projection(&areas[1], views[1], &top, o)?;
         if panels == 3 {
             self.directions_panel(&areas[2])?;
         }
@@ -62,41 +62,6 @@ impl Figure for SpatialChart<'_> {
 }
 
 impl SpatialChart<'_> {
-    fn projection<DB: DrawingBackend>(
-        &self,
-        area: &Area<DB>,
-        (title, ylabel): (&str, &str),
-        view: &dyn Fn(&[f64; 3]) -> (f64, f64),
-        o: &SpatialOptimum,
-    ) -> Result<(), Failure>
-    where
-        DB::ErrorType: 'static,
-    {
-        let area = area.titled(title, ("sans-serif", crate::chart_style::TITLE_FONT))?;
-        let all: Vec<(f64, f64)> = o
-            .loaded_shape
-            .iter()
-            .chain(&o.unloaded_shape)
-            .map(view)
-            .chain(std::iter::once((0.0, 0.0)))
-            .collect();
-        let zs = padded(all.iter().map(|p| p.0));
-        let hs = padded(all.iter().map(|p| p.1));
-        let (mut chart, zs, hs) = shape_chart(&area, zs, hs, false)?;
-        draw_grid(
-            &mut chart,
-            "ẑ √(B₂/F)".to_string(),
-            ylabel.to_string(),
-            (zs.1 - zs.0, hs.1 - hs.0),
-        )?;
-        let loaded: Vec<(f64, f64)> = o.loaded_shape.iter().map(view).collect();
-        let unloaded: Vec<(f64, f64)> = o.unloaded_shape.iter().map(view).collect();
-        line(&mut chart, loaded, colour(0), Stroke::Solid, 3)?;
-        line(&mut chart, unloaded, colour(0), Stroke::Dashed, 2)?;
-        chart.draw_series(std::iter::once(Circle::new((0.0, 0.0), 5, BLACK.filled())))?;
-        frame(chart.plotting_area())
-    }
-
     fn directions_panel<DB: DrawingBackend>(&self, area: &Area<DB>) -> Result<(), Failure>
     where
         DB::ErrorType: 'static,
@@ -135,4 +100,39 @@ impl SpatialChart<'_> {
         )?;
         frame(chart.plotting_area())
     }
+}
+
+/// One projection of the loaded and unloaded centrelines, to scale.
+fn projection<DB: DrawingBackend>(
+    area: &Area<DB>,
+    (title, ylabel): (&str, &str),
+    view: &dyn Fn(&[f64; 3]) -> (f64, f64),
+    o: &SpatialOptimum,
+) -> Result<(), Failure>
+where
+    DB::ErrorType: 'static,
+{
+    let area = area.titled(title, ("sans-serif", crate::chart_style::TITLE_FONT))?;
+    let all: Vec<(f64, f64)> = o
+        .loaded_shape
+        .iter()
+        .chain(&o.unloaded_shape)
+        .map(view)
+        .chain(std::iter::once((0.0, 0.0)))
+        .collect();
+    let zs = padded(all.iter().map(|p| p.0));
+    let hs = padded(all.iter().map(|p| p.1));
+    let (mut chart, zs, hs) = shape_chart(&area, zs, hs, false)?;
+    draw_grid(
+        &mut chart,
+        "ẑ √(B₂/F)".to_string(),
+        ylabel.to_string(),
+        (zs.1 - zs.0, hs.1 - hs.0),
+    )?;
+    let loaded: Vec<(f64, f64)> = o.loaded_shape.iter().map(view).collect();
+    let unloaded: Vec<(f64, f64)> = o.unloaded_shape.iter().map(view).collect();
+    line(&mut chart, loaded, colour(0), Stroke::Solid, 3)?;
+    line(&mut chart, unloaded, colour(0), Stroke::Dashed, 2)?;
+    chart.draw_series(std::iter::once(Circle::new((0.0, 0.0), 5, BLACK.filled())))?;
+    frame(chart.plotting_area())
 }

@@ -38,7 +38,7 @@ pub use hdf5_output::{
     StabilityResult,
 };
 #[cfg(feature = "hdf5")]
-pub use spatial_arm_output::write_spatial_arm;
+pub use spatial_arm_output::{write_spatial_arm, SpatialStudy};
 #[cfg(feature = "hdf5")]
 pub use store::{StoreError, StoreResult};
 #[cfg(feature = "hdf5")]

@@ -39,7 +39,7 @@ pub use control_path::{
 pub use fig5::{ClosestStraight, ReachMap};
 pub use resolve::{MeshStudy, Resolution, Verdict, MAX_ELEMENTS, REACH_TOLERANCE};
 pub use scene::{ArmScene, ArmWeight};
-pub use spatial::{PathVerdict, SpatialArm, SpatialDesign, SpatialOptimum};
+pub use spatial::{DirectionComparison, PathVerdict, SpatialArm, SpatialDesign, SpatialOptimum};
 
 mod warm_start;
 

@@ -92,15 +92,16 @@ pub enum PathVerdict {
         /// |r_tip(1) − r_design(1)| / L.
         miss: f64,
     },
-    /// The path leaves the design: it loses stability or ends at
-    /// `parameter` < 1, or ends at λ = 1 on another equilibrium.
+    /// The path leaves the design: it loses stability or turns back at a
+    /// fold at `parameter` < 1, or ends at λ = 1 on another equilibrium.
     Misses {
-        /// The load factor where it lost stability or ended.
+        /// The load factor where it lost stability or turned back.
         parameter: f64,
         /// What happened.
         reason: String,
     },
-    /// Continuation failed: no answer either way.
+    /// Continuation failed or stopped short without a fold or a loss of
+    /// stability: no answer either way.
     Undecided(String),
 }
 
@@ -113,6 +114,19 @@ impl PathVerdict {
             PathVerdict::Undecided(_) => "undecided",
         }
     }
+}
+
+/// The planar and spatial optima in one direction (`arm.directions`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DirectionComparison {
+    /// α (rad).
+    pub alpha: f64,
+    /// Planar R* and its Richardson error (NaN: none found / undecided).
+    pub planar: (f64, f64),
+    /// Spatial R* and its Richardson error (NaN: none found / undecided).
+    pub spatial: (f64, f64),
+    /// The spatial optimum's loading path.
+    pub verdict: PathVerdict,
 }
 
 /// The reported spatial optimum.
@@ -208,6 +222,7 @@ impl SpatialArm {
     }
 
     /// This problem in the direction `alpha` (rad).
+    #[must_use]
     pub fn towards(&self, alpha: f64) -> SpatialArm {
         let mut a = self.clone();
         a.planar.alpha = alpha;
@@ -366,6 +381,7 @@ impl SpatialArm {
     }
 
     /// This problem on `elements` elements.
+    #[must_use]
     pub fn on_mesh(&self, elements: usize) -> SpatialArm {
         let mut a = self.clone();
         a.planar.stability = a
@@ -498,20 +514,27 @@ impl SpatialArm {
                 PathVerdict::Undecided("the designed rod could not be built".into()),
             );
         };
-        let family = Family::new(
-            rod,
-            Parameter::LoadScale,
-            ModelLevel::Kirchhoff,
-            32,
-            Tolerances::default(),
-        );
-        match continue_family(&self.planar, &family, stop) {
-            Ok(d) => {
-                let verdict = path_verdict(&d, optimum, scene);
-                (Some(d), verdict)
+        // A strongly curved unloaded arm can defeat the start's shooting on
+        // 32 segments; 64 and 128 are tried before the verdict is undecided.
+        let mut failure = String::new();
+        for segments in [32, 64, 128] {
+            let family = Family::new(
+                rod.clone(),
+                Parameter::LoadScale,
+                ModelLevel::Kirchhoff,
+                segments,
+                Tolerances::default(),
+            );
+            match continue_family(&self.planar, &family, stop) {
+                Ok(d) => {
+                    let verdict = path_verdict(&d, optimum, scene);
+                    return (Some(d), verdict);
+                }
+                Err(e @ ContinuationError::Start { .. }) => failure = path_error(&e),
+                Err(e) => return (None, PathVerdict::Undecided(path_error(&e))),
             }
-            Err(e) => (None, PathVerdict::Undecided(path_error(&e))),
         }
+        (None, PathVerdict::Undecided(failure))
     }
 }
 
@@ -542,24 +565,32 @@ fn path_verdict(d: &Diagram, optimum: &SpatialOptimum, scene: &ArmScene) -> Path
     let Some(last) = branch.points.last() else {
         return PathVerdict::Undecided("an empty branch".into());
     };
-    if last.parameter < 1.0 - 1e-6 {
-        let top = branch
-            .points
-            .iter()
-            .map(|p| p.parameter)
-            .fold(f64::NEG_INFINITY, f64::max);
-        let reason = if top > last.parameter {
-            format!(
-                "the path turns back at λ = {top:.4} (a fold) and ends at λ = {:.4}",
-                last.parameter
-            )
-        } else {
-            format!("the path ended at λ = {:.4}", last.parameter)
-        };
+    let top = branch
+        .points
+        .iter()
+        .map(|p| p.parameter)
+        .fold(f64::NEG_INFINITY, f64::max);
+    if last.parameter < 1.0 - 1e-6 && top > last.parameter + 1e-9 {
         return PathVerdict::Misses {
             parameter: top,
-            reason,
+            reason: format!(
+                "the path turns back at λ = {top:.4} (a fold) and ends at λ = {:.4}",
+                last.parameter
+            ),
         };
+    }
+    if last.parameter < 1.0 - 1e-6 {
+        // Stopped short without a fold or a loss of stability: the
+        // continuation gave up, which says nothing about the arm.
+        return PathVerdict::Undecided(format!(
+            "the continuation stopped at λ = {:.4} ({})",
+            last.parameter,
+            if d.warnings.is_empty() {
+                "no reason given".to_owned()
+            } else {
+                d.warnings.join("; ")
+            }
+        ));
     }
     let scale = scene.length(optimum.design.gamma);
     let tip = optimum
