@@ -583,8 +583,9 @@ fn path_verdict(d: &Diagram, optimum: &SpatialOptimum, scene: &ArmScene) -> Path
         // Stopped short without a fold or a loss of stability: the
         // continuation gave up, which says nothing about the arm.
         return PathVerdict::Undecided(format!(
-            "the continuation stopped at λ = {:.4} ({})",
+            "the continuation stopped at λ = {:.4} ({}; {})",
             last.parameter,
+            d.stop_reason.name(),
             if d.warnings.is_empty() {
                 "no reason given".to_owned()
             } else {
