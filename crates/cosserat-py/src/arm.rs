@@ -51,6 +51,13 @@ impl Interruption {
 fn arm_of(
     problem: &Problem,
 ) -> Result<(&ArmProblem, &SearchOptions, bool, &ArmScene, usize), Failure> {
+    if problem.arm_spatial.is_some() {
+        // The planar search would run silently in its place.
+        return Err(Failure::problem(
+            "arm.spatial",
+            "spatial arms run from the command line only (`cosserat optimize`)",
+        ));
+    }
     match (&problem.arm, &problem.arm_scene) {
         (Some((arm, search, straight)), Some((scene, samples))) => {
             Ok((arm, search, *straight, scene, *samples))
