@@ -247,6 +247,16 @@ fn bench_optimize(path: &Path, problem: &Problem, repeat: usize) -> Measured {
             ),
         ));
     }
+    if problem.arm_spatial.is_some() {
+        // The planar search would be timed silently in its place.
+        return Err(fail(
+            BAD_INPUT,
+            format!(
+                "{}: arm.spatial: bench optimize times planar arms only",
+                path.display()
+            ),
+        ));
+    }
     let (Some((arm, search, straight)), Some((scene, samples))) =
         (&problem.arm, &problem.arm_scene)
     else {

@@ -80,6 +80,9 @@ pub fn run_optimize(run: &OptimizeRun) -> ExitCode {
     if let Some(taper) = problem.arm_taper {
         return crate::taper_command::run_tapered(run, &problem, arm, search, taper);
     }
+    if let Some(spatial) = &problem.arm_spatial {
+        return crate::optimize_spatial::run_spatial(run, &problem, spatial, search, scene);
+    }
     let progress = match start_from(run, &problem, arm, scene) {
         Ok(p) => p,
         Err(code) => return code,

@@ -57,6 +57,13 @@ fn arm_of(
             "a tapered arm runs with `cosserat optimize` only (not yet in Python)",
         ));
     }
+    if problem.arm_spatial.is_some() {
+        // The planar search would run silently in its place.
+        return Err(Failure::problem(
+            "arm.spatial",
+            "spatial arms run from the command line only (`cosserat optimize`)",
+        ));
+    }
     match (&problem.arm, &problem.arm_scene) {
         (Some((arm, search, straight)), Some((scene, samples))) => {
             Ok((arm, search, *straight, scene, *samples))

@@ -8,7 +8,7 @@ use super::mesh::MeshKeys;
 use super::problem::{invalid, ProblemError};
 use crate::model::Rod;
 use crate::study::arm::taper::Taper;
-use crate::study::arm::{ArmProblem, ArmScene, ArmWeight, SearchOptions};
+use crate::study::arm::{ArmProblem, ArmScene, ArmWeight, SearchOptions, SpatialArm};
 
 /// `[arm]`.
 #[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
@@ -48,6 +48,24 @@ pub struct ArmSection {
     /// Halton samples of the reach map (the Fig. 5 data set); 0: none.
     #[serde(default)]
     pub map_samples: usize,
+    /// Spatial loaded shapes (issue 20): κ̄2 = φ' from `bounds`, κ̄1 and
+    /// κ̄3 from `bend_bounds` and `twist_bounds`, the roll about the chord
+    /// from `roll_bounds`; γ_crit of the full 3-D second variation.
+    #[serde(default)]
+    pub spatial: bool,
+    /// Bounds of the Taylor coefficients of κ̄1(s̄) (spatial; none: κ̄1 = 0).
+    #[serde(default, deserialize_with = "super::strict::vec")]
+    pub bend_bounds: Vec<[f64; 2]>,
+    /// Bounds of the Taylor coefficients of κ̄3(s̄) (spatial; none: κ̄3 = 0).
+    #[serde(default, deserialize_with = "super::strict::vec")]
+    pub twist_bounds: Vec<[f64; 2]>,
+    /// Bounds of the roll ψ (degrees) about the chord (spatial; absent: ψ = 0).
+    #[serde(default)]
+    pub roll_bounds: Option<[f64; 2]>,
+    /// Directions α (degrees) at which `optimize` also compares the planar
+    /// and spatial optima (spatial; empty: none).
+    #[serde(default)]
+    pub directions: Vec<f64>,
     /// A non-prismatic arm: the section profile optimized with the shape
     /// (`study::arm::taper`); absent: the prismatic arm.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -302,5 +320,88 @@ impl ArmSection {
             },
             self.straight,
         ))
+    }
+
+    /// The spatial arm of `[arm] spatial = true` (None without it), built
+    /// on the planar problem `planar`. The spatial keys without
+    /// `spatial = true`, and the planar-only keys with it (the actuator
+    /// limit, the reach map), are refused by name.
+    pub fn spatial_arm(
+        &self,
+        planar: &ArmProblem,
+        scene: &ArmScene,
+    ) -> Result<Option<SpatialArm>, ProblemError> {
+        if !self.spatial {
+            let given = [
+                ("arm.bend_bounds", !self.bend_bounds.is_empty()),
+                ("arm.twist_bounds", !self.twist_bounds.is_empty()),
+                ("arm.roll_bounds", self.roll_bounds.is_some()),
+                ("arm.directions", !self.directions.is_empty()),
+            ];
+            if let Some((key, _)) = given.iter().find(|(_, g)| *g) {
+                return Err(invalid(
+                    *key,
+                    "is a key of spatial arms: set arm.spatial = true",
+                ));
+            }
+            return Ok(None);
+        }
+        if scene.max_curvature.is_some() {
+            return Err(invalid(
+                "arm.max_curvature",
+                "the actuator limit is implemented for planar arms only (remove it or \
+                 arm.spatial)",
+            ));
+        }
+        if self.map_samples > 0 {
+            return Err(invalid(
+                "arm.map_samples",
+                "the reach map is of planar arms (c2, c3); use 0 with arm.spatial",
+            ));
+        }
+        let pairs = |key: &str, b: &[[f64; 2]]| -> Result<Vec<(f64, f64)>, ProblemError> {
+            b.iter()
+                .enumerate()
+                .map(|(i, [lo, hi])| {
+                    if lo.is_finite() && hi.is_finite() && lo < hi {
+                        Ok((*lo, *hi))
+                    } else {
+                        Err(invalid(
+                            format!("{key}[{i}]"),
+                            format!("need finite lo < hi, got [{lo}, {hi}]"),
+                        ))
+                    }
+                })
+                .collect()
+        };
+        let roll = match self.roll_bounds {
+            Some(b) => Some(pairs("arm.roll_bounds", &[b])?[0]),
+            None => None,
+        };
+        if let Some((lo, hi)) = roll {
+            if lo < -360.0 || hi > 360.0 {
+                return Err(invalid(
+                    "arm.roll_bounds",
+                    format!("the roll is an angle in degrees within [−360, 360], got [{lo}, {hi}]"),
+                ));
+            }
+        }
+        let directions = self
+            .directions
+            .iter()
+            .enumerate()
+            .map(|(i, a)| {
+                reach_direction(*a, planar.stability.elements())
+                    .map(f64::to_radians)
+                    .map_err(|e| invalid(format!("arm.directions[{i}]"), e.to_string()))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Some(SpatialArm {
+            directions,
+            planar: planar.clone(),
+            bend_bounds: pairs("arm.bend_bounds", &self.bend_bounds)?,
+            twist_bounds: pairs("arm.twist_bounds", &self.twist_bounds)?,
+            roll_bounds: roll.map(|(a, b)| (a.to_radians(), b.to_radians())),
+        }))
     }
 }

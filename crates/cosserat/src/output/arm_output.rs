@@ -178,7 +178,7 @@ fn write_design(g: &mut Group, o: &ArmOptimum) -> StoreResult<()> {
 }
 
 /// The discretization check of a design (`optimize::Resolution`).
-fn write_resolution(g: &mut Group, r: &Resolution) -> StoreResult<()> {
+pub(super) fn write_resolution(g: &mut Group, r: &Resolution) -> StoreResult<()> {
     let s = &r.study;
     let elements: Vec<u64> = s.elements.iter().map(|n| *n as u64).collect();
     g.counts("mesh_elements", &elements)?;

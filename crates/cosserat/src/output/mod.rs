@@ -17,6 +17,8 @@ mod hdf5_output;
 pub mod schema;
 pub mod seal;
 #[cfg(feature = "hdf5")]
+mod spatial_arm_output;
+#[cfg(feature = "hdf5")]
 pub mod store;
 #[cfg(feature = "hdf5")]
 mod sweep_output;
@@ -37,6 +39,8 @@ pub use hdf5_output::{
     check_target, read_solved, write_equilibrium, write_stability, OutputError, SolvedUnknowns,
     StabilityResult,
 };
+#[cfg(feature = "hdf5")]
+pub use spatial_arm_output::{write_spatial_arm, SpatialStudy};
 #[cfg(feature = "hdf5")]
 pub use store::{StoreError, StoreResult};
 #[cfg(feature = "hdf5")]

@@ -67,6 +67,17 @@ fn entry(parent: &str, name: &str) -> (&'static str, &'static str) {
         ("curve", "singularity") => ("1", "the test function along the curve"),
         ("curve", "cusps") => ("", "point indices of the cusps"),
         ("curve", "cusp_parameters") => ("as the two keys", "the two parameters at each cusp"),
+        // Spatial arms (`/spatial`).
+        ("spatial", "intrinsic_curvature") => ("1/m", "intrinsic curvature κ⁰(s) of the design, body components"),
+        ("spatial", "design") => ("1", "the searched design vector: c2..cM, κ̄1 and κ̄3 coefficients, roll"),
+        ("spatial", "bend_coefficients" | "bending_coefficients" | "twist_coefficients") => ("1", "Taylor coefficients of κ̄1, κ̄2, κ̄3 of the loaded shape (per rod length)"),
+        ("spatial", "roll") => ("rad", "roll of the clamp about the chord"),
+        ("spatial", "clamp_frame") => ("1", "clamp frame, columns d1(0), d2(0), d3(0)"),
+        ("directions", "alpha") => ("rad", "reach direction α above the horizontal"),
+        ("directions", "planar_reach" | "spatial_reach") => ("1", "R* per rod length of the planar or spatial optimum"),
+        ("directions", "planar_error" | "spatial_error") => ("1", "Richardson estimate of the mesh error of R* (NaN: undecided)"),
+        ("directions", "loading_path") => ("", "loading-path verdict of the spatial optimum: reaches, misses or undecided"),
+        ("spatial" | "directions", "loading_path_end") => ("1", "load factor (× design load) where the loading path ended or lost stability"),
         // Arm studies.
         (_, "curvature_coefficients" | "shape_coefficients") => ("1", "Taylor coefficients of the loaded shape (per rod length)"),
         (_, "gamma_crit") => ("1", "critical load factor γ = w L³/B of the design"),

@@ -116,7 +116,7 @@ impl FixedShape {
 }
 
 /// K0 (stiffness terms) and K1 (terms per unit load factor) coefficients.
-fn split_coefficients(
+pub(super) fn split_coefficients(
     rod: &Rod,
     samples: &[RodSample],
 ) -> (Vec<FormCoefficients>, Vec<FormCoefficients>) {

@@ -7,9 +7,11 @@
 
 pub use crate::numerics::{banded, constrained, eigen};
 mod fixed_shape;
+mod fixed_shape_spatial;
 mod second_variation;
 
 pub use fixed_shape::{critical_load, CriticalLoad, FixedShape};
+pub use fixed_shape_spatial::{critical_load_spatial, SpatialShape};
 pub use second_variation::{Block, FiniteElements, FormCoefficients};
 
 use nalgebra::{Matrix3, Vector3};

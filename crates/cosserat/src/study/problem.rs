@@ -8,7 +8,7 @@ use crate::bvp::SolverOptions;
 use crate::continuation::{ContinuationOptions, Family};
 use crate::model::{ModelChoice, Rod};
 use crate::stability::{FixedShape, StabilityOptions};
-use crate::study::arm::{ArmProblem, ArmScene, SearchOptions};
+use crate::study::arm::{ArmProblem, ArmScene, SearchOptions, SpatialArm};
 use crate::study::sweep::Sweep;
 
 /// A curve of singular points to follow: the two parameters, the second's
@@ -50,6 +50,8 @@ pub struct Problem {
     pub arm_scene: Option<(ArmScene, usize)>,
     /// `[arm] taper`: the section's design space of a tapered arm.
     pub arm_taper: Option<crate::study::arm::taper::Taper>,
+    /// `[arm] spatial = true`: the spatial arm (its planar part is `arm`).
+    pub arm_spatial: Option<SpatialArm>,
     /// The grid of a `[sweep]` table.
     pub sweep: Option<Sweep>,
     /// The keys of the later stages of a chained continuation

@@ -160,6 +160,25 @@ impl Problem {
             (Some(a), Some((p, _, _))) => a.taper(&rod, p)?,
             _ => None,
         };
+        let arm_spatial = match (&file.arm, &arm, &arm_scene) {
+            (Some(section), Some((planar, _, _)), Some((scene, _))) => {
+                section.spatial_arm(planar, scene)?
+            }
+            _ => None,
+        };
+        if arm_spatial.is_some() && arm_taper.is_some() {
+            return Err(invalid(
+                "arm.taper",
+                "tapered sections are optimized for planar arms only; remove arm.taper or \
+                 arm.spatial",
+            ));
+        }
+        if arm_spatial.is_some() && file.sweep.is_some() {
+            return Err(invalid(
+                "arm.spatial",
+                "a sweep runs planar arms only; remove [sweep] or arm.spatial",
+            ));
+        }
         let sweep = file.sweep.as_ref().map(SweepSection::build).transpose()?;
         let problem = Problem {
             rod,
@@ -173,6 +192,7 @@ impl Problem {
             arm,
             arm_scene,
             arm_taper,
+            arm_spatial,
             sweep,
             stage_keys: vec![],
         };

@@ -32,6 +32,7 @@ mod sampling;
 pub mod scene;
 pub mod taper;
 mod taper_arm;
+pub mod spatial;
 
 pub use control_path::{
     control_path, control_path_until, loading_path_in, loading_path_until, shape_holding_path,
@@ -41,6 +42,7 @@ pub use fig5::{ClosestStraight, ReachMap};
 pub use resolve::{MeshStudy, Resolution, Verdict, MAX_ELEMENTS, REACH_TOLERANCE};
 pub use scene::{ArmScene, ArmWeight};
 pub use taper_arm::{loading_verdict, LoadingVerdict, TaperedArm, TaperedOptimum};
+pub use spatial::{DirectionComparison, PathVerdict, SpatialArm, SpatialDesign, SpatialOptimum};
 
 mod warm_start;
 
