@@ -30,9 +30,9 @@ pub mod fig5;
 mod resolve;
 mod sampling;
 pub mod scene;
+pub mod spatial;
 pub mod taper;
 mod taper_arm;
-pub mod spatial;
 
 pub use control_path::{
     control_path, control_path_until, loading_path_in, loading_path_until, shape_holding_path,
@@ -41,8 +41,8 @@ pub use control_path::{
 pub use fig5::{ClosestStraight, ReachMap};
 pub use resolve::{MeshStudy, Resolution, Verdict, MAX_ELEMENTS, REACH_TOLERANCE};
 pub use scene::{ArmScene, ArmWeight};
-pub use taper_arm::{loading_verdict, LoadingVerdict, TaperedArm, TaperedOptimum};
 pub use spatial::{DirectionComparison, PathVerdict, SpatialArm, SpatialDesign, SpatialOptimum};
+pub use taper_arm::{loading_verdict, LoadingVerdict, TaperedArm, TaperedOptimum};
 
 mod warm_start;
 
