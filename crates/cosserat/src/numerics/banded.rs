@@ -142,6 +142,63 @@ impl SymmetricBanded {
     }
 }
 
+impl SymmetricBanded {
+    /// The number of negative pivots of the LDLᵀ factors of self + b·other
+    /// (the inertia of K − σG for b = −σ), as [`Self::ldlt`] counts them
+    /// and with the same zero-pivot test, without forming the sum or
+    /// storing L: row i needs only the rows i − bw … i − 1 of L, kept in a
+    /// ring of bw + 1 rows, so a Sturm count costs O(n·bw²) work in
+    /// O(bw²) memory (at 4·10⁵ unknowns the stored factors were 20 MB
+    /// written and read for one number).
+    pub fn shifted_negative_pivots(
+        &self,
+        b: f64,
+        other: &SymmetricBanded,
+    ) -> Result<usize, PivotBreakdown> {
+        assert_eq!(self.n, other.n, "sizes differ");
+        let (n, bw) = (self.n, self.bw.max(other.bw));
+        let entry = |i: usize, j: usize| self.get(i, j) + b * other.get(i, j);
+        let scale = (0..n)
+            .map(|i| entry(i, i).abs())
+            .fold(0.0, f64::max)
+            .max(f64::MIN_POSITIVE);
+        let rows = bw + 1;
+        // ring[(r % rows) * bw + (d − 1)] = L[r, r − d]; pivots[r % rows] = D_r.
+        let mut ring = vec![0.0; rows * bw.max(1)];
+        let mut pivots = vec![0.0; rows];
+        // u[d − 1] = L[i, i − d]·D_{i−d} of the current row.
+        let mut u = vec![0.0; bw.max(1)];
+        let mut negative = 0;
+        for i in 0..n {
+            let reach = bw.min(i);
+            for d in (1..=reach).rev() {
+                let j = i - d;
+                let row_j = (j % rows) * bw;
+                let mut v = entry(i, j);
+                // k = i − e for e = d + 1 ..= reach (columns left of j).
+                for e in d + 1..=reach {
+                    v -= u[e - 1] * ring[row_j + (e - d - 1)];
+                }
+                u[d - 1] = v;
+            }
+            let row_i = (i % rows) * bw;
+            let mut dii = entry(i, i);
+            for d in 1..=reach {
+                let dk = pivots[(i - d) % rows];
+                let lik = u[d - 1] / dk;
+                dii -= u[d - 1] * lik;
+                ring[row_i + d - 1] = lik;
+            }
+            if dii.abs() <= 1e3 * f64::EPSILON * scale || !dii.is_finite() {
+                return Err(PivotBreakdown { row: i });
+            }
+            pivots[i % rows] = dii;
+            negative += usize::from(dii < 0.0);
+        }
+        Ok(negative)
+    }
+}
+
 /// A = L D Lᵀ with L unit lower banded.
 #[derive(Debug, Clone)]
 pub struct BandedLdlt {
@@ -222,6 +279,16 @@ mod tests {
                 a.ldlt().unwrap().negative_pivots(),
                 negative,
                 "shift {shift}"
+            );
+            // The same shift as a pencil with the identity (bandwidth 0).
+            let mut unit = SymmetricBanded::zeros(30, 0);
+            for i in 0..30 {
+                unit.add(i, i, 1.0);
+            }
+            assert_eq!(
+                sample(30, 2, 0.0).shifted_negative_pivots(shift, &unit),
+                Ok(negative),
+                "count-only, shift {shift}"
             );
         }
     }
