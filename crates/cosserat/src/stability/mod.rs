@@ -6,6 +6,7 @@
 //! factor and λ_crit is a generalized eigenvalue (no root finder).
 
 pub use crate::numerics::{banded, constrained, eigen};
+pub mod factored;
 mod fixed_shape;
 mod second_variation;
 
