@@ -68,19 +68,43 @@ impl SymmetricBanded {
         self.data[k] += v;
     }
 
-    /// y = A x.
+    /// y = A x: each stored row of the lower band gives y_i its lower part
+    /// and scatters the mirrored upper part (slices, no per-entry index
+    /// checks: the Lanczos loop's most frequent product).
     pub fn matvec(&self, x: &[f64], y: &mut [f64]) {
-        for v in y.iter_mut() {
-            *v = 0.0;
-        }
-        for i in 0..self.n {
-            let row = &self.data[i * (self.bw + 1)..(i + 1) * (self.bw + 1)];
-            y[i] += row[0] * x[i];
-            for d in 1..=self.bw.min(i) {
-                y[i] += row[d] * x[i - d];
-                y[i - d] += row[d] * x[i];
+        assert!(x.len() == self.n && y.len() == self.n, "sizes differ");
+        y.fill(0.0);
+        for (i, row) in self.data.chunks_exact(self.bw + 1).enumerate() {
+            let reach = self.bw.min(i);
+            let xi = x[i];
+            let mut acc = row[0] * xi;
+            let lower = row[1..=reach].iter();
+            let (xs, ys) = (&x[i - reach..i], &mut y[i - reach..i]);
+            for ((a, xj), yj) in lower.zip(xs.iter().rev()).zip(ys.iter_mut().rev()) {
+                acc += a * xj;
+                *yj += a * xi;
             }
+            y[i] += acc;
         }
+    }
+
+    /// max_i Σ_j |A_ij|, the ∞-norm (rows of the band and their mirrored
+    /// upper parts in one pass).
+    pub fn row_sum_norm(&self) -> f64 {
+        let mut sums = vec![0.0; self.n];
+        for (i, row) in self.data.chunks_exact(self.bw + 1).enumerate() {
+            let reach = self.bw.min(i);
+            let lower = row[1..=reach]
+                .iter()
+                .zip(sums[i - reach..i].iter_mut().rev());
+            let mut own = row[0].abs();
+            for (a, upper) in lower {
+                own += a.abs();
+                *upper += a.abs();
+            }
+            sums[i] += own;
+        }
+        sums.into_iter().fold(0.0, f64::max)
     }
 
     /// xᵀ A y.
@@ -157,7 +181,15 @@ impl SymmetricBanded {
     ) -> Result<usize, PivotBreakdown> {
         assert_eq!(self.n, other.n, "sizes differ");
         let (n, bw) = (self.n, self.bw.max(other.bw));
-        let entry = |i: usize, j: usize| self.get(i, j) + b * other.get(i, j);
+        let same = self.bw == other.bw;
+        let entry = |i: usize, j: usize| {
+            if same {
+                let at = i * (bw + 1) + (i - j);
+                self.data[at] + b * other.data[at]
+            } else {
+                self.get(i, j) + b * other.get(i, j)
+            }
+        };
         let scale = (0..n)
             .map(|i| entry(i, i).abs())
             .fold(0.0, f64::max)
@@ -215,26 +247,30 @@ impl BandedLdlt {
         self.d.iter().filter(|&&v| v < 0.0).count()
     }
 
-    /// Solves A x = b in place.
-    #[allow(clippy::needless_range_loop)] // k indexes both b and the band
+    /// Solves A x = b in place: L y = b, D z = y, Lᵀ x = z, the rows of L
+    /// read as slices (no per-entry index checks; one solve per Lanczos
+    /// step).
     pub fn solve_in_place(&self, b: &mut [f64]) {
+        assert_eq!(b.len(), self.n, "sizes differ");
         let w = self.bw + 1;
-        for i in 0..self.n {
-            let mut v = b[i];
-            for k in i.saturating_sub(self.bw)..i {
-                v -= self.l[i * w + (i - k)] * b[k];
-            }
+        for (i, row) in self.l.chunks_exact(w).enumerate() {
+            let reach = self.bw.min(i);
+            let below = row[1..=reach].iter().zip(b[i - reach..i].iter().rev());
+            let v = b[i] - below.map(|(l, bk)| l * bk).sum::<f64>();
             b[i] = v;
         }
         for (bi, di) in b.iter_mut().zip(&self.d) {
             *bi /= di;
         }
-        for i in (0..self.n).rev() {
-            let mut v = b[i];
-            for k in i + 1..self.n.min(i + self.bw + 1) {
-                v -= self.l[k * w + (k - i)] * b[k];
+        // Lᵀ: x_i = z_i − Σ_k L[k, i] x_k over k > i, done as each x_i is
+        // known by scattering its column of Lᵀ (the row i of L) upwards.
+        for (i, row) in self.l.chunks_exact(w).enumerate().rev() {
+            let reach = self.bw.min(i);
+            let xi = b[i];
+            let above = row[1..=reach].iter().zip(b[i - reach..i].iter_mut().rev());
+            for (l, bk) in above {
+                *bk -= l * xi;
             }
-            b[i] = v;
         }
     }
 }
@@ -265,6 +301,10 @@ mod tests {
             .iter()
             .zip(dense.iter())
             .all(|(p, q)| (p - q).abs() < 1e-13));
+        let dense_norm = (0..40)
+            .map(|i| a.to_dense().row(i).iter().map(|v| v.abs()).sum::<f64>())
+            .fold(0.0, f64::max);
+        assert!((a.row_sum_norm() - dense_norm).abs() < 1e-13 * dense_norm);
         a.ldlt().unwrap().solve_in_place(&mut b);
         assert!(b.iter().zip(&x).all(|(p, q)| (p - q).abs() < 1e-11));
     }

@@ -25,7 +25,7 @@
 use nalgebra::DMatrix;
 
 use super::banded::SymmetricBanded;
-use super::eigen::{count_below, diagonal_ratio, row_sum_norm, Eigenpairs, Inertia};
+use super::eigen::{count_below, diagonal_ratio, dot, row_sum_norm, Eigenpairs, Inertia};
 
 /// Backward error every accepted pair meets, as the Lanczos of
 /// [`super::eigen`]; the eigenvalues, Rayleigh quotients, err by its
@@ -200,10 +200,6 @@ impl Ritz {
             vectors: self.v,
         }
     }
-}
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
 /// out = Σ_j s_j w_j.
