@@ -17,6 +17,7 @@
 //! (ε N²)² + ε N — below 1e-10 at 10⁵ elements.
 
 use super::second_variation::{Block, FiniteElements, FormCoefficients};
+use crate::numerics::eigen::Eigenpairs;
 
 /// vᵀKv from the factors: Σ_q w_q q(ω_q, ω'_q) for the block unknowns `v`
 /// and the coefficients at the quadrature points.
@@ -29,24 +30,22 @@ pub fn form(fe: &FiniteElements, coeffs: &[FormCoefficients], block: Block, v: &
         .sum()
 }
 
-/// vᵀGv from the factors: Σ_q w_q |ω_q|².
-pub fn gram(fe: &FiniteElements, block: Block, v: &[f64]) -> f64 {
-    fe.interpolate(block, v)
-        .iter()
-        .zip(fe.quadrature_weights())
-        .map(|((w, _), weight)| weight * w.norm_squared())
-        .sum()
-}
-
 /// The Rayleigh quotient vᵀKv / vᵀGv from the factors: an eigenvalue of
-/// (K, G) to second order in the error of its vector `v`.
+/// (K, G) to second order in the error of its vector `v` (one
+/// interpolation for both sums).
 pub fn rayleigh_quotient(
     fe: &FiniteElements,
     coeffs: &[FormCoefficients],
     block: Block,
     v: &[f64],
 ) -> f64 {
-    form(fe, coeffs, block, v) / gram(fe, block, v)
+    let (mut stiffness, mut metric) = (0.0, 0.0);
+    let points = fe.interpolate(block, v);
+    for (((w, dw), weight), c) in points.iter().zip(fe.quadrature_weights()).zip(coeffs) {
+        stiffness += weight * c.evaluate(w, dw);
+        metric += weight * w.norm_squared();
+    }
+    stiffness / metric
 }
 
 /// The load factor λ = −vᵀK0v / vᵀK1v of the pencil K0 + λK1 at its null
@@ -63,4 +62,25 @@ pub fn load_factor(
     let (stiffness, load) = (form(fe, coeffs.0, block, v), form(fe, coeffs.1, block, v));
     let lambda = -stiffness / load;
     (load < 0.0 && lambda.is_finite() && lambda > 0.0).then_some(lambda)
+}
+
+/// The pairs with each eigenvalue replaced by its Rayleigh quotient from
+/// the factors, in increasing order again (a cluster may swap by
+/// round-off).
+pub fn refined(
+    fe: &FiniteElements,
+    coeffs: &[FormCoefficients],
+    block: Block,
+    pairs: Eigenpairs,
+) -> Eigenpairs {
+    let mut all: Vec<(f64, Vec<f64>)> = pairs
+        .vectors
+        .into_iter()
+        .map(|v| (rayleigh_quotient(fe, coeffs, block, &v), v))
+        .collect();
+    all.sort_by(|a, b| a.0.total_cmp(&b.0));
+    Eigenpairs {
+        values: all.iter().map(|p| p.0).collect(),
+        vectors: all.into_iter().map(|p| p.1).collect(),
+    }
 }

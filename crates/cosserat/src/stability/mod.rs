@@ -169,7 +169,12 @@ pub fn block_spectrum(
 ) -> Result<BlockSpectrum, StabilityError> {
     let k = fe.stiffness(coeffs, block);
     let g = fe.mass(block);
-    let pairs = lowest_eigenpairs_constrained(&k, &g, constraints, count, None)?;
+    let pairs = factored::refined(
+        fe,
+        coeffs,
+        block,
+        lowest_eigenpairs_constrained(&k, &g, constraints, count, None)?,
+    );
     Ok(BlockSpectrum {
         block,
         eigenvalues: pairs.values,
