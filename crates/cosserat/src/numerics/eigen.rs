@@ -559,7 +559,7 @@ pub(super) fn lanczos(
         let done = j + 1 >= steps
             || exhausted
             || (j + 1 >= count + 4
-                && (j + 1) % 2 == 0
+                && (j + 1).is_multiple_of(2)
                 && converged(&alpha, &beta, b, count, &order));
         if done {
             break;
