@@ -15,7 +15,7 @@
 //! | output samples | `solver.output_points` | points × 3 S (the samples and the HDF5 write buffers) |
 //! | multiple shooting | `solver.segments` | 4 × 8 N², N = u + n (segments − 1) (dense Jacobian, its LU, Newton's copies) |
 //! | collocation | `solver.max_intervals` | 2 × 8 K (m²n² + 2mn² + 2mn + (m+1)n), K = max_intervals, m = stages (per interval: the condensed LU, its right-hand sides, the stage Jacobians; the old and the new mesh during adaptation) |
-//! | stability verdict | `stability.elements` | the finite elements below at 32 × elements (the verdict's finest mesh, [`crate::stability::REFINEMENTS`] doublings), eigenvalues + 1 |
+//! | stability verdict | `stability.elements` | the finite elements below at the verdict's finest mesh, max(2E, min(32E, [`crate::stability::MAX_VERDICT_ELEMENTS`])) for E = elements (its first comparison, then [`crate::stability::REFINEMENTS`] doublings up to the cap), eigenvalues + 1 |
 //! | continuation system | `continuation.intervals` (collocation) or `solver.segments` | 6 × 8 (N+1)², N the family's unknowns (dense F_x, the bordered matrix, its LU, the SVD at branch points) |
 //! | continuation points | `continuation.max_points` | points × branches × (8 (2N + 1 + 3k + 3 shape_points + measures) + S + 256), branches = (1 + both_directions)(1 + 6 k switch_depth) |
 //! | tracked spectrum | `continuation.elements` | the finite elements below at `continuation.elements`, plus the previous point's 3k eigenvectors |
@@ -25,10 +25,14 @@
 //!
 //! Finite elements of E elements of order p with k eigenvalues: n_fe = 3 E p
 //! unknowns over the blocks; 4 banded matrices (K, G, the LDLᵀ factor, a
-//! shifted copy) of n_fe × (3(p + 1)) numbers; the Lanczos basis and its
-//! G-image, 2 n_fe (3k + 40); and the shape at E (p + 1) quadrature points
-//! (a sample and the form coefficients, S + 216): 8 (4 · 3(p+1) +
-//! 2 (3k + 40)) n_fe + E (p + 1)(S + 216).
+//! shifted copy) of n_fe × (3(p + 1)) numbers; the Lanczos basis, n_fe
+//! (3k + 40) (Sturm counts store no factor, and the basis's G-image is not
+//! kept); and the shape at E (p + 1) quadrature points (a sample and the
+//! form coefficients, S + 216): 8 (4 · 3(p+1) + 3k + 40) n_fe +
+//! E (p + 1)(S + 216). Measured (issue 18, `/usr/bin/time -v`): the
+//! cantilever's verdict from 10⁵ elements (meshes 10⁵ and 2·10⁵) peaks at
+//! 601 MB resident, 3.0 KB per element of the finest mesh, where the
+//! formula gives 5.5 KB: an upper bound, as it must be.
 //!
 //! The total is the sum of the items (an upper bound: the phases of one
 //! run are not all alive at once). The budget is [`DEFAULT_BUDGET`] (4 GiB)
@@ -37,7 +41,7 @@
 
 use crate::bvp::{equations, Method};
 use crate::equations::RodSample;
-use crate::stability::REFINEMENTS;
+use crate::stability::{MAX_VERDICT_ELEMENTS, REFINEMENTS};
 
 use super::problem::{invalid, Problem, ProblemError};
 
@@ -93,7 +97,7 @@ fn finite_elements(elements: f64, order: f64, eigenvalues: f64) -> f64 {
     let n = 3.0 * elements * order;
     let band = 3.0 * (order + 1.0);
     let lanczos = 3.0 * eigenvalues + 40.0;
-    8.0 * (4.0 * band + 2.0 * lanczos) * n + elements * (order + 1.0) * (SAMPLE + 216.0)
+    8.0 * (4.0 * band + lanczos) * n + elements * (order + 1.0) * (SAMPLE + 216.0)
 }
 
 /// What a run of `problem` will allocate (module docs).
@@ -142,7 +146,9 @@ fn add_solver(e: &mut MemoryEstimate, problem: &Problem, n: f64, u: f64) {
 /// The stability verdict's finest mesh.
 fn add_stability(e: &mut MemoryEstimate, problem: &Problem) {
     let st = &problem.stability;
-    let finest = st.elements() as f64 * 2f64.powi(REFINEMENTS as i32);
+    let elements = st.elements() as f64;
+    let refined = (elements * 2f64.powi(REFINEMENTS as i32)).min(MAX_VERDICT_ELEMENTS as f64);
+    let finest = (2.0 * elements).max(refined);
     e.add(
         "stability.elements",
         finite_elements(finest, st.order() as f64, st.eigenvalues() as f64 + 1.0),

@@ -187,7 +187,7 @@ pub fn lowest_eigenpairs_constrained(
     if k.size() <= DENSE_LIMIT {
         return dense_constrained(k, g, c, count);
     }
-    let sigma = shift_below_constrained(k, g, c);
+    let sigma = shift_below_constrained(k, g, c, count);
     let bordered = Bordered::new(k, g, c, sigma)
         .ok_or_else(|| EigenError::NotDefinite(format!("K − σG is singular at σ = {sigma}")))?;
     let s_inv = bordered
@@ -213,8 +213,13 @@ pub fn lowest_eigenpairs_constrained(
 
 /// A shift below the constrained spectrum: [`shift_below`] on the
 /// constrained Sturm count.
-fn shift_below_constrained(k: &SymmetricBanded, g: &SymmetricBanded, c: &Constraints) -> f64 {
-    shift_below(diagonal_ratio(k, g), |s| {
+fn shift_below_constrained(
+    k: &SymmetricBanded,
+    g: &SymmetricBanded,
+    c: &Constraints,
+    wanted: usize,
+) -> f64 {
+    shift_below(diagonal_ratio(k, g), wanted, |s| {
         try_count_below_constrained(k, g, c, s).below()
     })
 }

@@ -123,8 +123,8 @@ pub fn count_below(k: &SymmetricBanded, g: &SymmetricBanded, sigma: f64) -> Iner
     let nudge = 1e-10 * diagonal_ratio(k, g);
     let mut s = sigma;
     for _ in 0..8 {
-        match k.combine(1.0, g, -s).ldlt() {
-            Ok(f) => return Inertia::Below(f.negative_pivots()),
+        match k.shifted_negative_pivots(-s, g) {
+            Ok(count) => return Inertia::Below(count),
             Err(PivotBreakdown { .. }) => s += nudge,
         }
     }
@@ -190,8 +190,8 @@ pub fn lowest_eigenpairs_near(
     } else {
         // Sturm bisection; should σ sit on an eigenvalue to round-off,
         // step further down.
-        let mut sigma = shift_below_spectrum(k, g);
-        let step = FLOOR * diagonal_ratio(k, g);
+        let mut sigma = shift_below_spectrum(k, g, count);
+        let step = 1e-8 * diagonal_ratio(k, g);
         let mut factored = positive(sigma);
         for _ in 0..8 {
             if factored.is_some() {
@@ -329,8 +329,6 @@ fn converged_lanczos(
     }
 }
 
-/// A shift σ < λ_1 close to λ_1: Sturm counts double outwards to bracket
-/// λ_1, then bisect.
 /// max |K_ii/G_ii|: the scale of the spectrum.
 pub(super) fn diagonal_ratio(k: &SymmetricBanded, g: &SymmetricBanded) -> f64 {
     (0..k.size())
@@ -338,36 +336,88 @@ pub(super) fn diagonal_ratio(k: &SymmetricBanded, g: &SymmetricBanded) -> f64 {
         .fold(1e-12, f64::max)
 }
 
-fn shift_below_spectrum(k: &SymmetricBanded, g: &SymmetricBanded) -> f64 {
-    shift_below(diagonal_ratio(k, g), |s| count_below(k, g, s).below())
+fn shift_below_spectrum(k: &SymmetricBanded, g: &SymmetricBanded, wanted: usize) -> f64 {
+    shift_below(diagonal_ratio(k, g), wanted, |s| {
+        count_below(k, g, s).below()
+    })
 }
 
-/// A shift σ < λ_1 close to λ_1, from Sturm counts `count(σ)` (None when
-/// undecidable, e.g. persistent zero pivots, which counts as "below" so
-/// that the shift errs on the safe side): counts double outwards to
-/// bracket λ_1, then bisect; `scale` is the spectrum's.
-pub(super) fn shift_below(scale: f64, count: impl Fn(f64) -> Option<usize>) -> f64 {
-    let none_below = |s: f64| count(s) == Some(0);
+/// A shift σ < λ_1 close to λ_1 relative to the `wanted` lowest
+/// eigenvalues, from Sturm counts `count(σ)` (None when undecidable, e.g.
+/// persistent zero pivots, which counts as "below" so that the shift errs
+/// on the safe side); `scale` is the spectrum's (max K_ii/G_ii).
+///
+/// Counts step outwards by factors of 4 from ±1e-6·scale until none lies
+/// below and more than `wanted` lie below (λ_{wanted+1} < top); then λ_1
+/// is bisected to 5 % of its size, and σ lies below it by 5 % of the
+/// bracket but at least [`FLOOR`]·(top − σ). Shift-invert Lanczos
+/// converges at the rate of the ratios (λ_i − σ)/(λ_{i+1} − σ), so σ must
+/// sit near the wanted eigenvalues, not near the spectrum's scale (∝ N²,
+/// which left σ ~1e-8·N² below λ_1: at 10⁵ elements 100 below a λ_1 of
+/// 4.7, and the Sturm bisection took 20 counts). Not closer to λ_1 than
+/// the floor: a shift on top of a (near) zero cluster, as at a
+/// bifurcation, makes the shifted operator lopsided — the Ritz value of
+/// λ_i carries the error ε (λ_i − σ)/(λ_1 − σ) relative, and the second
+/// copy of a double eigenvalue, found by deflation, is lost (Greenhill's
+/// double zero at 4π² failed that way with the floor tied to the wanted
+/// cluster alone, hence λ_{wanted+1}).
+pub(super) fn shift_below(scale: f64, wanted: usize, count: impl Fn(f64) -> Option<usize>) -> f64 {
+    let wanted = wanted.max(1) + 1;
     let mut lo = -1e-6 * scale;
-    while !none_below(lo) && lo > -1e6 * scale {
+    while count(lo) != Some(0) && lo > -1e6 * scale {
         lo *= 4.0;
     }
-    let mut hi = 1e-6 * scale;
-    while none_below(hi) && hi < 1e6 * scale {
-        hi *= 4.0;
-    }
-    let (lo, hi) = crate::numerics::scalar::bisect(lo, hi, 60, none_below, |lo, hi| {
-        hi - lo <= (0.05 * (hi.abs() + lo.abs())).max(FLOOR * scale)
-    });
-    // Not closer to λ_1 than FLOOR·scale: a shift on top of a (near) zero
-    // eigenvalue, as at a bifurcation, would make the shifted operator so
-    // lopsided that the other Ritz pairs lose their accuracy.
-    lo - (0.05 * (hi - lo)).max(FLOOR * scale)
+    // Upwards until `wanted` (one more than asked) lie below; the first point with any below
+    // brackets λ_1, and any point with none below raises `lo`.
+    let mut probe = 1e-6 * scale;
+    let mut first = None;
+    let top = loop {
+        let c = count(probe);
+        if c == Some(0) {
+            lo = lo.max(probe);
+        } else if first.is_none() {
+            first = Some(probe);
+        }
+        if c.is_some_and(|c| c >= wanted) || probe >= 1e6 * scale {
+            break probe;
+        }
+        probe *= 4.0;
+    };
+    let hi = first.unwrap_or(top);
+    let top = std::cell::Cell::new(top);
+    let none_below = |s: f64| {
+        let c = count(s);
+        if c.is_some_and(|c| c >= wanted) {
+            top.set(top.get().min(s));
+        }
+        c == Some(0)
+    };
+    let floor = |lo: f64| (FLOOR * (top.get() - lo)).max(1e-14 * scale);
+    // Bisection in t = asinh(σ/s0): linear within s0 of zero, logarithmic
+    // beyond, so a bracket of ±1e-6·scale closes on a λ_1 of order one in
+    // ~10 counts instead of ~20.
+    let s0 = 1e-12 * scale;
+    let (to_t, to_s) = (|s: f64| (s / s0).asinh(), |t: f64| s0 * t.sinh());
+    let (t_lo, t_hi) = crate::numerics::scalar::bisect(
+        to_t(lo),
+        to_t(hi),
+        80,
+        |t| none_below(to_s(t)),
+        |a, b| {
+            let (lo, hi) = (to_s(a), to_s(b));
+            hi - lo <= (0.05 * (hi.abs() + lo.abs())).max(floor(lo))
+        },
+    );
+    // The ends mapped back may differ from the counted ones by an ulp,
+    // far less than the margin below.
+    let (lo, hi) = (to_s(t_lo), to_s(t_hi));
+    lo - (0.05 * (hi - lo)).max(floor(lo))
 }
 
 /// The closest a shift comes to the lowest eigenvalue, relative to the
-/// largest diagonal ratio K_ii/G_ii.
-const FLOOR: f64 = 1e-8;
+/// distance from the shift to an upper bound of the first eigenvalue past
+/// the wanted ones.
+const FLOOR: f64 = 1e-4;
 
 /// Checks the backward error ‖Kv − λGv‖ / ((‖K‖ + |λ|‖G‖)‖v‖) ≤ 1e-8
 /// for every pair (norms: max row sums).
@@ -414,15 +464,27 @@ pub(super) fn verify_with(
 }
 
 pub(super) fn row_sum_norm(a: &SymmetricBanded) -> f64 {
-    let n = a.size();
-    let bw = a.bandwidth();
-    (0..n)
-        .map(|i| {
-            (i.saturating_sub(bw)..n.min(i + bw + 1))
-                .map(|j| a.get(i, j).abs())
-                .sum::<f64>()
-        })
-        .fold(0.0, f64::max)
+    a.row_sum_norm()
+}
+
+/// xᵀy with four partial sums: a single running sum waits on each add's
+/// latency, four keep the adder busy (the dot products of the Lanczos
+/// reorthogonalization are most of its time at large N).
+pub(super) fn dot(x: &[f64], y: &[f64]) -> f64 {
+    let (xs, ys) = (x.chunks_exact(4), y.chunks_exact(4));
+    let tail: f64 = xs
+        .remainder()
+        .iter()
+        .zip(ys.remainder())
+        .map(|(a, b)| a * b)
+        .sum();
+    let mut acc = [0.0; 4];
+    for (a, b) in xs.zip(ys) {
+        for k in 0..4 {
+            acc[k] += a[k] * b[k];
+        }
+    }
+    (acc[0] + acc[1]) + (acc[2] + acc[3]) + tail
 }
 
 /// Lanczos on an operator self-adjoint in the `metric` inner product, with
@@ -440,7 +502,6 @@ pub(super) fn lanczos(
     order: impl Fn(f64, f64) -> std::cmp::Ordering,
 ) -> Eigenpairs {
     let steps = n.saturating_sub(locked.len()).min(steps).max(1);
-    let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
     let m_locked: Vec<Vec<f64>> = locked
         .iter()
         .map(|l| {
@@ -455,8 +516,8 @@ pub(super) fn lanczos(
             w.iter_mut().zip(l).for_each(|(a, b)| *a -= c * b);
         }
     };
-    // q_j and M q_j, so that every inner product is a plain dot product.
-    let (mut q, mut mq): (Vec<Vec<f64>>, Vec<Vec<f64>>) = (vec![], vec![]);
+    // The basis q_j alone: inner products with it are taken against M w.
+    let mut q: Vec<Vec<f64>> = Vec::new();
     let (mut alpha, mut beta) = (Vec::new(), Vec::new());
     // A deterministic start vector with components along every mode.
     let mut v: Vec<f64> = (0..n)
@@ -474,18 +535,20 @@ pub(super) fn lanczos(
     }
     let mut w = vec![0.0; n];
     let mut mw = vec![0.0; n];
+    let mut coefficients = Vec::new();
     loop {
         let j = q.len();
         q.push(v.clone());
-        mq.push(mv.clone());
         apply(&q[j], &mut w);
-        alpha.push(dot(&mq[j], &w));
+        alpha.push(dot(&mv, &w));
+        // Classical Gram–Schmidt twice ("twice is enough": Giraud et al.,
+        // Numer. Math. 101, 2005), as accurate as the modified process
+        // and reading each basis vector twice per pass instead of four
+        // times (the basis is the memory traffic of a long run).
         for _ in 0..2 {
             deflate(&mut w);
-            for (qi, mqi) in q.iter().zip(&mq) {
-                let c = dot(mqi, &w);
-                w.iter_mut().zip(qi).for_each(|(a, b)| *a -= c * b);
-            }
+            metric.matvec(&w, &mut mw);
+            project_out(&q, &mw, &mut w, &mut coefficients);
         }
         metric.matvec(&w, &mut mw);
         // wᵀMw ≥ 0 for the positive definite metric M; a negative value is
@@ -496,7 +559,7 @@ pub(super) fn lanczos(
         let done = j + 1 >= steps
             || exhausted
             || (j + 1 >= count + 4
-                && (j + 1) % 4 == 0
+                && (j + 1).is_multiple_of(2)
                 && converged(&alpha, &beta, b, count, &order));
         if done {
             break;
@@ -525,6 +588,32 @@ pub(super) fn lanczos(
     Eigenpairs {
         values: pairs.iter().map(|p| p.0).collect(),
         vectors: pairs.into_iter().map(|p| p.1).collect(),
+    }
+}
+
+/// w ← w − Σ_i c_i q_i with c_i = q_iᵀ(M w) given `mw` = M w: one
+/// classical Gram–Schmidt pass in the metric M, over blocks of the vectors
+/// so that the block of `mw` or `w` stays in cache while every q_i passes.
+fn project_out(q: &[Vec<f64>], mw: &[f64], w: &mut [f64], c: &mut Vec<f64>) {
+    const BLOCK: usize = 1024;
+    c.clear();
+    c.resize(q.len(), 0.0);
+    for start in (0..w.len()).step_by(BLOCK) {
+        let end = (start + BLOCK).min(w.len());
+        let block = &mw[start..end];
+        for (ci, qi) in c.iter_mut().zip(q) {
+            *ci += dot(&qi[start..end], block);
+        }
+    }
+    for start in (0..w.len()).step_by(BLOCK) {
+        let end = (start + BLOCK).min(w.len());
+        let block = &mut w[start..end];
+        for (ci, qi) in c.iter().zip(q) {
+            block
+                .iter_mut()
+                .zip(&qi[start..end])
+                .for_each(|(a, b)| *a -= ci * b);
+        }
     }
 }
 

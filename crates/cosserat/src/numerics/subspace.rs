@@ -25,7 +25,7 @@
 use nalgebra::DMatrix;
 
 use super::banded::SymmetricBanded;
-use super::eigen::{count_below, diagonal_ratio, row_sum_norm, Eigenpairs, Inertia};
+use super::eigen::{count_below, diagonal_ratio, dot, row_sum_norm, Eigenpairs, Inertia};
 
 /// Backward error every accepted pair meets, as the Lanczos of
 /// [`super::eigen`]; the eigenvalues, Rayleigh quotients, err by its
@@ -72,9 +72,15 @@ pub fn lowest_eigenpairs_from(
         g.matvec(w, gw);
     }
     ritz.project()?;
+    // Below θ₁ by half its gap, never closer than 1e-6 of the wanted
+    // spread (as [`super::eigen::shift_below`]: not 1e-8 of the spectrum's
+    // scale ∝ N², which at 10⁵ elements put σ far below every wanted
+    // eigenvalue and stalled the sweeps).
+    let spread = ritz.values[p - 1] - ritz.values[0];
     let margin = (0.5 * (ritz.values[1] - ritz.values[0]))
         .max(1e-3 * ritz.values[0].abs())
-        .max(1e-8 * scale);
+        .max(1e-6 * spread)
+        .max(1e-14 * scale);
     let sigma = ritz.values[0] - margin;
     let shifted = k.combine(1.0, g, -sigma).ldlt().ok()?;
     if shifted.negative_pivots() != 0 {
@@ -102,7 +108,7 @@ pub fn lowest_eigenpairs_from(
         let last = error;
         error = ritz.backward_error(count, norms);
         if error <= ACCEPT && (error <= TOLERANCE || error > 0.1 * last) {
-            return certified(k, g, count, ritz.into_pairs(), scale);
+            return certified(k, g, count, ritz.into_pairs(), error * scale);
         }
     }
     None
@@ -196,10 +202,6 @@ impl Ritz {
     }
 }
 
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x * y).sum()
-}
-
 /// out = Σ_j s_j w_j.
 fn combine(w: &[Vec<f64>], s: &[f64], out: &mut [f64]) {
     out.fill(0.0);
@@ -210,17 +212,21 @@ fn combine(w: &[Vec<f64>], s: &[f64], out: &mut [f64]) {
 
 /// The pairs, if exactly `count` eigenvalues lie below τ halfway between
 /// λ_count and the next Ritz value (which bounds λ_{count+1} from above),
-/// and the half gap is well above the pairs' error.
+/// and the half gap is well above the pairs' error `bound`: a backward
+/// error β bounds |λ − θ| by ‖r‖_{G⁻¹} ≲ β·max K_ii/G_ii (the residual
+/// measured against ‖K‖ ∝ 1/h and G ∝ h). The bound used to be 1e-9 of the
+/// scale whatever the pairs' accuracy, ∝ N²: at 10⁵ elements a half gap of
+/// 175 that no warm start met.
 fn certified(
     k: &SymmetricBanded,
     g: &SymmetricBanded,
     count: usize,
     pairs: Eigenpairs,
-    scale: f64,
+    bound: f64,
 ) -> Option<Eigenpairs> {
     let (last, next) = (pairs.values[count - 1], pairs.values[count]);
     let tau = 0.5 * (last + next);
-    if tau - last <= 1e-9 * scale {
+    if tau - last <= 10.0 * bound {
         return None;
     }
     (count_below(k, g, tau) == Inertia::Below(count)).then_some(pairs)

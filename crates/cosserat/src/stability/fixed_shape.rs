@@ -12,6 +12,7 @@
 use nalgebra::{Matrix3, Vector3};
 
 use super::eigen::smallest_positive_load_factor;
+use super::factored;
 use super::second_variation::{Block, FiniteElements, FormCoefficients};
 use super::{StabilityError, StabilityOptions};
 use crate::equations::RodSample;
@@ -176,7 +177,10 @@ pub fn critical_load(
         let (k0, k1) = (fe.stiffness(&c0, block), fe.stiffness(&c1, block));
         let found = smallest_positive_load_factor(&k0, &k1)?;
         let (lambda, mode) = match found {
-            Some((l, v)) => (Some(l), fe.nodal_rotations(block, &v)),
+            Some((l, v)) => (
+                Some(factored::load_factor(&fe, (&c0, &c1), block, &v).unwrap_or(l)),
+                fe.nodal_rotations(block, &v),
+            ),
             None => (None, vec![]),
         };
         blocks.push((block, lambda, mode));

@@ -396,9 +396,9 @@ impl FiniteElements {
         let (xs, _) = gauss(self.order + 1);
         let (p, h) = (self.order, self.h());
         let mut out = Vec::with_capacity(self.elements * xs.len());
+        let shapes: Vec<_> = xs.iter().map(|&x| self.shape(x)).collect();
         for e in 0..self.elements {
-            for &x in &xs {
-                let (val, der) = self.shape(x);
+            for (val, der) in &shapes {
                 let mut w = Vector3::zeros();
                 let mut dw = Vector3::zeros();
                 for a in 0..=p {
