@@ -11,7 +11,9 @@ use std::cell::Cell;
 use std::path::Path;
 
 use cosserat::input::Problem;
-use cosserat::study::arm::{ArmOptimum, ArmProblem, ArmScene, SearchOptions, SearchProgress};
+use cosserat::study::arm::{
+    ArmOptimum, ArmProblem, ArmScene, MeshStudy, SearchOptions, SearchProgress,
+};
 
 /// The Fig. 5 arm of problems/longest_arm_fig5.toml with a short search.
 fn fig5_arm() -> (ArmProblem, ArmScene, SearchOptions) {
@@ -113,4 +115,62 @@ fn resumed_search_ends_on_the_uninterrupted_optimum() {
         );
     }
     assert!(interruptions >= 4, "only {interruptions} runs interrupted");
+}
+
+/// Richardson's limit of a sequence with a known limit: R_N = R∞ + C N⁻² +
+/// D N⁻⁴ (the form of a conforming element's eigenvalue error). The limit
+/// is within the stated bound of R∞, and the bound is below the finest
+/// mesh's own error.
+#[test]
+fn converged_reach_of_a_known_sequence() {
+    let (limit, c, d) = (3.7, 0.6, 50.0);
+    let at = |n: usize| limit + c / (n as f64).powi(2) + d / (n as f64).powi(4);
+    let study = MeshStudy {
+        elements: [100, 200, 400],
+        reach: [at(100), at(200), at(400)],
+        local_optima: false,
+    };
+    let (extrapolated, bound) = study.converged().expect("geometric differences");
+    assert!(
+        (extrapolated - limit).abs() <= bound,
+        "{extrapolated} ± {bound}"
+    );
+    assert!(bound <= (at(400) - limit).abs() * 1.01, "bound {bound}");
+    // Differences that do not shrink give no limit (undecided, not a value).
+    let stalled = MeshStudy {
+        reach: [3.0, 3.1, 3.0],
+        ..study
+    };
+    assert_eq!(stalled.converged(), None);
+}
+
+/// On the arm: the limit from 25, 50 and 100 elements against the design's
+/// reach on 1600 elements (an independent, finer computation): they agree
+/// within the stated bound plus the 1600-element value's own error (≤ the
+/// 100-element error / 256 at order 2).
+#[test]
+#[cfg_attr(debug_assertions, ignore = "1600-element critical loads: release only")]
+fn converged_reach_agrees_with_a_fine_mesh() {
+    let (arm, scene, _) = fig5_arm();
+    let on = |elements: usize| {
+        let mut a = arm.clone();
+        a.stability = a.stability.with_elements(elements).expect("a valid mesh");
+        a
+    };
+    let coarse = on(25);
+    let design = (1..)
+        .find_map(|i| coarse.design_in(&scene, &coarse.sample_point(i)))
+        .expect("a feasible sample");
+    let (study, _) = coarse.mesh_study(&scene, &design, 0);
+    let (limit, bound) = study.converged().expect("the order is measured");
+    let fine = on(1600)
+        .design_in(&scene, &design.shape_coefficients[1..])
+        .expect("the design is feasible on the fine mesh")
+        .reach;
+    let fine_error = (study.reach[2] - limit).abs() / 256.0;
+    assert!(
+        (limit - fine).abs() <= bound + fine_error,
+        "limit {limit} ± {bound} against {fine} on 1600 elements (study {:?})",
+        study.reach
+    );
 }
