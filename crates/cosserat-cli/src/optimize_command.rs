@@ -474,6 +474,17 @@ fn report_mesh(opt: &ArmOptimum) {
         s.elements[2],
         r.verdict.name()
     );
+    if let Some((limit, bound)) = s.converged() {
+        // Digits down to the bound's: every printed digit is converged.
+        let digits = (-bound.max(f64::EPSILON * limit.abs()).log10())
+            .floor()
+            .clamp(0.0, 15.0);
+        println!(
+            "          R*(N → ∞) = {limit:.0$} ± {bound:.1e} (Richardson at the measured order; \
+             ± the finest mesh's estimated error)",
+            digits as usize
+        );
+    }
     if s.local_optima {
         println!("          (on the finer meshes: the optima near the design, infeasible there)");
     }

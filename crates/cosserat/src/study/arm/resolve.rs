@@ -63,6 +63,23 @@ impl MeshStudy {
         Some(self.reach[0] - self.error()?)
     }
 
+    /// The mesh-converged reach with a bound on its error: (R̂_∞, e) with
+    /// R̂_∞ Richardson's extrapolation at the measured order and
+    /// e = |R̂_4N − R̂_∞|, the estimated error of the finest mesh's value.
+    ///
+    /// Three meshes measure the order, so they cannot also measure the
+    /// error of R̂_∞ (the extrapolations from (N, 2N) and from (2N, 4N) at
+    /// the measured order are the same number). Richardson's value removes
+    /// the leading term C N^−p; what is left is of higher order and, in the
+    /// asymptotic range the geometric differences attest, smaller than that
+    /// term on the finest mesh. So e is an estimated bound on the error of
+    /// R̂_∞, a conservative one: it is the estimated error of R̂_4N itself.
+    /// None with the order.
+    pub fn converged(&self) -> Option<(f64, f64)> {
+        let limit = self.extrapolated()?;
+        Some((limit, (self.reach[2] - limit).abs()))
+    }
+
     /// Whether R̂_N is resolved to `tolerance` (relative): the three values
     /// agree to it and, where the order is measured, so does the estimated
     /// error. A NaN (no critical load on a finer mesh) never agrees.

@@ -3,6 +3,14 @@
 //! (argmin) from the best few (the polish) on the cost −R̂, points outside
 //! the box projected into it and charged their squared distance; with the
 //! progress kept so that an interrupted search can be resumed.
+//!
+//! Samples and polishes run in parallel (rayon), each on its own data, and
+//! are folded in their sequence order: the optimum is the same bit for bit
+//! on any number of threads, and the same as a resumed run's.
+
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::OnceLock;
+use std::time::Duration;
 
 use argmin::core::{CostFunction, Error as ArgminError, Executor, State};
 use argmin::solver::neldermead::NelderMead;
@@ -91,16 +99,27 @@ impl ArmProblem {
     ) -> (Option<ArmOptimum>, SearchProgress, bool) {
         let keep = opts.starts.max(1);
         while progress.samples_done < opts.samples && !stop() {
-            let i = progress.samples_done + 1;
-            let p = self.sample_point(i);
-            progress.evaluations += 1;
-            if let Some(d) = self.design_in(scene, &p) {
-                let at = progress.leaders.partition_point(|(r, _)| *r >= d.reach);
-                progress.leaders.insert(at, (d.reach, p));
-                progress.leaders.truncate(keep);
+            let first = progress.samples_done + 1;
+            let count = SAMPLE_BATCH.min(opts.samples - progress.samples_done);
+            let reaches = in_parallel(count, stop, |k, _| {
+                let p = self.sample_point(first + k);
+                Some(self.design_in(scene, &p).map(|d| d.reach))
+            });
+            // In sample order, so that the leaders (ties included) are those
+            // of a sequential run, whatever the threads did first.
+            for (k, reach) in reaches.into_iter().enumerate() {
+                let Some(reach) = reach else { break };
+                progress.evaluations += 1;
+                if let Some(r) = reach {
+                    let at = progress.leaders.partition_point(|(q, _)| *q >= r);
+                    progress
+                        .leaders
+                        .insert(at, (r, self.sample_point(first + k)));
+                    progress.leaders.truncate(keep);
+                }
+                progress.samples_done = first + k;
+                checkpoint(&progress);
             }
-            progress.samples_done = i;
-            checkpoint(&progress);
         }
         if self.bounds.is_empty() {
             let optimum = self
@@ -115,20 +134,29 @@ impl ArmProblem {
                 .and_then(|(_, p)| self.design_in(scene, p));
         }
         let starts = opts.starts.min(progress.leaders.len());
-        while progress.polishes_done < starts && !stop() {
-            let start = progress.leaders[progress.polishes_done].1.clone();
-            let (design, used) = self.polish(scene, &start, opts.iterations, stop);
-            if stop() {
-                break;
-            }
-            progress.evaluations += used;
-            if let Some(d) = design {
-                if progress.best.as_ref().is_none_or(|b| d.reach > b.reach) {
-                    progress.best = Some(d);
+        if progress.polishes_done < starts && !stop() {
+            let first = progress.polishes_done;
+            let leaders = &progress.leaders;
+            let polished = in_parallel(starts - first, stop, |k, halt| {
+                let start = &leaders[first + k].1;
+                let halted = || halt.load(Ordering::Relaxed);
+                let result = self.polish(scene, start, opts.iterations, &halted);
+                // A polish that ran into a stop is redone on resumption.
+                (!halted()).then_some(result)
+            });
+            // Folded in start order (the first of equal reaches kept), as a
+            // sequential run does.
+            for result in polished {
+                let Some((design, used)) = result else { break };
+                progress.evaluations += used;
+                if let Some(d) = design {
+                    if progress.best.as_ref().is_none_or(|b| d.reach > b.reach) {
+                        progress.best = Some(d);
+                    }
                 }
+                progress.polishes_done += 1;
+                checkpoint(&progress);
             }
-            progress.polishes_done += 1;
-            checkpoint(&progress);
         }
         let optimum = self.best_so_far(scene, &progress);
         (optimum, progress, stop())
@@ -288,5 +316,64 @@ impl CostFunction for &ReachCost<'_> {
             .design_in(self.scene, &q)
             .map_or(0.0, |d| d.reach);
         Ok(-reach + outside)
+    }
+}
+
+/// Samples evaluated between two looks at the stop test and checkpoints.
+const SAMPLE_BATCH: usize = 64;
+
+/// `job(k, halt)` for k = 0..count on rayon's threads, the results in k
+/// order; `None` for a job that `stop()` cut short (it returned `None`
+/// after seeing `halt`, or never started).
+///
+/// `stop` is the caller's test and need not be `Sync` (a Python or sweep
+/// interrupt lives on its own thread), so only the calling thread calls it:
+/// it polls `stop()` between running queued jobs itself
+/// (`rayon::yield_now`: on a one-thread pool it runs them all) and raises
+/// `halt`, which the jobs read.
+fn in_parallel<T, F>(count: usize, stop: &dyn Fn() -> bool, job: F) -> Vec<Option<T>>
+where
+    T: Send + Sync,
+    F: Fn(usize, &AtomicBool) -> Option<T> + Sync,
+{
+    let halt = AtomicBool::new(false);
+    let done = AtomicUsize::new(0);
+    let slots: Vec<OnceLock<Option<T>>> = (0..count).map(|_| OnceLock::new()).collect();
+    rayon::in_place_scope(|scope| {
+        for (k, slot) in slots.iter().enumerate() {
+            let (halt, done, job) = (&halt, &done, &job);
+            scope.spawn(move |_| {
+                // Counted even when the job panics (the scope re-raises it),
+                // so that the polling below ends.
+                let _finished = Finished(done);
+                let result = if halt.load(Ordering::Relaxed) {
+                    None
+                } else {
+                    job(k, halt)
+                };
+                let _ = slot.set(result);
+            });
+        }
+        while done.load(Ordering::Acquire) < count {
+            if !halt.load(Ordering::Relaxed) && stop() {
+                halt.store(true, Ordering::Relaxed);
+            }
+            if rayon::yield_now() != Some(rayon::Yield::Executed) {
+                std::thread::sleep(Duration::from_micros(200));
+            }
+        }
+    });
+    slots
+        .into_iter()
+        .map(|slot| slot.into_inner().flatten())
+        .collect()
+}
+
+/// Counts a job as finished when dropped.
+struct Finished<'a>(&'a AtomicUsize);
+
+impl Drop for Finished<'_> {
+    fn drop(&mut self) {
+        self.0.fetch_add(1, Ordering::Release);
     }
 }
