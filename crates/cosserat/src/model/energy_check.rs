@@ -22,6 +22,14 @@
 //! Hessian (the coupling blocks H_κν included) against ∇W, ∂(H v)/∂z
 //! against H v, the s-rates, H symmetric and positive definite (strong
 //! ellipticity: no material instability in shear and extension either).
+//!
+//! Frame indifference needs no check: W is a function of the body strains
+//! κ = axial(RᵀR') and ν = Rᵀr', which a superposed rigid motion
+//! (R, r) → (QR, Qr + c) leaves unchanged, so every energy the trait can
+//! express is objective by construction (Antman, *Nonlinear Problems of
+//! Elasticity*, 2nd ed., §8.2). What an energy can claim wrongly are its
+//! material symmetries, and those are checked: the planar claim and the
+//! evenness per strain component (`StoredEnergy::even_components`).
 
 use nalgebra::{Matrix3, Matrix6, Vector3, Vector6};
 
