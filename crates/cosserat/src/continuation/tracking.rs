@@ -11,6 +11,8 @@
 //! the first point of a branch, on a constrained pencil, and where the warm
 //! start cannot vouch for its pairs.
 
+use std::cell::RefCell;
+
 use nalgebra::Vector3;
 
 use super::family::{Family, PointError};
@@ -67,6 +69,11 @@ pub struct Tracker {
     shape_points: usize,
     previous: Option<Modes>,
     previous_values: Option<Vec<Vec<f64>>>,
+    /// G of every block and the mesh it was assembled on: the L² Gram
+    /// matrix depends on the mesh alone (length, elements, order, base),
+    /// not on the shape, so along a branch that keeps the length it is
+    /// assembled once (the same sums, so bit for bit the same matrices).
+    masses: RefCell<Option<(FiniteElements, Vec<SymmetricBanded>)>>,
 }
 
 impl Tracker {
@@ -82,6 +89,7 @@ impl Tracker {
             shape_points: 21,
             previous: None,
             previous_values: None,
+            masses: RefCell::new(None),
         }
     }
 
@@ -174,12 +182,14 @@ impl Tracker {
             .sqrt();
         let c = coefficients(&rod, &samples);
         let tip = shape.last().expect("at least two shape points");
+        let masses = self.masses_on(&fe);
         let mats = self
             .blocks
             .iter()
-            .map(|&b| {
+            .zip(masses)
+            .map(|(&b, g)| {
                 let constraints = support_constraints(&rod, &fe, b, &samples, tip);
-                (fe.stiffness(&c, b), fe.mass(b), constraints)
+                (fe.stiffness(&c, b), g, constraints)
             })
             .collect();
         Ok((fe, mats, norm, shape))
@@ -307,6 +317,21 @@ impl Tracker {
 }
 
 impl Tracker {
+    /// G of every block on the mesh `fe`, assembled only when the mesh
+    /// differs from the last one's.
+    fn masses_on(&self, fe: &FiniteElements) -> Vec<SymmetricBanded> {
+        let mut cache = self.masses.borrow_mut();
+        match cache.as_ref() {
+            Some((mesh, masses)) if mesh == fe => masses.clone(),
+            _ => {
+                let masses: Vec<SymmetricBanded> =
+                    self.blocks.iter().map(|&b| fe.mass(b)).collect();
+                *cache = Some((fe.clone(), masses.clone()));
+                masses
+            }
+        }
+    }
+
     /// The lowest `eigenvalues` + [`GUARD`] eigenpairs of block `bi`
     /// (fewer when the block has fewer unknowns), in increasing order:
     /// warm-started from the previous point's vectors when there are such

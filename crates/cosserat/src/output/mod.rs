@@ -1,7 +1,7 @@
 //! Results out: HDF5 files of equilibria, stability, bifurcation diagrams,
 //! arm studies and sweeps (feature `hdf5`: pure Rust through hdf5-pure,
-//! behind the one module [`store`]), written atomically to outputs claimed by [`target`] and
-//! sealed with a checksum ([`seal`]) that is verified before a file is read
+//! behind the one module `store`), written atomically to outputs claimed by `target` and
+//! sealed with a checksum (`seal`) that is verified before a file is read
 //! back. Writers read results; they never build or compute them. No stage
 //! imports this module.
 
