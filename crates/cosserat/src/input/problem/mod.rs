@@ -156,29 +156,8 @@ impl Problem {
             .as_ref()
             .map(|a| a.scene(&rod).map(|s| (s, a.map_samples)))
             .transpose()?;
-        let arm_taper = match (&file.arm, &arm) {
-            (Some(a), Some((p, _, _))) => a.taper(&rod, p)?,
-            _ => None,
-        };
-        let arm_spatial = match (&file.arm, &arm, &arm_scene) {
-            (Some(section), Some((planar, _, _)), Some((scene, _))) => {
-                section.spatial_arm(planar, scene)?
-            }
-            _ => None,
-        };
-        if arm_spatial.is_some() && arm_taper.is_some() {
-            return Err(invalid(
-                "arm.taper",
-                "tapered sections are optimized for planar arms only; remove arm.taper or \
-                 arm.spatial",
-            ));
-        }
-        if arm_spatial.is_some() && file.sweep.is_some() {
-            return Err(invalid(
-                "arm.spatial",
-                "a sweep runs planar arms only; remove [sweep] or arm.spatial",
-            ));
-        }
+        let (arm_taper, arm_spatial) =
+            arm_extensions(&file, &rod, arm.as_ref(), arm_scene.as_ref())?;
         let sweep = file.sweep.as_ref().map(SweepSection::build).transpose()?;
         let problem = Problem {
             rod,
@@ -218,6 +197,53 @@ pub const MAX_PROBLEM_BYTES: u64 = 1 << 20;
 /// a regular file (a directory; a device such as /dev/zero or a FIFO would
 /// be read without end, or block) or is larger than [`MAX_PROBLEM_BYTES`];
 /// at most that many bytes are read even if the file grows meanwhile.
+/// The extensions of `[arm]` beyond the paper's planar prismatic arm: a
+/// tapered section (`arm.taper`) or spatial loaded shapes (`arm.spatial`),
+/// never both (the section's optimizer works on planar shapes), and a
+/// spatial arm never in a sweep (the sweep's arm job is planar).
+#[allow(clippy::type_complexity)]
+fn arm_extensions(
+    file: &ProblemFile,
+    rod: &crate::model::Rod,
+    arm: Option<&(
+        crate::study::arm::ArmProblem,
+        crate::study::arm::SearchOptions,
+        bool,
+    )>,
+    arm_scene: Option<&(crate::study::arm::ArmScene, usize)>,
+) -> Result<
+    (
+        Option<crate::study::arm::taper::Taper>,
+        Option<crate::study::arm::SpatialArm>,
+    ),
+    ProblemError,
+> {
+    let arm_taper = match (&file.arm, arm) {
+        (Some(a), Some((p, _, _))) => a.taper(rod, p)?,
+        _ => None,
+    };
+    let arm_spatial = match (&file.arm, arm, arm_scene) {
+        (Some(section), Some((planar, _, _)), Some((scene, _))) => {
+            section.spatial_arm(planar, scene)?
+        }
+        _ => None,
+    };
+    if arm_spatial.is_some() && arm_taper.is_some() {
+        return Err(invalid(
+            "arm.taper",
+            "tapered sections are optimized for planar arms only; remove arm.taper or \
+             arm.spatial",
+        ));
+    }
+    if arm_spatial.is_some() && file.sweep.is_some() {
+        return Err(invalid(
+            "arm.spatial",
+            "a sweep runs planar arms only; remove [sweep] or arm.spatial",
+        ));
+    }
+    Ok((arm_taper, arm_spatial))
+}
+
 fn read_problem_file(path: &Path) -> Result<String, ProblemError> {
     use std::io::Read;
     let fail = |message: String| ProblemError::Read {
