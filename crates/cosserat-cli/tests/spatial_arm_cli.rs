@@ -22,7 +22,7 @@ const CHEAP: [&str; 8] = [
 /// Release only: the debug build's continuation of the loading path is
 /// slow for CI's budget (the library's tests check the numbers in debug).
 #[test]
-#[cfg_attr(debug_assertions, ignore)]
+#[cfg_attr(debug_assertions, ignore = "heavy in a debug build: run in release")]
 fn spatial_optimum_file_holds_design_shapes_and_verdict() {
     let dir = scratch("spatial", "file");
     let out = dir.join("spatial.h5");

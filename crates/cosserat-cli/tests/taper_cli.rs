@@ -14,7 +14,7 @@ use cosserat::output::schema::UNDESCRIBED;
 /// prismatic start, its section has unit volume above the bound, and every
 /// dataset is described. Release only (a minute of search in debug).
 #[test]
-#[cfg_attr(debug_assertions, ignore)]
+#[cfg_attr(debug_assertions, ignore = "heavy in a debug build: run in release")]
 fn tapered_optimize_writes_the_design() {
     let dir = scratch("taper_cli", "run");
     let out = dir.join("arm.h5");

@@ -307,7 +307,7 @@ fn a_formula_rod_is_continued_in_its_length_with_an_exact_derivative() {
 /// curved, in 3-D, on every method.
 #[test]
 // Six solves on the general path: a second in release, long in debug.
-#[cfg_attr(debug_assertions, ignore)]
+#[cfg_attr(debug_assertions, ignore = "heavy in a debug build: run in release")]
 fn shear_formula_reproduces_energy_shear_on_every_method() {
     let quadratic = tapered(
         r#"kind = "linear"

@@ -177,7 +177,7 @@ fn nonlinear_axial_law_stretches_as_its_closed_form() {
 /// stability spectrum.
 #[test]
 // Many six-strain solves: seconds in release, minutes in a debug build.
-#[cfg_attr(debug_assertions, ignore)]
+#[cfg_attr(debug_assertions, ignore = "heavy in a debug build: run in release")]
 fn general_path_reproduces_the_quadratic_shearable() {
     let (b, s) = ([3.0, 1.0, 2.0], [10.0, 6.0, 20.0]);
     let bending: Arc<dyn StoredEnergy> = Arc::new(LinearElastic::uniform(b, [0.0; 3]).unwrap());
@@ -261,7 +261,7 @@ fn coupled_energy_bends_a_circle_with_the_schur_stiffness() {
 /// lowest eigenvalue, and of the shooting Jacobian's determinant.
 #[test]
 // Many six-strain solves: seconds in release, minutes in a debug build.
-#[cfg_attr(debug_assertions, ignore)]
+#[cfg_attr(debug_assertions, ignore = "heavy in a debug build: run in release")]
 fn stretch_dependent_column_buckles_at_its_closed_form() {
     let (b, beta, shear, s3) = (1.0, 3.0, 4.0, 20.0);
     let q = PI * PI / 4.0;
@@ -464,7 +464,7 @@ fn general_linearization_matches_differences() {
 /// named failure of the strain's Newton, never a value.
 #[test]
 // Many six-strain solves: seconds in release, minutes in a debug build.
-#[cfg_attr(debug_assertions, ignore)]
+#[cfg_attr(debug_assertions, ignore = "heavy in a debug build: run in release")]
 fn a_force_the_material_cannot_carry_is_a_named_failure() {
     #[derive(Debug)]
     struct Softening;
@@ -604,7 +604,7 @@ fn the_checker_covers_the_six_strains() {
 /// continuation's own augmented system.
 #[test]
 // Many six-strain solves: seconds in release, minutes in a debug build.
-#[cfg_attr(debug_assertions, ignore)]
+#[cfg_attr(debug_assertions, ignore = "heavy in a debug build: run in release")]
 fn continuation_finds_the_stretch_dependent_column_branch_point() {
     use cosserat::continuation::continuation;
     let text = r#"
