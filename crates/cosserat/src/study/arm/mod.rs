@@ -27,6 +27,7 @@ use crate::stability::{FixedShape, StabilityOptions};
 
 pub mod control_path;
 pub mod fig5;
+mod polish;
 mod resolve;
 mod sampling;
 pub mod scene;

@@ -12,13 +12,11 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::OnceLock;
 use std::time::Duration;
 
-use argmin::core::{CostFunction, Error as ArgminError, Executor, State};
-use argmin::solver::neldermead::NelderMead;
-
 use crate::model::Profile;
 use crate::stability::{critical_load, FixedShape};
 
 use super::design::{intrinsic_shape, least_squares_polynomial};
+use super::polish::{box_simplex, polish_in_box};
 use super::{
     derivative, polynomial, ArmDesign, ArmOptimum, ArmProblem, ArmScene, SearchOptions,
     SearchProgress, REACH_TOLERANCE,
@@ -183,19 +181,7 @@ impl ArmProblem {
 
     /// The simplex with steps of `fraction` of each bound's width.
     pub(super) fn simplex_sized(&self, start: &[f64], fraction: f64) -> Vec<Vec<f64>> {
-        std::iter::once(start.to_vec())
-            .chain((0..start.len()).map(|d| {
-                let mut p = start.to_vec();
-                let (lo, hi) = self.bounds[d];
-                let step = fraction * (hi - lo);
-                p[d] = if p[d] + step <= hi {
-                    p[d] + step
-                } else {
-                    p[d] - step
-                };
-                p
-            }))
-            .collect()
+        box_simplex(start, &self.bounds, fraction)
     }
 
     /// Nelder–Mead from `start` on −R̂ (projected into the bounds).
@@ -218,23 +204,14 @@ impl ArmProblem {
         iterations: u64,
         stop: &dyn Fn() -> bool,
     ) -> (Option<ArmDesign>, usize) {
-        let cost = ReachCost {
-            problem: self,
-            scene,
+        let (best, calls) = polish_in_box(
+            simplex,
+            iterations,
+            &|p| self.project(p),
+            &|q| self.design_in(scene, q).map(|d| d.reach),
             stop,
-            calls: std::cell::Cell::new(0),
-        };
-        let Ok(solver) = NelderMead::new(simplex).with_sd_tolerance(1e-12) else {
-            return (None, 0);
-        };
-        let result = Executor::new(&cost, solver)
-            .configure(|state| state.max_iters(iterations))
-            .run();
-        let calls = cost.calls.get();
-        let design = result.ok().and_then(|r| {
-            let p = r.state().get_best_param()?.clone();
-            self.design_in(scene, &self.project(&p))
-        });
+        );
+        let design = best.and_then(|q| self.design_in(scene, &q));
         (design, calls)
     }
 
@@ -285,37 +262,6 @@ impl ArmProblem {
             scene: *scene,
             resolution: None,
         })
-    }
-}
-
-/// −R̂ for Nelder–Mead; points outside the box are projected into it and
-/// charged their squared distance.
-struct ReachCost<'a> {
-    problem: &'a ArmProblem,
-    scene: &'a ArmScene,
-    stop: &'a dyn Fn() -> bool,
-    calls: std::cell::Cell<usize>,
-}
-
-impl CostFunction for &ReachCost<'_> {
-    type Param = Vec<f64>;
-    type Output = f64;
-
-    fn cost(&self, p: &Vec<f64>) -> Result<f64, ArgminError> {
-        if (self.stop)() {
-            // Stopping: the worst cost, not an error — argmin's Nelder–Mead
-            // unwraps the costs of its first simplex (a panic), and the
-            // caller discards a polish that ran into a stop.
-            return Ok(f64::INFINITY);
-        }
-        self.calls.set(self.calls.get() + 1);
-        let q = self.problem.project(p);
-        let outside: f64 = p.iter().zip(&q).map(|(a, b)| (a - b).powi(2)).sum();
-        let reach = self
-            .problem
-            .design_in(self.scene, &q)
-            .map_or(0.0, |d| d.reach);
-        Ok(-reach + outside)
     }
 }
 

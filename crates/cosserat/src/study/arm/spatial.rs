@@ -35,11 +35,10 @@
 
 use std::sync::Arc;
 
-use argmin::core::{CostFunction, Error as ArgminError, Executor, State};
-use argmin::solver::neldermead::NelderMead;
 use nalgebra::{Matrix3, Rotation3, Unit, Vector3};
 
 use super::design::derivative;
+use super::polish::{box_simplex, polish_in_box};
 use super::resolve::{MeshStudy, Resolution, Verdict, REACH_TOLERANCE};
 use super::{continue_family, sampling, ArmProblem, ArmScene, SearchOptions};
 use crate::continuation::{ContinuationError, Diagram, Family, Parameter};
@@ -346,37 +345,15 @@ impl SpatialArm {
         iterations: u64,
         stop: &dyn Fn() -> bool,
     ) -> (Option<SpatialDesign>, usize) {
-        let bounds = self.bounds();
-        let simplex: Vec<Vec<f64>> = std::iter::once(start.to_vec())
-            .chain((0..start.len()).map(|d| {
-                let mut p = start.to_vec();
-                let (lo, hi) = bounds[d];
-                let step = 0.05 * (hi - lo);
-                p[d] = if p[d] + step <= hi {
-                    p[d] + step
-                } else {
-                    p[d] - step
-                };
-                p
-            }))
-            .collect();
-        let cost = SpatialReachCost {
-            arm: self,
-            scene,
+        let simplex = box_simplex(start, &self.bounds(), 0.05);
+        let (best, calls) = polish_in_box(
+            simplex,
+            iterations,
+            &|p| self.project(p),
+            &|q| self.design_in(scene, q).map(|d| d.reach),
             stop,
-            calls: std::cell::Cell::new(0),
-        };
-        let Ok(solver) = NelderMead::new(simplex).with_sd_tolerance(1e-12) else {
-            return (None, 0);
-        };
-        let result = Executor::new(&cost, solver)
-            .configure(|state| state.max_iters(iterations))
-            .run();
-        let calls = cost.calls.get();
-        let design = result.ok().and_then(|r| {
-            let p = r.state().get_best_param()?.clone();
-            self.design_in(scene, &self.project(&p))
-        });
+        );
+        let design = best.and_then(|q| self.design_in(scene, &q));
         (design, calls)
     }
 
@@ -617,29 +594,4 @@ fn intrinsic_shape(
     Ok(SpatialShape {
         curvature: [component(0)?, component(1)?, component(2)?],
     })
-}
-
-/// −R̂ for Nelder–Mead; points outside the box projected into it and
-/// charged their squared distance (as the planar search).
-struct SpatialReachCost<'a> {
-    arm: &'a SpatialArm,
-    scene: &'a ArmScene,
-    stop: &'a dyn Fn() -> bool,
-    calls: std::cell::Cell<usize>,
-}
-
-impl CostFunction for &SpatialReachCost<'_> {
-    type Param = Vec<f64>;
-    type Output = f64;
-
-    fn cost(&self, p: &Vec<f64>) -> Result<f64, ArgminError> {
-        if (self.stop)() {
-            return Ok(f64::INFINITY);
-        }
-        self.calls.set(self.calls.get() + 1);
-        let q = self.arm.project(p);
-        let outside: f64 = p.iter().zip(&q).map(|(a, b)| (a - b).powi(2)).sum();
-        let reach = self.arm.design_in(self.scene, &q).map_or(0.0, |d| d.reach);
-        Ok(-reach + outside)
-    }
 }

@@ -19,10 +19,8 @@
 
 use std::sync::Arc;
 
-use argmin::core::{CostFunction, Error as ArgminError, Executor, State};
-use argmin::solver::neldermead::NelderMead;
-
 use super::design::intrinsic_shape;
+use super::polish::polish_in_box;
 use super::taper::{
     strongest_section_until, Section, SectionPencil, SectionSearch, Taper, TaperError,
 };
@@ -265,21 +263,18 @@ impl TaperedArm {
             let d = self.evaluate(start, section, &self.arm.stability);
             return (d.map(|(d, _, _)| (d, vec![])), 1);
         }
-        let cost = TaperedCost {
-            arm: self,
-            section,
+        let reach = |q: &[f64]| {
+            self.evaluate(q, section, &self.arm.stability)
+                .map(|(d, _, _)| d.reach)
+        };
+        let (best, calls) = polish_in_box(
+            self.arm.simplex(start),
+            iterations,
+            &|p| self.arm.project(p),
+            &reach,
             stop,
-            calls: std::cell::Cell::new(0),
-        };
-        let Ok(solver) = NelderMead::new(self.arm.simplex(start)).with_sd_tolerance(1e-12) else {
-            return (None, 0);
-        };
-        let result = Executor::new(&cost, solver)
-            .configure(|state| state.max_iters(iterations))
-            .run();
-        let calls = cost.calls.get();
-        let best = result.ok().and_then(|r| {
-            let p = self.arm.project(r.state().get_best_param()?);
+        );
+        let best = best.and_then(|p| {
             let (d, _, _) = self.evaluate(&p, section, &self.arm.stability)?;
             Some((d, p))
         });
@@ -464,34 +459,4 @@ pub fn loading_verdict(diagram: &Diagram, optimum: &TaperedOptimum) -> LoadingVe
 
 fn model(e: &ModelError) -> TaperError {
     TaperError::Invalid(e.to_string())
-}
-
-/// −R̂ of the shape with the section held, for Nelder–Mead; points outside
-/// the box projected into it and charged their squared distance.
-struct TaperedCost<'a> {
-    arm: &'a TaperedArm,
-    section: &'a Section,
-    stop: &'a dyn Fn() -> bool,
-    calls: std::cell::Cell<usize>,
-}
-
-impl CostFunction for &TaperedCost<'_> {
-    type Param = Vec<f64>;
-    type Output = f64;
-
-    fn cost(&self, p: &Vec<f64>) -> Result<f64, ArgminError> {
-        if (self.stop)() {
-            // The worst cost, not an error (argmin unwraps the first
-            // simplex's costs); the caller discards a stopped polish.
-            return Ok(f64::INFINITY);
-        }
-        self.calls.set(self.calls.get() + 1);
-        let q = self.arm.arm.project(p);
-        let outside: f64 = p.iter().zip(&q).map(|(a, b)| (a - b).powi(2)).sum();
-        let reach = self
-            .arm
-            .evaluate(&q, self.section, &self.arm.arm.stability)
-            .map_or(0.0, |(d, _, _)| d.reach);
-        Ok(-reach + outside)
-    }
 }
