@@ -93,6 +93,74 @@ struct Balance {
     nu: Vector3<f64>,
 }
 
+/// One direction v of the variational equations at a state: the perturbed
+/// frame δd1, δd2 (read from v), δd3 = δd1×d2 + d1×δd2, δκ; the
+/// linearized director rates (of d1' = d2κ3 − d3κ2 and d2' = d3κ1 − d1κ3);
+/// and the body components of δn — the frame turned under the internal
+/// force n, plus the reaction's perturbation (v[12..15]) where the tip is
+/// held. Shared by the quadratic and the general Cosserat linearizations,
+/// which differ only in δκ' and δν.
+struct FrameVariation {
+    dd1: Vector3<f64>,
+    dd2: Vector3<f64>,
+    dd3: Vector3<f64>,
+    dk: Vector3<f64>,
+    rate1: Vector3<f64>,
+    rate2: Vector3<f64>,
+    dn: Vector3<f64>,
+}
+
+impl FrameVariation {
+    fn at(st: &State, v: &[f64], n: &Vector3<f64>) -> Self {
+        let k = st.kappa;
+        let dreaction = if v.len() > 12 {
+            Vector3::new(v[12], v[13], v[14])
+        } else {
+            Vector3::zeros()
+        };
+        let dd1 = Vector3::new(v[0], v[1], v[2]);
+        let dd2 = Vector3::new(v[3], v[4], v[5]);
+        let dk = Vector3::new(v[6], v[7], v[8]);
+        let dd3 = dd1.cross(&st.d2) + st.d1.cross(&dd2);
+        FrameVariation {
+            rate1: st.d2 * dk[2] + dd2 * k[2] - st.d3 * dk[1] - dd3 * k[1],
+            rate2: st.d3 * dk[0] + dd3 * k[0] - st.d1 * dk[2] - dd1 * k[2],
+            dn: Vector3::new(
+                n.dot(&dd1) + dreaction.dot(&st.d1),
+                n.dot(&dd2) + dreaction.dot(&st.d2),
+                n.dot(&dd3) + dreaction.dot(&st.d3),
+            ),
+            dd1,
+            dd2,
+            dd3,
+            dk,
+        }
+    }
+
+    /// Writes the rates of the direction: δd1', δd2', δκ' = `rk` and
+    /// δr' = Σ δd_i ν_i + d_i δν_i; the reaction is constant (δR' = 0).
+    fn write(
+        &self,
+        st: &State,
+        nu: &Vector3<f64>,
+        dnu: &Vector3<f64>,
+        rk: &Vector3<f64>,
+        out: &mut [f64],
+    ) {
+        let dr = self.dd1 * nu[0]
+            + self.dd2 * nu[1]
+            + self.dd3 * nu[2]
+            + st.d1 * dnu[0]
+            + st.d2 * dnu[1]
+            + st.d3 * dnu[2];
+        out[0..3].copy_from_slice(self.rate1.as_slice());
+        out[3..6].copy_from_slice(self.rate2.as_slice());
+        out[6..9].copy_from_slice(rk.as_slice());
+        out[9..12].copy_from_slice(dr.as_slice());
+        out[12..].fill(0.0);
+    }
+}
+
 impl KirchhoffEquations {
     /// The spatial Kirchhoff equations of a rod (unshearable and
     /// inextensible, whatever the energy's shear part).
@@ -341,35 +409,10 @@ impl KirchhoffEquations {
         for c in 0..cols {
             let v = &phi[dim * c..dim * (c + 1)];
             let out = &mut dphi[dim * c..dim * (c + 1)];
-            let dreaction = if dim > 12 {
-                Vector3::new(v[12], v[13], v[14])
-            } else {
-                Vector3::zeros()
-            };
-            let dd1 = Vector3::new(v[0], v[1], v[2]);
-            let dd2 = Vector3::new(v[3], v[4], v[5]);
-            let dk = Vector3::new(v[6], v[7], v[8]);
-            let dd3 = dd1.cross(&st.d2) + st.d1.cross(&dd2);
-            let r1 = st.d2 * dk[2] + dd2 * k[2] - st.d3 * dk[1] - dd3 * k[1];
-            let r2 = st.d3 * dk[0] + dd3 * k[0] - st.d1 * dk[2] - dd1 * k[2];
-            let dn = Vector3::new(
-                n.dot(&dd1) + dreaction.dot(&st.d1),
-                n.dot(&dd2) + dreaction.dot(&st.d2),
-                n.dot(&dd3) + dreaction.dot(&st.d3),
-            );
-            let df = Vector3::new(f.dot(&dd1), f.dot(&dd2), f.dot(&dd3));
-            let (rk, dnu) = p.linearized(&third, &k, &dk, &dn, &df);
-            let dr = dd1 * p.nu[0]
-                + dd2 * p.nu[1]
-                + dd3 * p.nu[2]
-                + st.d1 * dnu[0]
-                + st.d2 * dnu[1]
-                + st.d3 * dnu[2];
-            out[0..3].copy_from_slice(r1.as_slice());
-            out[3..6].copy_from_slice(r2.as_slice());
-            out[6..9].copy_from_slice(rk.as_slice());
-            out[9..12].copy_from_slice(dr.as_slice());
-            out[12..].fill(0.0);
+            let w = FrameVariation::at(st, v, &n);
+            let df = Vector3::new(f.dot(&w.dd1), f.dot(&w.dd2), f.dot(&w.dd3));
+            let (rk, dnu) = p.linearized(&third, &k, &w.dk, &w.dn, &df);
+            w.write(st, &p.nu, &dnu, &rk, out);
         }
     }
 }
@@ -455,36 +498,12 @@ impl RodEquations for KirchhoffEquations {
         for c in 0..cols {
             let v = &phi[n * c..n * (c + 1)];
             let out = &mut dphi[n * c..n * (c + 1)];
-            let dreaction = if n > 12 {
-                Vector3::new(v[12], v[13], v[14])
-            } else {
-                Vector3::zeros()
-            };
-            let dd1 = Vector3::new(v[0], v[1], v[2]);
-            let dd2 = Vector3::new(v[3], v[4], v[5]);
-            let dk = Vector3::new(v[6], v[7], v[8]);
-            let dd3 = dd1.cross(&st.d2) + st.d1.cross(&dd2);
-            let r1 = st.d2 * dk[2] + dd2 * k[2] - st.d3 * dk[1] - dd3 * k[1];
-            let r2 = st.d3 * dk[0] + dd3 * k[0] - st.d1 * dk[2] - dd1 * k[2];
-            let dn = Vector3::new(
-                b.n.dot(&dd1) + dreaction.dot(&st.d1),
-                b.n.dot(&dd2) + dreaction.dot(&st.d2),
-                b.n.dot(&dd3) + dreaction.dot(&st.d3),
-            );
+            let w = FrameVariation::at(&st, v, &b.n);
+            let (dk, dn) = (w.dk, w.dn);
             let dnu = self.compliance.component_mul(&dn);
             let dq = (b.h * dk).cross(&k) + b.m.cross(&dk) + dn.cross(&b.nu) + body_n.cross(&dnu);
             let rk = b.h_inv * (dq - kappa_jac * dk);
-            let dr = dd1 * b.nu[0]
-                + dd2 * b.nu[1]
-                + dd3 * b.nu[2]
-                + st.d1 * dnu[0]
-                + st.d2 * dnu[1]
-                + st.d3 * dnu[2];
-            out[0..3].copy_from_slice(r1.as_slice());
-            out[3..6].copy_from_slice(r2.as_slice());
-            out[6..9].copy_from_slice(rk.as_slice());
-            out[9..12].copy_from_slice(dr.as_slice());
-            out[12..].fill(0.0);
+            w.write(&st, &b.nu, &dnu, &rk, out);
         }
     }
 
