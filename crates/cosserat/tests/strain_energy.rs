@@ -597,6 +597,26 @@ fn the_checker_covers_the_six_strains() {
     assert!(err.to_string().contains("6 × 6 Hessian"), "{err}");
 }
 
+/// The checker is not fooled by a stiff extension: with S3 = 10¹² the
+/// density is near 10⁹ at the sampled stretches while its κ-rates are of
+/// order one, so a difference of W in κ carries rounding ε W/h; the
+/// correct quadratic energy must not fail (undecided is allowed where
+/// rounding hides the rate). It failed before the rounding entered the
+/// difference's error bound, and every debug-build solve of such a rod
+/// (Haringx's column, tests/cosserat.rs) was refused.
+#[test]
+fn the_checker_is_not_fooled_by_a_stiff_extension() {
+    use cosserat::model::energy_check::{check, typical_curvature};
+    let bending = Arc::new(LinearElastic::uniform([1.0, 1.0, 0.8], [0.0; 3]).unwrap());
+    let stiff: Arc<dyn StoredEnergy> =
+        Arc::new(Shearable::new(bending, Vector3::new(2.0, 1e3, 1e12)).unwrap());
+    // Haringx's column near its critical thrust (tests/cosserat.rs), with
+    // the strains the solver's own check samples.
+    let r = rod(stiff.clone(), tip_force(Vector3::new(0.0, 0.0, -1.9)));
+    let report = check(stiff.as_ref(), 1.0, typical_curvature(&r));
+    assert!(report.passed(), "{report}");
+}
+
 /// Continuation in the load on the general path: the column with a
 /// stretch-dependent bending stiffness (as in
 /// `stretch_dependent_column_buckles_at_its_closed_form`, written as a

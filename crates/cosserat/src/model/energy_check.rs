@@ -261,14 +261,29 @@ struct Sample<'e> {
 }
 
 /// The fourth-order central difference of f at 0 with step h, and the
-/// Richardson bound of its error: |D(h) − D(h/2)|.
+/// bound of its error: the Richardson gap |D(h) − D(h/2)| (truncation)
+/// plus the rounding of D(h/2), 16 ε max|f| / h (each of the four values
+/// rounded within 4 ε of its size, the weights 18/12 over h/2). The
+/// rounding term matters where a component's values are large against
+/// its rate: a stiff extension S3 = 10¹² puts W near 10⁹ while W's
+/// κ-rate is of order one, and D(h) and D(h/2) of such a W can agree by
+/// chance while both are off by ε W/h — the scaling must not fool the
+/// check, so that sample is undecided rather than failed.
 fn derivative<const N: usize>(f: impl Fn(f64) -> [f64; N], h: f64) -> ([f64; N], [f64; N]) {
     let d = |h: f64| {
         let (a, b, c, e) = (f(-2.0 * h), f(-h), f(h), f(2.0 * h));
-        std::array::from_fn(|i| (a[i] - 8.0 * b[i] + 8.0 * c[i] - e[i]) / (12.0 * h))
+        let size: [f64; N] =
+            std::array::from_fn(|i| a[i].abs().max(b[i].abs()).max(c[i].abs()).max(e[i].abs()));
+        let value = std::array::from_fn(|i| (a[i] - 8.0 * b[i] + 8.0 * c[i] - e[i]) / (12.0 * h));
+        (value, size)
     };
-    let (coarse, fine): ([f64; N], [f64; N]) = (d(h), d(0.5 * h));
-    (fine, std::array::from_fn(|i| (coarse[i] - fine[i]).abs()))
+    let (coarse, _): ([f64; N], [f64; N]) = d(h);
+    let (fine, size): ([f64; N], [f64; N]) = d(0.5 * h);
+    let rounding = 16.0 * f64::EPSILON / h;
+    (
+        fine,
+        std::array::from_fn(|i| (coarse[i] - fine[i]).abs() + rounding * size[i]),
+    )
 }
 
 /// [`derivative`] in s, where profiles may have knots (tables, the ends
