@@ -10,7 +10,18 @@ import pytest
 import cosserat
 
 
-def test_ctrl_c_stops_the_arm_search(problem_path):
+@pytest.fixture
+def keyboard_interrupt():
+    # Python raises KeyboardInterrupt only where it installed its own SIGINT
+    # handler, which it does not when it starts with SIGINT ignored (a job
+    # started in the background by a non-interactive shell, as CI runners
+    # may): install it for the test, as an interactive session has it.
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)
+
+
+def test_ctrl_c_stops_the_arm_search(problem_path, keyboard_interrupt):
     # 250 times the shipped samples: a search of well over ten seconds
     # (`cosserat optimize` runs 10 s without finishing it); SIGINT comes
     # after 0.3 s and stops it at the next evaluation.
