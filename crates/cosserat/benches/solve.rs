@@ -2,7 +2,9 @@
 //! model level and method, on the planar cantilever (k = 0.5, 3, 10).
 //!
 //! Run: `cargo bench --bench solve` (median of repeated solves in one
-//! process; integrator tolerance swept from 1e-8 to 1e-12).
+//! process; integrator tolerance swept from 1e-8 to 1e-12). "RHS" counts
+//! the right-hand side evaluations of one solve (ramp, Newton, sampling):
+//! the cost that does not depend on the machine's load.
 
 #[path = "../tests/support/mod.rs"]
 mod support;
@@ -21,8 +23,8 @@ fn median(mut v: Vec<f64>) -> f64 {
 
 fn main() {
     println!(
-        "{:>5} {:>10} {:>18} {:>8} {:>10} {:>12} {:>6}",
-        "k", "model", "method", "rtol", "tip error", "time [µs]", "ramp"
+        "{:>5} {:>10} {:>18} {:>8} {:>10} {:>12} {:>6} {:>8}",
+        "k", "model", "method", "rtol", "tip error", "time [µs]", "ramp", "RHS"
     );
     for k in [0.5, 3.0, 10.0] {
         let reference = cosserat::references::CantileverTip::at(k);
@@ -55,14 +57,15 @@ fn main() {
                         .abs()
                         .max((tip[2] - reference.z).abs());
                     println!(
-                        "{:>5} {:>10} {:>18} {:>8.0e} {:>10.1e} {:>12.1} {:>6}",
+                        "{:>5} {:>10} {:>18} {:>8.0e} {:>10.1e} {:>12.1} {:>6} {:>8}",
                         k,
                         level.name(),
                         method.name(),
                         rtol,
                         err,
                         median(times) * 1e6,
-                        eq.load_steps
+                        eq.load_steps,
+                        eq.integration.evaluations
                     );
                 }
             }

@@ -6,7 +6,7 @@ mod support;
 use std::f64::consts::TAU;
 use std::sync::Arc;
 
-use cosserat::bvp::{solve, Equilibrium, Method, SolverOptions};
+use cosserat::bvp::{solve, Equilibrium, Method, SolverOptions, Strategy};
 use cosserat::model::{
     Clamp, DeadLoads, LinearElastic, ModelChoice, ModelLevel, QuarticStiffening, Rod,
 };
@@ -214,25 +214,95 @@ fn large_load_follows_the_loading_branch() {
     }
 }
 
-/// At k = 100 the shooting sensitivities grow like exp(√k s) ≈ e¹⁰: single
-/// shooting must fail with a clear error, multiple shooting must succeed.
+/// At k = 100 the shooting sensitivities grow like exp(√k s) ≈ e¹⁰: a
+/// direct single-shooting start must fail with a clear error; the load
+/// ramp (intermediate steps at warm-start accuracy, secant predictor)
+/// reaches the loading branch, and so does multiple shooting, both to the
+/// closed form within 1e-9.
 #[test]
 fn single_shooting_fails_clearly_where_multiple_shooting_recovers() {
     let k = 100.0;
     let rod = cantilever(k);
     let choice = ModelChoice::forced(&rod, ModelLevel::Planar).unwrap();
-    let err = solve(&rod, &choice, &SolverOptions::default()).unwrap_err();
+    let direct = SolverOptions {
+        strategy: Strategy::Direct,
+        ..Default::default()
+    };
+    let err = solve(&rod, &choice, &direct).unwrap_err();
     let message = err.to_string();
     assert!(message.contains("shooting"), "{message}");
-    assert!(
-        message.contains("stalled") || message.contains("did not converge"),
-        "{message}"
-    );
+    assert!(message.contains("did not converge"), "{message}");
     let reference = CantileverTip::at(k);
-    let eq = solve_with(&rod, ModelLevel::Planar, METHODS[1]);
-    let tip = eq.tip().position;
+    for method in [Method::Shooting, METHODS[1]] {
+        let eq = solve_with(&rod, ModelLevel::Planar, method);
+        let tip = eq.tip().position;
+        assert!(eq.load_steps > 0, "{method:?}");
+        assert!(
+            (tip[0] - reference.x).abs() <= 1e-9,
+            "{method:?}: x {}",
+            tip[0]
+        );
+        assert!(
+            (tip[2] - reference.z).abs() <= 1e-9,
+            "{method:?}: z {}",
+            tip[2]
+        );
+    }
+}
+
+/// [`Strategy::Auto`] below the ramp threshold (k = 0.5): a direct start
+/// from a wrong guess (κ(0) = 1e5 against 0.49: more turns than 400
+/// integrator steps can follow) fails, and the load ramp,
+/// which starts from the unloaded rod, rescues it — the closed form to
+/// 1e-9, the ramp's steps reported.
+#[test]
+fn failed_direct_start_is_rescued_by_the_ramp() {
+    let k = 0.5;
+    let rod = cantilever(k);
+    let choice = ModelChoice::forced(&rod, ModelLevel::Planar).unwrap();
+    let opts = SolverOptions {
+        initial_guess: Some(vec![0.0, 1e5, 0.0]),
+        integration: cosserat::bvp::integrator::Tolerances {
+            max_steps: 400,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let direct = SolverOptions {
+        strategy: Strategy::Direct,
+        ..opts.clone()
+    };
+    assert!(
+        solve(&rod, &choice, &direct).is_err(),
+        "the direct start must fail"
+    );
+    let eq = solve(&rod, &choice, &opts).expect("the ramp rescues it");
+    assert!(eq.load_steps > 0);
+    let (tip, reference) = (eq.tip().position, CantileverTip::at(k));
     assert!((tip[0] - reference.x).abs() <= 1e-9, "x {}", tip[0]);
     assert!((tip[2] - reference.z).abs() <= 1e-9, "z {}", tip[2]);
+}
+
+/// Both the direct start and the ramp fail (an integrator budget of 3
+/// steps cannot cross the rod): the named error of the ramp, carrying the
+/// last failure, never a result.
+#[test]
+fn direct_and_ramp_failing_is_a_named_error() {
+    let rod = cantilever(0.5);
+    let choice = ModelChoice::forced(&rod, ModelLevel::Planar).unwrap();
+    let opts = SolverOptions {
+        integration: cosserat::bvp::integrator::Tolerances {
+            max_steps: 3,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let err = solve(&rod, &choice, &opts).unwrap_err();
+    assert!(
+        matches!(err, cosserat::bvp::SolveError::RampStalled { .. }),
+        "{err}"
+    );
+    assert!(err.to_string().contains("steps before"), "{err}");
 }
 
 /// A tapered cantilever, B2(s) = 2 − s (polynomial profile), under a small

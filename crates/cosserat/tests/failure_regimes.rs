@@ -110,7 +110,8 @@ fn large_load_single_shooting_fails_others_recover() {
 }
 
 /// A long rod: L = 16 under F = 1 (k = 256). Single shooting with the load
-/// ramp stalls and says so. Its direct solve is the hazard: it converges,
+/// ramp reaches the loading branch (to its conditioning) or says why not.
+/// Its direct solve is the hazard: it converges,
 /// but to a looped equilibrium, not the loading branch (asserted here so the
 /// hazard stays documented; use the ramp, multiple shooting or
 /// collocation). 16-segment multiple shooting and adaptive collocation
@@ -119,7 +120,25 @@ fn large_load_single_shooting_fails_others_recover() {
 fn long_rod_single_shooting_fails_others_recover() {
     let (length, force) = (16.0, 1.0);
     let rod = cantilever(length, force);
-    assert_clear_failure(run(&rod, Method::Shooting, Strategy::Auto), "shooting");
+    // The ramp's intermediate steps at warm-start accuracy carry single
+    // shooting through where the tight steps stalled: a result then has to
+    // be the loading branch (the looped equilibrium lies 1e-2 away), to the
+    // accuracy single shooting's conditioning allows: its sensitivities
+    // grow like e^{L√(F/B)} = e^16 ≈ 9·10⁶, so integrator rtol 1e-12 bounds
+    // the tip error near 10⁻⁵ (measured 9.0e-9; the other methods 1e-9).
+    match run(&rod, Method::Shooting, Strategy::Auto) {
+        Ok(eq) => {
+            let err = cantilever_error(&eq, length, force);
+            eprintln!(
+                "ramped single shooting: relative tip error {err:.2e}, {} steps",
+                eq.load_steps
+            );
+            assert!(err <= 1e-8, "{err:e}");
+        }
+        Err(e) => {
+            assert_clear_failure(Err(e), "shooting");
+        }
+    }
     if let Ok(eq) = run(&rod, Method::Shooting, Strategy::Direct) {
         let err = cantilever_error(&eq, length, force);
         eprintln!("direct single shooting: another equilibrium, relative tip distance {err:.2e}");

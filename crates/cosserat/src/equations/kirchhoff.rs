@@ -31,7 +31,9 @@ use super::planar::straight_rod_clamp_moment;
 use super::strained::Strained;
 use super::tip::{condition_rates, conditions, rates_cover, TipRates, TipState};
 use super::{RodEquations, RodSample};
-use crate::model::{Rod, RodTangent, StoredEnergy, StrainEnergy, StrainError, TipSupport};
+use crate::model::{
+    ResidualScales, Rod, RodTangent, StoredEnergy, StrainEnergy, StrainError, TipSupport,
+};
 use crate::numerics::newton::{self, Convergence, Damping, Options, System};
 
 /// The 9-ODE Kirchhoff equations (12 with the position), or the Cosserat
@@ -46,6 +48,9 @@ pub struct KirchhoffEquations {
     /// The first failure of that Newton, kept for the solver to name
     /// (the rates there are NaN, which no integrator accepts).
     failure: Arc<Mutex<Option<StrainError>>>,
+    /// [`Rod::residual_scales`] computed once (it samples the energy at 65
+    /// points; the tip residual needs it at every shooting evaluation).
+    units: ResidualScales,
 }
 
 /// The state unpacked.
@@ -166,6 +171,7 @@ impl KirchhoffEquations {
     /// inextensible, whatever the energy's shear part).
     pub fn new(rod: Rod) -> Self {
         KirchhoffEquations {
+            units: rod.residual_scales(),
             rod,
             compliance: Vector3::zeros(),
             strained: false,
@@ -297,7 +303,7 @@ impl KirchhoffEquations {
                 g[(i, 6 + j)] = h[(i, j)];
             }
         }
-        let unit = self.rod.residual_scales().moment;
+        let unit = self.units.moment;
         for i in 0..3 {
             g.row_mut(i).scale_mut(1.0 / unit[i]);
         }
@@ -322,7 +328,7 @@ impl KirchhoffEquations {
             reaction: st.reaction,
             couple: &self.rod.loads().tip_couple,
         };
-        conditions(support, &tip, &self.rod.residual_scales(), self.dim())
+        conditions(support, &tip, &self.units, self.dim())
     }
 
     /// M(L): ∇W at the tip, W_κ(L, κ, ν) on the general path (NaN, the
@@ -515,7 +521,7 @@ impl RodEquations for KirchhoffEquations {
         let st = State::read(y);
         let m = self.tip_moment(&st);
         let c = self.rod.loads().tip_couple;
-        let unit = self.rod.residual_scales().moment;
+        let unit = self.units.moment;
         r[0] = (m[0] - c.dot(&st.d1)) / unit[0];
         r[1] = (m[1] - c.dot(&st.d2)) / unit[1];
         r[2] = (m[2] - c.dot(&st.d3)) / unit[2];
@@ -627,7 +633,7 @@ impl RodEquations for KirchhoffEquations {
         let mut scales = vec![1.0; self.dim()];
         scales[6..9].fill(1.0 / l);
         scales[9..12].fill(l);
-        scales[12..].fill(self.rod.residual_scales().force);
+        scales[12..].fill(self.units.force);
         scales
     }
 
@@ -703,11 +709,11 @@ impl RodEquations for KirchhoffEquations {
                 spin: t.support_spin(),
                 scales: t.residual_scales_rate(&self.rod),
             };
-            let scales = self.rod.residual_scales();
+            let scales = self.units;
             out.copy_from_slice(&condition_rates(support, &tip, &scales, &rates));
             return;
         }
-        let unit = self.rod.residual_scales().moment;
+        let unit = self.units.moment;
         let dunit = t.residual_scales_rate(&self.rod).moment;
         let d = [st.d1, st.d2, st.d3];
         for i in 0..3 {

@@ -25,19 +25,28 @@
 use nalgebra::{DMatrix, Vector3};
 
 use super::{RodEquations, RodSample};
-use crate::model::{Freedom, Rod, RodTangent, TipSupport};
+use crate::model::{Freedom, ResidualScales, Rod, RodTangent, TipSupport};
 
 /// The 4-ODE planar equations of a rod.
 #[derive(Debug, Clone)]
 pub struct PlanarEquations {
     rod: Rod,
+    /// The rod's residual units ([`Rod::residual_scales`], which samples
+    /// the energy at 65 points), computed once: the tip residual and its
+    /// Jacobian need them at every shooting evaluation.
+    units: ResidualScales,
+    /// The clamp's d1(0), d3(0): the in-plane axes x, z that every
+    /// right-hand side evaluation projects the internal force on.
+    axes: (Vector3<f64>, Vector3<f64>),
 }
 
 impl PlanarEquations {
     /// The planar equations of a rod whose scene is planar (see
     /// [`crate::model::ModelChoice`]).
     pub fn new(rod: Rod) -> Self {
-        PlanarEquations { rod }
+        let units = rod.residual_scales();
+        let axes = (rod.clamp().director(0), rod.clamp().director(2));
+        PlanarEquations { rod, units, axes }
     }
 
     fn kappa(k2: f64) -> Vector3<f64> {
@@ -61,10 +70,7 @@ impl PlanarEquations {
         } else {
             (0.0, 0.0)
         };
-        (
-            n.dot(&self.rod.clamp().director(0)) + rx,
-            n.dot(&self.rod.clamp().director(2)) + rz,
-        )
+        (n.dot(&self.axes.0) + rx, n.dot(&self.axes.1) + rz)
     }
 
     /// κ2' at (s, y) with the pieces its linearization and p-derivative
@@ -130,9 +136,9 @@ impl PlanarEquations {
     fn supported_tip(&self, support: &TipSupport, y: &[f64]) -> (Vec<f64>, DMatrix<f64>) {
         let n = self.dim();
         let l = self.rod.length();
-        let scales = self.rod.residual_scales();
+        let scales = self.units;
         let c = &self.rod.clamp();
-        let (ex, ez) = (c.director(0), c.director(2));
+        let (ex, ez) = self.axes;
         let target = support.position - c.position;
         let (px, pz) = (target.dot(&ex), target.dot(&ez));
         let mut r = Vec::with_capacity(3);
@@ -190,10 +196,7 @@ impl PlanarEquations {
     /// value δu/u).
     fn supported_tip_rates(&self, support: &TipSupport, y: &[f64], t: &RodTangent) -> Vec<f64> {
         let l = self.rod.length();
-        let (scales, rates) = (
-            self.rod.residual_scales(),
-            t.residual_scales_rate(&self.rod),
-        );
+        let (scales, rates) = (self.units, t.residual_scales_rate(&self.rod));
         let c = self.rod.clamp();
         let w = t.clamp_spin();
         let (ex, ez) = (c.director(0), c.director(2));
@@ -250,7 +253,7 @@ impl PlanarEquations {
         let e = self.rod.energy();
         let d2 = self.rod.clamp().director(1);
         let c = &self.rod.loads().tip_couple;
-        let unit = self.rod.residual_scales().moment[1];
+        let unit = self.units.moment[1];
         let dunit = t.residual_scales_rate(&self.rod).moment[1];
         let g = (e.moment(l, &kappa)[1] - c.dot(&d2)) / unit;
         let dm = t.energy_rate(e.as_ref(), l, &kappa).moment[1];
@@ -345,7 +348,7 @@ impl RodEquations for PlanarEquations {
             .rod
             .energy()
             .moment(self.rod.length(), &Self::kappa(y[3]))[1];
-        let unit = self.rod.residual_scales().moment[1];
+        let unit = self.units.moment[1];
         r[0] = (m2
             - self
                 .rod
@@ -363,7 +366,7 @@ impl RodEquations for PlanarEquations {
             .rod
             .energy()
             .stiffness(self.rod.length(), &Self::kappa(y[3]))[(1, 1)];
-        let unit = self.rod.residual_scales().moment[1];
+        let unit = self.units.moment[1];
         DMatrix::from_row_slice(1, 4, &[0.0, 0.0, 0.0, h22 / unit])
     }
 
@@ -433,7 +436,7 @@ impl RodEquations for PlanarEquations {
     fn state_scales(&self) -> Vec<f64> {
         let l = self.rod.length();
         let mut scales = vec![l, l, 1.0, 1.0 / l];
-        scales.resize(self.dim(), self.rod.residual_scales().force);
+        scales.resize(self.dim(), self.units.force);
         scales
     }
 

@@ -392,9 +392,14 @@ impl Dop853 {
         let (mut err5, mut err3) = (0.0, 0.0);
         for i in 0..controlled {
             let sk = tol.atol + tol.rtol * y[i].abs().max(self.next[i].abs());
-            let bsum: f64 = B.iter().enumerate().map(|(l, b)| b * self.k[l][i]).sum();
+            // B and ER vanish at stages 2 to 5: summing over the others
+            // alone is the same sum at two thirds of the cost.
+            let (mut bsum, mut e5) = (B[0] * self.k[0][i], ER[0] * self.k[0][i]);
+            for l in 5..12 {
+                bsum += B[l] * self.k[l][i];
+                e5 += ER[l] * self.k[l][i];
+            }
             let e3 = bsum - BHH[0] * self.k[0][i] - BHH[1] * self.k[8][i] - BHH[2] * self.k[11][i];
-            let e5: f64 = ER.iter().enumerate().map(|(l, e)| e * self.k[l][i]).sum();
             err3 += (e3 / sk).powi(2);
             err5 += (e5 / sk).powi(2);
         }
