@@ -765,7 +765,12 @@ impl Run<'_> {
         });
         let qr = projected.qr();
         let independent = qr.r().diagonal().iter().all(|d| d.abs() > 1e-3);
-        independent.then(|| qr.q().column_iter().map(|c| c.into_owned()).collect())
+        independent.then(|| {
+            qr.q()
+                .column_iter()
+                .map(nalgebra::Matrix::into_owned)
+                .collect()
+        })
     }
 }
 

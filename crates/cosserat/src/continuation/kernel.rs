@@ -97,7 +97,7 @@ impl BandedJacobian {
 
     /// y = F_x x.
     pub fn apply(&self, x: &[f64], y: &mut [f64]) {
-        y.iter_mut().for_each(|v| *v = 0.0);
+        y.fill(0.0);
         for &(i, j, v) in &self.entries {
             y[i] += v * x[j];
         }
