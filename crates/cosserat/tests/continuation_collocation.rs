@@ -157,3 +157,70 @@ fn collocation_steps_do_not_shrink_with_the_mesh() {
         "collocation {fine} points, shooting {shooting}"
     );
 }
+
+/// The Euler column's double branch point (B1 = B2, the Kirchhoff model
+/// sees both buckling planes) on collocation meshes of 16 and 32
+/// intervals: 16 (≈ 150 unknowns) runs the dense bordered test and the
+/// dense kernel of [F_x F_p], 32 (≈ 300, above the dense limit) the O(N)
+/// ones (inverse iteration on the band LU, `continuation/kernel.rs`). Both
+/// are located at π²/4 (Euler 1744) within the collocation error measured
+/// between them (|p16 − π²/4| bounds the error of the finer mesh, whose
+/// order is ≥ 2) plus the event tolerance, and both switch onto the four
+/// buckled branches (two kernel directions, both ways), which bend.
+#[test]
+#[cfg_attr(
+    debug_assertions,
+    ignore = "two collocation diagrams, ≈ 3 s in release: run with --release"
+)]
+fn double_branch_point_switches_on_a_large_collocation_family() {
+    let reference = std::f64::consts::PI.powi(2) / 4.0;
+    let column = include_str!("../../../problems/euler_column.toml");
+    let run = |intervals: usize| {
+        let set = [
+            "solver.method=\"collocation\"".to_string(),
+            "solver.model=\"kirchhoff\"".to_string(),
+            format!("continuation.intervals={intervals}"),
+            "continuation.bounds=[0.0, 2.7]".to_string(),
+        ];
+        let p = Problem::from_str_with(column, &set).unwrap();
+        let (family, opts) = p.continuation.clone().unwrap();
+        (
+            family.size(),
+            continuation(&family, &opts, &mut |_, _| true).unwrap(),
+        )
+    };
+    let (coarse_size, coarse) = run(16);
+    let (fine_size, fine) = run(32);
+    assert!(
+        coarse_size <= 200 && fine_size > 200,
+        "{coarse_size}, {fine_size}"
+    );
+    let located = |d: &cosserat::continuation::Diagram| {
+        let bps: Vec<_> = d
+            .special_points
+            .iter()
+            .filter(|s| s.kind == SpecialKind::BranchPoint)
+            .collect();
+        assert_eq!(bps.len(), 1, "one double branch point");
+        assert_eq!(bps[0].multiplicity, 2);
+        bps[0].point.parameter
+    };
+    let (p16, p32) = (located(&coarse), located(&fine));
+    let error16 = (p16 - reference).abs();
+    eprintln!(
+        "16: {p16} ({error16:e}), 32: {p32} ({:e})",
+        (p32 - reference).abs()
+    );
+    assert!(
+        (p32 - reference).abs() <= error16 + 1e-10 * reference,
+        "32 intervals: {p32} against π²/4 = {reference}"
+    );
+    for d in [&coarse, &fine] {
+        assert_eq!(d.branches.len(), 5, "the loading branch and four switched");
+        for b in &d.branches[1..] {
+            let last = b.points.last().unwrap();
+            assert!(last.parameter > 2.6, "a switched branch reaches the bound");
+            assert!(last.norm > 0.1, "and is buckled (‖κ‖ = {})", last.norm);
+        }
+    }
+}

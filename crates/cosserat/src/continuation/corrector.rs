@@ -48,7 +48,7 @@ fn bordered_solve(a: DMatrix<f64>, rhs: &DVector<f64>) -> Option<DVector<f64>> {
 /// in the solve decides whether a step converges (measured: accurate
 /// staircase solves, residual 1e-26 against right-hand sides 1e-10, still
 /// end that branch at λ = 0.9757 instead of 1).
-pub(super) const DENSE_UP_TO: usize = 200;
+pub(crate) const DENSE_UP_TO: usize = 200;
 
 /// F_x at a point in the shape of the family's discretization: dense for
 /// single shooting and small systems, almost block diagonal

@@ -27,10 +27,12 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use super::corrector::DENSE_UP_TO;
+use super::kernel::BandedJacobian;
 use super::{Location, Point, Run, SpecialKind, SpecialPoint};
 use crate::model::ModelLevel;
 use crate::numerics::scalar::{End, Illinois};
-use crate::numerics::staircase::StaircaseLu;
+use crate::numerics::staircase::{Staircase, StaircaseLu};
 use crate::stability::Block;
 
 /// A test function along the step from a point: f(σ) and the point there.
@@ -190,6 +192,25 @@ impl Run<'_> {
         self.dense_jacobian(x, p).ok().map(|(_, j)| j)
     }
 
+    /// F_x at (x, p) as a staircase when the family's systems are solved
+    /// in O(N) (multiple shooting and collocation above
+    /// [`DENSE_UP_TO`] unknowns, as the corrector does); None for the
+    /// small dense systems, whose results stay those of the dense SVD.
+    fn large_jacobian(&self, x: &[f64], p: f64) -> Option<Staircase> {
+        if x.len() <= DENSE_UP_TO {
+            return None;
+        }
+        let mut a = self.family.staircase()?;
+        let mut r = DVector::zeros(x.len());
+        self.family.residual_staircase(x, p, &mut r, &mut a).ok()?;
+        Some(a)
+    }
+
+    /// Whether the events of this family use the O(N) algebra.
+    fn is_large(&self, n: usize) -> bool {
+        n > DENSE_UP_TO && self.family.staircase().is_some()
+    }
+
     /// det F_x, dense up to [`super::corrector::DENSE_UP_TO`] unknowns;
     /// above, from the O(N) staircase factors as sign · |det|^(1/N) (the
     /// geometric mean of the pivots: the same sign and root, without the
@@ -221,6 +242,9 @@ impl Run<'_> {
         right: &DMatrix<f64>,
         left: &DMatrix<f64>,
     ) -> Option<DMatrix<f64>> {
+        if self.is_large(x.len()) {
+            return self.bordered_banded(x, p, right, left);
+        }
         let fx = self.jacobian(x, p)?;
         let (n, m) = (x.len(), right.ncols());
         let mut big = DMatrix::zeros(n + m, n + m);
@@ -232,6 +256,53 @@ impl Run<'_> {
         let solution = big.lu().solve(&rhs)?;
         let g = solution.rows(n, m).into_owned();
         g.iter().all(|v| v.is_finite()).then_some(g)
+    }
+
+    /// Govaerts' G in O(N) where F_x is a large staircase: with F_x
+    /// regular, block elimination of [F_x Ψ; Φᵀ 0] [V; G] = [0; I_m]
+    /// gives V = −F_x⁻¹ Ψ G and G = −(Φᵀ F_x⁻¹ Ψ)⁻¹ (the Schur
+    /// complement; det of the bordered matrix = det F_x · det(−Φᵀ F_x⁻¹ Ψ),
+    /// so G exists exactly where the bordered matrix is regular). m band
+    /// solves with the LU of F_x; None where F_x has an exactly zero pivot
+    /// or the Schur complement is singular.
+    fn bordered_banded(
+        &self,
+        x: &[f64],
+        p: f64,
+        right: &DMatrix<f64>,
+        left: &DMatrix<f64>,
+    ) -> Option<DMatrix<f64>> {
+        let a = self.large_jacobian(x, p)?;
+        let mut lu = StaircaseLu::default();
+        lu.factor(&a, None).ok()?;
+        let m = right.ncols();
+        let mut schur = DMatrix::zeros(m, m);
+        let mut y = vec![0.0; x.len()];
+        for c in 0..m {
+            y.copy_from_slice(left.column(c).as_slice());
+            if !lu.solve(&mut y) {
+                return None;
+            }
+            for r in 0..m {
+                schur[(r, c)] = right.column(r).iter().zip(&y).map(|(u, v)| u * v).sum();
+            }
+        }
+        let g: DMatrix<f64> = -schur.try_inverse()?;
+        g.iter().all(|v| v.is_finite()).then_some(g)
+    }
+
+    /// The borders of the bordered test at one end in O(N): the m
+    /// smallest singular triplets of the staircase F_x by inverse
+    /// iteration ([`BandedJacobian::smallest`]) and σ_m/σ_{m+1}.
+    fn banded_borders(&self, end: &Point, m: usize) -> Option<(f64, DMatrix<f64>, DMatrix<f64>)> {
+        let a = self.large_jacobian(&end.unknowns, end.parameter)?;
+        let s = BandedJacobian::of(&a)?.smallest(m + 1)?;
+        let ratio = s.values[m - 1] / s.values[m];
+        Some((
+            ratio,
+            s.right.columns(0, m).into_owned(),
+            s.left.columns(0, m).into_owned(),
+        ))
     }
 
     /// The bordered test of multiplicity m for the step from `a` to `b`:
@@ -247,6 +318,13 @@ impl Run<'_> {
         }
         let mut best: Option<(f64, DMatrix<f64>, DMatrix<f64>)> = None;
         for end in [a, b] {
+            if self.is_large(n) {
+                let here = self.banded_borders(end, m)?;
+                if best.as_ref().is_none_or(|b| here.0 < b.0) {
+                    best = Some(here);
+                }
+                continue;
+            }
             let svd = self.jacobian(&end.unknowns, end.parameter)?.svd(true, true);
             let (u, v_t) = (svd.u.as_ref()?, svd.v_t.as_ref()?);
             let mut idx: Vec<usize> = (0..n).collect();
@@ -596,6 +674,9 @@ impl Run<'_> {
         if m > n {
             return None;
         }
+        if self.is_large(n) {
+            return self.banded_kernel_directions(sp, neighbour);
+        }
         let fx = self.jacobian(x, p)?;
         let fp = self.family.parameter_derivative(x, p).ok()?;
         let mut e = DMatrix::zeros(n, n + 1);
@@ -627,6 +708,69 @@ impl Run<'_> {
                 .map(|&c| u.column(c).into_owned().normalize())
                 .collect(),
         )
+    }
+}
+
+impl Run<'_> {
+    /// [`Run::kernel_directions`] in O(N) where F_x is a large staircase.
+    /// At a branch point of multiplicity m, F_x has the m null vectors
+    /// φ_i (the smallest singular triplets by inverse iteration,
+    /// [`BandedJacobian::smallest`]) and F_p lies in its range, so the
+    /// null space of E = [F_x F_p] is spanned by the (φ_i, 0) and the
+    /// branch tangent τ: the directions are the (φ_i, 0) with their
+    /// τ-components removed, orthonormalized. Accepted where σ_i² and
+    /// ‖E τ‖² are all ≤ 1e-6 of the neighbour's ‖F_x‖_F² — the dense
+    /// test's bound on the m + 1 smallest eigenvalues of EᵀE, whose scale
+    /// is at least that — and the projected vectors stay independent
+    /// (a tangent inside the kernel of F_x leaves fewer than m).
+    fn banded_kernel_directions(
+        &self,
+        sp: &SpecialPoint,
+        neighbour: &Point,
+    ) -> Option<Vec<DVector<f64>>> {
+        let (x, p, m) = (
+            &sp.point.unknowns,
+            sp.point.parameter,
+            sp.multiplicity.max(1),
+        );
+        let n = x.len();
+        let fx = BandedJacobian::of(&self.large_jacobian(x, p)?)?;
+        let kernel = fx.smallest(m)?;
+        let near = self.large_jacobian(&neighbour.unknowns, neighbour.parameter)?;
+        let scale = BandedJacobian::of(&near)?
+            .frobenius()
+            .powi(2)
+            .max(f64::MIN_POSITIVE);
+        let fp = self.family.parameter_derivative(x, p).ok()?;
+        let tau = DVector::from_column_slice(&sp.point.tangent);
+        let mut e_tau = vec![0.0; n];
+        fx.apply(&sp.point.tangent[..n], &mut e_tau);
+        let e_tau: f64 = e_tau
+            .iter()
+            .zip(fp.iter())
+            .map(|(a, b)| (a + b * tau[n]).powi(2))
+            .sum();
+        if kernel.values.iter().any(|s| s * s > 1e-6 * scale) || e_tau > 1e-6 * scale {
+            return None;
+        }
+        // τᵀ(φ_c, 0) once per column: O(N m).
+        let along: Vec<f64> = kernel
+            .right
+            .column_iter()
+            .map(|phi| phi.iter().zip(tau.iter()).map(|(a, b)| a * b).sum())
+            .collect();
+        let projected = DMatrix::from_fn(n + 1, m, |r, c| {
+            let v = if r < n { kernel.right[(r, c)] } else { 0.0 };
+            v - tau[r] * along[c]
+        });
+        let qr = projected.qr();
+        let independent = qr.r().diagonal().iter().all(|d| d.abs() > 1e-3);
+        independent.then(|| {
+            qr.q()
+                .column_iter()
+                .map(nalgebra::Matrix::into_owned)
+                .collect()
+        })
     }
 }
 

@@ -34,7 +34,7 @@ use super::Run;
 /// for the two difference quotients) and factors three (n + 1)² matrices
 /// (the bordered system, its transpose, the Newton step), once per fold;
 /// measured 0.25 s per fold at 381 unknowns (collocation, 64 intervals).
-pub(super) const FOLD_DENSE_UP_TO: usize = 1000;
+pub(crate) const FOLD_DENSE_UP_TO: usize = 1000;
 
 /// Newton iterations before the augmented system is given up.
 const MAX_ITERATIONS: usize = 12;

@@ -32,6 +32,7 @@ pub mod engine;
 mod events;
 mod family;
 mod fold;
+mod kernel;
 mod landing;
 mod lens;
 mod measure;
@@ -44,12 +45,15 @@ mod status;
 mod tracking;
 
 pub use codim2::{follow_singular, CurveOptions, CurvePoint, Lens2, ParameterOn, SingularCurve};
+/// The size limits of the dense algebra (the memory estimate's).
+pub(crate) use corrector::DENSE_UP_TO;
 pub use corrector::{Linearization, RodFactors};
 pub use diagram::{
     Branch, ContinuationError, Diagram, Location, Point, Progress, SpecialKind, SpecialPoint,
 };
 pub use driver::continuation;
 pub use family::{tip_angle, CarryError, DerivativeMethod, Family, FamilyError, PointError};
+pub(crate) use fold::FOLD_DENSE_UP_TO;
 pub use lens::{Lens, Parameter, RodLens};
 pub use measure::{Measure, Quantity};
 pub use options::ContinuationOptions;

@@ -65,6 +65,11 @@ impl Run<'_> {
     /// approximates the direction of the copies of the branch being
     /// entered, which the slice through the predictor then excludes.
     pub(super) fn nearest_kernel(&self, x: &[f64], p: f64) -> Option<(DVector<f64>, DVector<f64>)> {
+        // Dense only: never the N² matrix of a large system (memory
+        // linear in the mesh), which has no slice.
+        if x.len() > super::corrector::DENSE_UP_TO {
+            return None;
+        }
         let (_, fx) = self.dense_jacobian(x, p).ok()?;
         smallest_pair(&fx).map(|(v, w, _)| (v, w))
     }
@@ -75,6 +80,9 @@ impl Run<'_> {
         x: &[f64],
         p: f64,
     ) -> Option<(DVector<f64>, DVector<f64>)> {
+        if x.len() > super::corrector::DENSE_UP_TO {
+            return None;
+        }
         let (_, fx) = self.dense_jacobian(x, p).ok()?;
         persistent_kernel(&fx)
     }
