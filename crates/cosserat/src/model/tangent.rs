@@ -65,6 +65,9 @@ impl RodTangent {
         finite("tip force rate", &rates.tip_force)?;
         finite("tip couple rate", &rates.tip_couple)?;
         finite("distributed force rate", &rates.distributed_force)?;
+        for p in &rates.point_forces {
+            finite("point force rate", &p.force)?;
+        }
         self.loads = rates;
         Ok(self)
     }
@@ -152,17 +155,30 @@ impl RodTangent {
             let h = e.stiffness(0.0, &Vector3::zeros());
             h == Matrix3::from_diagonal(&h.diagonal())
         };
-        (!energy_moves || (e.is_quadratic() && diagonal)) && (self.length == 0.0 || e.is_uniform())
+        // A point force stays at its s_k while a length rate moves every
+        // point at fixed σ = s/L: the jump would move in σ, a term the
+        // sensitivity equations do not carry.
+        let points_stay = self.length == 0.0 || rod.loads().point_forces.is_empty();
+        (!energy_moves || (e.is_quadratic() && diagonal))
+            && (self.length == 0.0 || e.is_uniform())
+            && points_stay
     }
 
-    /// dn/dp at a fixed σ = s/L of the internal force n = P + f (L − s)
-    /// ([`DeadLoads::internal_force`]): dP + df (L − s) + f L' (1 − s/L).
+    /// dn/dp at a fixed σ = s/L of the internal force n = P + f (L − s) +
+    /// Σ_{s_k > s} F_k ([`DeadLoads::internal_force`]): dP + df (L − s) +
+    /// f L' (1 − s/L) + Σ_{s_k > s} dF_k (the rates' point forces at the
+    /// rod's own points s_k; a length rate with point forces is not
+    /// [`RodTangent::fits`]).
     pub fn internal_force_rate(&self, rod: &Rod, s: f64) -> Vector3<f64> {
         let l = rod.length();
         let f = rod.loads().distributed_force;
-        self.loads.tip_force
+        let mut rate = self.loads.tip_force
             + self.loads.distributed_force * (l - s)
-            + f * (self.length * (1.0 - s / l))
+            + f * (self.length * (1.0 - s / l));
+        for p in self.loads.point_forces.iter().filter(|p| p.s > s) {
+            rate += p.force;
+        }
+        rate
     }
 
     /// dM, dH and d(∂sM) at fixed (s, κ) for W = ½ Σ B_i (κ_i − κ⁰_i)²
