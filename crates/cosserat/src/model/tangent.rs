@@ -117,6 +117,31 @@ impl RodTangent {
         Ok(self)
     }
 
+    /// self + factor·other: the tangent of a parameter that moves several
+    /// numbers at once (linked keys, each at the rate `factor`), the rates
+    /// being linear in the motion (spins add as ω × d_i does). Point-force
+    /// rates are concatenated: n's rate sums over them.
+    #[must_use]
+    pub fn plus(mut self, other: &RodTangent, factor: f64) -> RodTangent {
+        let l = &other.loads;
+        self.loads.tip_force += l.tip_force * factor;
+        self.loads.tip_couple += l.tip_couple * factor;
+        self.loads.distributed_force += l.distributed_force * factor;
+        self.loads
+            .point_forces
+            .extend(l.point_forces.iter().map(|p| crate::model::PointForce {
+                s: p.s,
+                force: p.force * factor,
+            }));
+        self.length += other.length * factor;
+        self.stiffness += other.stiffness * factor;
+        self.intrinsic_curvature += other.intrinsic_curvature * factor;
+        self.clamp_spin += other.clamp_spin * factor;
+        self.support_shift += other.support_shift * factor;
+        self.support_spin += other.support_spin * factor;
+        self
+    }
+
     /// The spin Ω of the support's held frame.
     pub fn support_spin(&self) -> &Vector3<f64> {
         &self.support_spin
