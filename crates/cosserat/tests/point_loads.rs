@@ -6,8 +6,11 @@
 mod support;
 
 use cosserat::bvp::{solve, Equilibrium, Method, SolverOptions};
+use cosserat::continuation::{continuation, Diagram, Location, SpecialKind, SpecialPoint};
+use cosserat::input::Problem;
 use cosserat::model::{DeadLoads, ModelChoice, ModelLevel, PointForce, Rod};
 use cosserat::references::CantileverTip;
+use cosserat::references::{arch_elastica_folds, strip_elastica_fold};
 use nalgebra::Vector3;
 
 /// Every method; 8 segments and the default collocation mesh put no node at
@@ -81,4 +84,117 @@ fn a_cantilever_loaded_inside_is_bisshopp_drucker_up_to_the_load() {
             }
         }
     }
+}
+
+const ARCH_FULL: &str = include_str!("../../../problems/shallow_arch_full.toml");
+const ARCH_HALF: &str = include_str!("../../../problems/shallow_arch_snap.toml");
+const STRIP_FULL: &str = include_str!("../../../problems/bistable_strip_full.toml");
+const STRIP_HALF: &str = include_str!("../../../problems/bistable_strip_snap.toml");
+
+fn diagram(text: &str, sets: &[&str]) -> Diagram {
+    let sets: Vec<String> = sets.iter().map(|s| (*s).to_string()).collect();
+    let problem = Problem::from_str_with(text, &sets).unwrap();
+    let (family, opts) = problem.continuation.clone().unwrap();
+    continuation(&family, &opts, &mut |_, _| true).unwrap()
+}
+
+/// The first fold of branch `b` located on the augmented system.
+fn first_fold(d: &Diagram, b: usize) -> SpecialPoint {
+    d.special_points
+        .iter()
+        .filter(|s| s.kind == SpecialKind::Fold && s.branch == b)
+        .min_by_key(|s| s.index)
+        .cloned()
+        .expect("a fold")
+}
+
+/// The full clamped arch with its crown load as `[[loads.point]]` folds
+/// where the half model (crown load P/2 on a guided clamp) folds, P = 2Q,
+/// and where the independent elastica shooting folds, to 1e-8 relative;
+/// on the full arch the asymmetric branch point (Morse index 1 → 2) comes
+/// only after the fold, on the unstable branch, for Θ = 0.3: the limit
+/// point governs this low arch.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "two continuations: seconds in release")]
+fn full_arch_loaded_at_its_crown_folds_as_the_half_model() {
+    let elastica = arch_elastica_folds(0.3).unwrap();
+    let exact = 2.0 * elastica.loads[0];
+    let full = diagram(
+        ARCH_FULL,
+        &[
+            "continuation.bounds=[-1.0, 5.0]",
+            "continuation.switch_depth=0",
+        ],
+    );
+    let fold = first_fold(&full, 0);
+    assert_eq!(fold.location, Location::Augmented);
+    let half = diagram(ARCH_HALF, &["continuation.bounds=[-1.0, 3.0]"]);
+    let half_fold = 2.0 * first_fold(&half, 0).point.parameter;
+    let p = fold.point.parameter;
+    eprintln!("full fold {p:.13}, half 2Q {half_fold:.13}, elastica {exact:.13}");
+    assert!((p - exact).abs() <= 1e-8 * exact, "{p} vs elastica {exact}");
+    assert!(
+        (p - half_fold).abs() <= 1e-8 * exact,
+        "{p} vs half {half_fold}"
+    );
+    let branch_point = full
+        .special_points
+        .iter()
+        .find(|s| s.kind == SpecialKind::BranchPoint && s.branch == 0)
+        .expect("the asymmetric branch point");
+    eprintln!(
+        "asymmetric branch point at P = {:.10} after the fold (index {} > {})",
+        branch_point.point.parameter, branch_point.index, fold.index
+    );
+    assert!(branch_point.index > fold.index);
+    assert!(branch_point.point.parameter < p);
+    let before: Vec<_> = full.branches[0].points[..fold.index]
+        .iter()
+        .filter(|q| q.parameter > 0.1)
+        .collect();
+    assert!(before.iter().all(|q| q.stable), "stable up to the fold");
+}
+
+/// The full strip with both clamps turned by one linked parameter
+/// (`continuation.link`) folds at the half model's and the elastica's α
+/// to 1e-8 relative; its in-plane Morse index turns 0 → 1 before the
+/// fold: the asymmetric mode comes first, so the full strip loses
+/// stability before the symmetric fold (the half model cannot see it).
+#[test]
+#[cfg_attr(debug_assertions, ignore = "two continuations: seconds in release")]
+fn full_strip_turned_by_a_linked_parameter_folds_as_the_half_model() {
+    let (exact, _) = strip_elastica_fold(0.9).unwrap();
+    let bounds = "continuation.bounds=[-0.9, 0.05]";
+    let full = diagram(STRIP_FULL, &[bounds]);
+    let half = diagram(STRIP_HALF, &[bounds]);
+    let fold_of = |d: &Diagram| {
+        let f = d
+            .special_points
+            .iter()
+            .find(|s| s.kind == SpecialKind::Fold)
+            .cloned()
+            .expect("a fold");
+        assert_eq!(f.location, Location::Augmented);
+        f
+    };
+    let (fold, half_fold) = (fold_of(&full), fold_of(&half));
+    let alpha = -fold.point.parameter;
+    eprintln!(
+        "full α {alpha:.13}, half {:.13}, elastica {exact:.13}",
+        -half_fold.point.parameter
+    );
+    assert!((alpha - exact).abs() <= 1e-8 * exact);
+    assert!((fold.point.parameter - half_fold.point.parameter).abs() <= 1e-8 * exact);
+    let points = &full.branches[fold.branch].points;
+    assert_eq!(points[0].morse_index, 0, "the inverted strip is stable");
+    let lost = points[..fold.index]
+        .iter()
+        .position(|q| q.morse_index > 0)
+        .expect("stability lost before the fold");
+    eprintln!(
+        "asymmetric mode: Morse index 0 → 1 between α = {:.6} and {:.6}",
+        -points[lost - 1].parameter,
+        -points[lost].parameter
+    );
+    assert!(-points[lost].parameter < alpha);
 }
