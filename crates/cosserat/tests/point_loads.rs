@@ -327,7 +327,7 @@ fn hostile_point_loads_and_links_are_refused_by_name() {
         ),
     ];
     for (set, field) in &links {
-        let got = match Problem::from_str_with(STRIP_FULL, &[set.clone()]) {
+        let got = match Problem::from_str_with(STRIP_FULL, std::slice::from_ref(set)) {
             Err(ProblemError::Invalid { field, .. }) => field,
             Err(other) => format!("{other}"),
             Ok(_) => panic!("{set}: accepted"),

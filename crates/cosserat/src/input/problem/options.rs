@@ -232,6 +232,25 @@ fn check_measures(
             ));
         }
     }
+    let integral = opts.measures.iter().find(|m| {
+        matches!(
+            m,
+            Measure::Turning | Measure::StoredEnergy | Measure::TotalPotentialEnergy
+        )
+    });
+    if let (Some(m), false) = (integral, rod.loads().point_forces.is_empty()) {
+        // The measure's quadrature straddles the jump of n(s), and the
+        // potential has no −F_k·r(s_k) term: refused, not approximate.
+        return Err(invalid(
+            "continuation.measures",
+            format!(
+                "`{}` is not computed with [[loads.point]] yet (its quadrature does not stop \
+                 at the points, and the potential leaves out their work); sample \
+                 `position[i]@σ` instead",
+                m.name()
+            ),
+        ));
+    }
     let spins = rod
         .support()
         .as_ref()
