@@ -13,6 +13,7 @@ use cosserat::input::{Problem, ProblemError};
 use cosserat::model::{DeadLoads, ModelChoice, ModelLevel, PointForce, Rod};
 use cosserat::references::CantileverTip;
 use cosserat::references::{arch_elastica_folds, strip_elastica_fold};
+use cosserat::stability::StabilityOptions;
 use nalgebra::{DVector, Vector3};
 
 /// Every method; 8 segments and the default collocation mesh put no node at
@@ -220,7 +221,8 @@ fn central_reference(family: &Family, x: &[f64], p: f64, h: f64) -> DVector<f64>
 /// A point force's component and a linked parameter are differentiated
 /// exactly (the sensitivity equations carried across the jump; the sum of
 /// the linked keys' partials), against extrapolated central differences
-/// to 1e-9 relative, on single and multiple shooting.
+/// to 1e-9 relative, on single and multiple shooting and on continuation's
+/// fixed-mesh collocation (Gauss steps split at the jump).
 #[test]
 fn point_force_and_linked_parameters_have_exact_derivatives() {
     let cases = [
@@ -232,7 +234,7 @@ fn point_force_and_linked_parameters_have_exact_derivatives() {
         (STRIP_FULL, "continuation.start=0.0", "clamp.angle"),
     ];
     for (text, start, key) in cases {
-        for method in ["shooting", "multiple-shooting"] {
+        for method in ["shooting", "multiple-shooting", "collocation"] {
             let sets = [
                 start.to_string(),
                 format!("solver.method={method:?}"),
@@ -260,6 +262,22 @@ fn point_force_and_linked_parameters_have_exact_derivatives() {
             );
         }
     }
+}
+
+/// The stability analysis refuses elements across which n(s) jumps, by
+/// name, and accepts a count that puts s₀ on a boundary.
+#[test]
+fn stability_elements_must_not_straddle_a_point_force() {
+    let rod = loaded_at(0.5, 2.0);
+    let eq = solve_with(&rod, ModelLevel::Planar, Method::Shooting);
+    let solver = options(Method::Shooting);
+    let analyze = |elements| {
+        let opts = StabilityOptions::new(elements, 2, 2).unwrap();
+        cosserat::stability::analyze(&rod, &eq, &solver, &opts)
+    };
+    let refused = analyze(33).unwrap_err().to_string();
+    assert!(refused.contains("inside an element"), "{refused}");
+    assert!(analyze(32).unwrap().stable);
 }
 
 /// The field a problem's refusal names.

@@ -417,6 +417,13 @@ pub fn decide(
         ));
     }
     if needed > opts.elements {
+        // A multiple of the asked count keeps point forces on element
+        // boundaries (check_jumps_on_boundaries) where the asked count does.
+        let needed = if rod.loads().point_forces.is_empty() {
+            needed
+        } else {
+            needed.div_ceil(opts.elements) * opts.elements
+        };
         opts = opts.with_elements(needed)?;
     }
     let first = opts.elements;
