@@ -30,6 +30,9 @@ pub struct ShootingSystem<'a> {
     /// Segments as single Gauss–Legendre steps (the collocation equations
     /// of the segment mesh) instead of adaptive DOP853 integration.
     gauss: Option<Tableau>,
+    /// The interior points where the right-hand side jumps
+    /// ([`RodEquations::jumps`]): every integration stops there.
+    jumps: Vec<f64>,
     /// Integration work so far.
     pub stats: IntegrationStats,
 }
@@ -45,6 +48,7 @@ impl<'a> ShootingSystem<'a> {
             dop: Dop853::new(eq.dim()),
             scales,
             gauss: None,
+            jumps: eq.jumps(),
             stats: IntegrationStats::default(),
         }
     }
@@ -111,9 +115,15 @@ impl<'a> ShootingSystem<'a> {
     ) -> Result<(Vec<f64>, DMatrix<f64>), IntegrationError> {
         let n = self.eq.dim();
         if let Some(tab) = &self.gauss {
-            let (a, b) = (self.node(j), self.node(j + 1));
-            self.stats.accepted += 1;
-            return gauss_step(self.eq, tab, a, b - a, start, phi0, forcing);
+            // A jump inside the interval splits the Gauss step there: the
+            // state and its sensitivities are continuous across a point
+            // force, so the pieces chain.
+            let mut y = (start.to_vec(), phi0.clone());
+            for (a, b) in pieces(&self.jumps, self.node(j), self.node(j + 1)) {
+                self.stats.accepted += 1;
+                y = gauss_step(self.eq, tab, a, b - a, &y.0, &y.1, forcing)?;
+            }
+            return Ok(y);
         }
         let cols = phi0.ncols();
         let mut y = Vec::with_capacity(n * (cols + 1));
@@ -121,7 +131,7 @@ impl<'a> ShootingSystem<'a> {
         y.extend_from_slice(phi0.as_slice());
         let eq = self.eq;
         let mut fp = vec![0.0; if forcing.is_some() { n } else { 0 }];
-        let rhs = |s: f64, y: &[f64], d: &mut [f64]| {
+        let mut rhs = |s: f64, y: &[f64], d: &mut [f64]| {
             let (dy, dphi) = d.split_at_mut(n);
             eq.rhs_linearized(s, &y[..n], cols, &y[n..], dy, dphi);
             if let Some(t) = forcing {
@@ -130,32 +140,35 @@ impl<'a> ShootingSystem<'a> {
                 last.iter_mut().zip(&fp).for_each(|(a, b)| *a += b);
             }
         };
-        let (a, b) = (self.node(j), self.node(j + 1));
         // Error control covers the sensitivities too (CVODES' "full" error
         // control): a trivial state (a straight column) would otherwise let
         // the steps grow until Φ, and so the Jacobian and the location of
         // its singularities, is wrong.
         let controlled = y.len();
-        let stats = self.dop.integrate(
-            rhs,
-            a,
-            b,
-            &mut y,
-            controlled,
-            &self.tol,
-            &[],
-            |_, _| {},
-            |y| {
-                // Interior nodes are free unknowns off the orthonormal
-                // manifold during Newton: projecting there would make Φ
-                // inconsistent with the flow. The exact flow preserves
-                // d_i·d_j, so nothing drifts that the clamp did not set.
-                if j == 0 {
-                    eq.project(&mut y[..n]);
-                }
-            },
-        )?;
-        self.stats += stats;
+        // The state and Φ are continuous across a point force: the pieces
+        // between jumps chain with the same y.
+        for (a, b) in pieces(&self.jumps, self.node(j), self.node(j + 1)) {
+            let stats = self.dop.integrate(
+                &mut rhs,
+                a,
+                b,
+                &mut y,
+                controlled,
+                &self.tol,
+                &[],
+                |_, _| {},
+                |y| {
+                    // Interior nodes are free unknowns off the orthonormal
+                    // manifold during Newton: projecting there would make Φ
+                    // inconsistent with the flow. The exact flow preserves
+                    // d_i·d_j, so nothing drifts that the clamp did not set.
+                    if j == 0 {
+                        eq.project(&mut y[..n]);
+                    }
+                },
+            )?;
+            self.stats += stats;
+        }
         let phi = DMatrix::from_column_slice(n, cols, &y[n..]);
         y.truncate(n);
         Ok((y, phi))
@@ -173,18 +186,20 @@ impl<'a> ShootingSystem<'a> {
         for j in 1..self.segments {
             if alive {
                 let eq = self.eq;
-                let out = self.dop.integrate(
-                    |s, y: &[f64], d: &mut [f64]| eq.rhs(s, y, d),
-                    self.node(j - 1),
-                    self.node(j),
-                    &mut y,
-                    n,
-                    &self.tol,
-                    &[],
-                    |_, _| {},
-                    |y| eq.project(y),
-                );
-                alive = out.is_ok();
+                for (a, b) in pieces(&self.jumps, self.node(j - 1), self.node(j)) {
+                    let out = self.dop.integrate(
+                        |s, y: &[f64], d: &mut [f64]| eq.rhs(s, y, d),
+                        a,
+                        b,
+                        &mut y,
+                        n,
+                        &self.tol,
+                        &[],
+                        |_, _| {},
+                        |y| eq.project(y),
+                    );
+                    alive = alive && out.is_ok();
+                }
             }
             if !alive {
                 y = self.eq.straight_state(self.node(j));
@@ -222,17 +237,19 @@ impl<'a> ShootingSystem<'a> {
             let eq = self.eq;
             // The new nodes read from the continuous extension: a fine mesh
             // costs the steps the tolerance needs, not one per node.
-            let stats = self.dop.integrate_serving(
-                |s, y: &[f64], d: &mut [f64]| eq.rhs(s, y, d),
-                (a, b, n),
-                &mut y,
-                &self.tol,
-                &stops,
-                Stops::Interpolated,
-                |_, y| out.extend_from_slice(&y[..n]),
-                |y| eq.project(y),
-            )?;
-            self.stats += stats;
+            for (pa, pb, stops) in served_pieces(&self.jumps, a, b, &stops, false) {
+                let stats = self.dop.integrate_serving(
+                    |s, y: &[f64], d: &mut [f64]| eq.rhs(s, y, d),
+                    (pa, pb, n),
+                    &mut y,
+                    &self.tol,
+                    stops,
+                    Stops::Interpolated,
+                    |_, y| out.extend_from_slice(&y[..n]),
+                    |y| eq.project(y),
+                )?;
+                self.stats += stats;
+            }
         }
         debug_assert_eq!(out.len(), p + n * fine.len());
         Ok(out)
@@ -457,17 +474,19 @@ impl<'a> ShootingSystem<'a> {
                 .collect();
             let mut y = self.node_state(x, j);
             let eq = self.eq;
-            let stats = self.dop.integrate_serving(
-                |s, y: &[f64], d: &mut [f64]| eq.rhs(s, y, d),
-                (a, b, n),
-                &mut y,
-                &self.tol,
-                &stops,
-                Stops::Interpolated,
-                |s, y| samples.push(eq.sample(s, y)),
-                |y| eq.project(y),
-            )?;
-            self.stats += stats;
+            for (pa, pb, stops) in served_pieces(&self.jumps, a, b, &stops, last) {
+                let stats = self.dop.integrate_serving(
+                    |s, y: &[f64], d: &mut [f64]| eq.rhs(s, y, d),
+                    (pa, pb, n),
+                    &mut y,
+                    &self.tol,
+                    stops,
+                    Stops::Interpolated,
+                    |s, y| samples.push(eq.sample(s, y)),
+                    |y| eq.project(y),
+                )?;
+                self.stats += stats;
+            }
         }
         let drift = samples
             .iter()
@@ -475,6 +494,57 @@ impl<'a> ShootingSystem<'a> {
             .fold(0.0, f64::max);
         Ok((samples, drift))
     }
+}
+
+/// The pieces of [a, b] on which the right-hand side is smooth: a jump s_k
+/// in (a, b] ends a piece at the float just below s_k (so that every
+/// evaluation on it, the step's last stage included, sees the left limit
+/// n(s_k⁻)) and, if s_k < b, starts the next at s_k (where the right-hand
+/// side is the right limit, [`crate::model::DeadLoads::internal_force`]).
+/// The ulp left out moves the state by O(ε |y'|). One piece without jumps.
+fn pieces(jumps: &[f64], a: f64, b: f64) -> Vec<(f64, f64)> {
+    let mut out = Vec::with_capacity(1);
+    let mut start = a;
+    for &s in jumps.iter().filter(|&&s| s > a && s <= b) {
+        let end = s.next_down();
+        if end > start {
+            out.push((start, end));
+        }
+        start = s;
+    }
+    if start < b {
+        out.push((start, b));
+    }
+    out
+}
+
+/// [`pieces`] of [a, b], each with the points of `stops` (sorted, in
+/// [a, b)) it serves: those in [start, next start); the last piece serves
+/// b too when `closed`.
+fn served_pieces<'s>(
+    jumps: &[f64],
+    a: f64,
+    b: f64,
+    stops: &'s [f64],
+    closed: bool,
+) -> Vec<(f64, f64, &'s [f64])> {
+    let ps = pieces(jumps, a, b);
+    let mut out = Vec::with_capacity(ps.len());
+    let mut rest = stops;
+    for (i, &(pa, pb)) in ps.iter().enumerate() {
+        let upto = ps.get(i + 1).map_or(b, |next| next.0);
+        let last = i + 1 == ps.len();
+        let count = rest
+            .iter()
+            .take_while(|&&s| s < upto || (last && closed && s <= upto))
+            .count();
+        let (mine, others) = rest.split_at(count);
+        // A stop in the ulp between the piece's end and the jump is read
+        // at the piece's end.
+        out.push((pa, pb, mine));
+        rest = others;
+    }
+    out
 }
 
 impl NonlinearSystem for ShootingSystem<'_> {

@@ -440,6 +440,10 @@ impl RodEquations for KirchhoffEquations {
         self.rod.length()
     }
 
+    fn jumps(&self) -> Vec<f64> {
+        self.rod.loads().jumps()
+    }
+
     fn initial_state(&self, u: &[f64], y0: &mut [f64]) {
         let c = &self.rod.clamp();
         y0[0..3].copy_from_slice(c.director(0).as_slice());

@@ -44,6 +44,12 @@ pub trait RodEquations: Send + Sync {
     fn unknowns(&self) -> usize;
     /// The rod length L (the interval is [0, L]).
     fn length(&self) -> f64;
+    /// The interior points where the right-hand side jumps (point forces:
+    /// [`crate::model::DeadLoads::jumps`]), sorted. Every solver stops its
+    /// integration there, puts a mesh node there, and never evaluates the
+    /// right-hand side of one side at the other's s (the right-hand side
+    /// at s = s_k is the right limit).
+    fn jumps(&self) -> Vec<f64>;
     /// y(0) for the free initial values u.
     fn initial_state(&self, u: &[f64], y0: &mut [f64]);
     /// ∂y(0)/∂u (dim × unknowns); y(0) is affine in u.

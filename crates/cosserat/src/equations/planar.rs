@@ -279,6 +279,10 @@ impl RodEquations for PlanarEquations {
         self.rod.length()
     }
 
+    fn jumps(&self) -> Vec<f64> {
+        self.rod.loads().jumps()
+    }
+
     fn initial_state(&self, u: &[f64], y0: &mut [f64]) {
         y0[..3].fill(0.0);
         y0[3..].copy_from_slice(u);

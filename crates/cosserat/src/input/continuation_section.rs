@@ -7,6 +7,25 @@ use super::mesh::MeshKeys;
 use super::problem::{invalid, within, ProblemError, NEWTON_TOLERANCE};
 use crate::continuation::{ContinuationOptions, Measure};
 
+/// One entry of `continuation.link`: a numeric key of the rod's tables
+/// set to `factor`·p + `offset` whenever the parameter is p.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct LinkSection {
+    /// The linked key, in the `--set` grammar (`support.turn.angle`).
+    pub key: String,
+    /// d(key)/dp.
+    #[serde(default = "unit_factor")]
+    pub factor: f64,
+    /// The key's value at p = 0.
+    #[serde(default)]
+    pub offset: f64,
+}
+
+fn unit_factor() -> f64 {
+    1.0
+}
+
 /// `[continuation]`.
 #[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
 #[serde(deny_unknown_fields)]
@@ -16,6 +35,10 @@ pub struct ContinuationSection {
     /// `[loads]` in the `--set` grammar (`loads.tip_force[2]`,
     /// `support.position[2]`, `support.turn.angle`, `energy.parameters.quartic`).
     pub parameter: String,
+    /// Keys set with the parameter (linked parameters): each to
+    /// factor·p + offset, e.g. both end turns of a strip by one angle.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub link: Vec<LinkSection>,
     /// The value to start from.
     pub start: f64,
     /// [min, max]: a branch stops when the parameter leaves it.

@@ -17,7 +17,7 @@ mod sweep_section;
 mod turn_section;
 
 pub use arm_section::ArmSection;
-pub use continuation_section::{ContinuationSection, CurveSection, MEASURES};
+pub use continuation_section::{ContinuationSection, CurveSection, LinkSection, MEASURES};
 pub use problem::{Problem, ProblemError, ProblemFile, ProfileSpec, MAX_PROBLEM_BYTES};
 pub use support_section::SupportSection;
 pub use sweep_section::{AxisSpec, SweepSection};

@@ -73,6 +73,22 @@ pub enum ModelError {
         /// The refused value.
         value: f64,
     },
+    /// A point load (`index` k from 0, in the order given) is not at an
+    /// interior point 0 < s < L, or its force is not finite.
+    #[error(
+        "point load {index} must act at an interior point 0 < s < {length} with a finite force, \
+         got s = {s}, force {force:?}"
+    )]
+    PointLoad {
+        /// Which point load, from 0.
+        index: usize,
+        /// Its point of application.
+        s: f64,
+        /// Its force.
+        force: [f64; 3],
+        /// The rod length.
+        length: f64,
+    },
     /// A profile of s cannot be built: what is wrong with it.
     #[error("invalid profile: {0}")]
     Profile(String),

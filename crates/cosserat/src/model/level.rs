@@ -103,11 +103,18 @@ fn planar_obstruction(rod: &Rod) -> Option<String> {
         return Some("the intrinsic curvature has κ⁰1 or κ⁰3 components".into());
     }
     let normal = rod.clamp().director(1);
-    let scale = rod
-        .loads()
-        .moment_scale(rod.length())
-        .max(f64::MIN_POSITIVE);
     let loads = &rod.loads();
+    let scale = loads
+        .point_forces
+        .iter()
+        .map(|p| p.force.norm() * p.s)
+        .fold(loads.moment_scale(rod.length()), f64::max)
+        .max(f64::MIN_POSITIVE);
+    for (k, p) in loads.point_forces.iter().enumerate() {
+        if (p.force.dot(&normal) * p.s).abs() > PLANE_TOLERANCE * scale {
+            return Some(format!("point force {k} has a component along d2(0)"));
+        }
+    }
     if (loads.tip_force.dot(&normal) * rod.length()).abs() > PLANE_TOLERANCE * scale {
         return Some("the tip force has a component along d2(0)".into());
     }

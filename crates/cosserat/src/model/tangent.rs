@@ -65,6 +65,9 @@ impl RodTangent {
         finite("tip force rate", &rates.tip_force)?;
         finite("tip couple rate", &rates.tip_couple)?;
         finite("distributed force rate", &rates.distributed_force)?;
+        for p in &rates.point_forces {
+            finite("point force rate", &p.force)?;
+        }
         self.loads = rates;
         Ok(self)
     }
@@ -114,6 +117,31 @@ impl RodTangent {
         Ok(self)
     }
 
+    /// self + factor·other: the tangent of a parameter that moves several
+    /// numbers at once (linked keys, each at the rate `factor`), the rates
+    /// being linear in the motion (spins add as ω × d_i does). Point-force
+    /// rates are concatenated: n's rate sums over them.
+    #[must_use]
+    pub fn plus(mut self, other: &RodTangent, factor: f64) -> RodTangent {
+        let l = &other.loads;
+        self.loads.tip_force += l.tip_force * factor;
+        self.loads.tip_couple += l.tip_couple * factor;
+        self.loads.distributed_force += l.distributed_force * factor;
+        self.loads
+            .point_forces
+            .extend(l.point_forces.iter().map(|p| crate::model::PointForce {
+                s: p.s,
+                force: p.force * factor,
+            }));
+        self.length += other.length * factor;
+        self.stiffness += other.stiffness * factor;
+        self.intrinsic_curvature += other.intrinsic_curvature * factor;
+        self.clamp_spin += other.clamp_spin * factor;
+        self.support_shift += other.support_shift * factor;
+        self.support_spin += other.support_spin * factor;
+        self
+    }
+
     /// The spin Ω of the support's held frame.
     pub fn support_spin(&self) -> &Vector3<f64> {
         &self.support_spin
@@ -152,17 +180,30 @@ impl RodTangent {
             let h = e.stiffness(0.0, &Vector3::zeros());
             h == Matrix3::from_diagonal(&h.diagonal())
         };
-        (!energy_moves || (e.is_quadratic() && diagonal)) && (self.length == 0.0 || e.is_uniform())
+        // A point force stays at its s_k while a length rate moves every
+        // point at fixed σ = s/L: the jump would move in σ, a term the
+        // sensitivity equations do not carry.
+        let points_stay = self.length == 0.0 || rod.loads().point_forces.is_empty();
+        (!energy_moves || (e.is_quadratic() && diagonal))
+            && (self.length == 0.0 || e.is_uniform())
+            && points_stay
     }
 
-    /// dn/dp at a fixed σ = s/L of the internal force n = P + f (L − s)
-    /// ([`DeadLoads::internal_force`]): dP + df (L − s) + f L' (1 − s/L).
+    /// dn/dp at a fixed σ = s/L of the internal force n = P + f (L − s) +
+    /// Σ_{s_k > s} F_k ([`DeadLoads::internal_force`]): dP + df (L − s) +
+    /// f L' (1 − s/L) + Σ_{s_k > s} dF_k (the rates' point forces at the
+    /// rod's own points s_k; a length rate with point forces is not
+    /// [`RodTangent::fits`]).
     pub fn internal_force_rate(&self, rod: &Rod, s: f64) -> Vector3<f64> {
         let l = rod.length();
         let f = rod.loads().distributed_force;
-        self.loads.tip_force
+        let mut rate = self.loads.tip_force
             + self.loads.distributed_force * (l - s)
-            + f * (self.length * (1.0 - s / l))
+            + f * (self.length * (1.0 - s / l));
+        for p in self.loads.point_forces.iter().filter(|p| p.s > s) {
+            rate += p.force;
+        }
+        rate
     }
 
     /// dM, dH and d(∂sM) at fixed (s, κ) for W = ½ Σ B_i (κ_i − κ⁰_i)²

@@ -26,6 +26,34 @@ pub(super) fn rescale_mesh(mesh: &[f64], length: f64) -> Vec<f64> {
     m
 }
 
+/// The mesh with a node at each of `points` (sorted, inside (s_0, s_N)):
+/// the collocation equations hold on each side of a jump of the
+/// right-hand side (a point force), never across it, so the jump costs no
+/// order. A node already within 1e-12 of the interval's width of a point
+/// is moved onto it rather than doubled; refinement keeps every node, so
+/// the points stay nodes.
+pub(super) fn with_nodes_at(mesh: Vec<f64>, points: &[f64]) -> Vec<f64> {
+    if points.is_empty() {
+        return mesh;
+    }
+    let mut out = mesh;
+    for &p in points {
+        let i = out.partition_point(|&s| s < p);
+        if i == 0 || i == out.len() {
+            continue;
+        }
+        let width = out[i] - out[i - 1];
+        if (out[i] - p).abs() <= 1e-12 * width {
+            out[i] = p;
+        } else if (p - out[i - 1]).abs() <= 1e-12 * width && i > 1 {
+            out[i - 1] = p;
+        } else {
+            out.insert(i, p);
+        }
+    }
+    out
+}
+
 /// The mesh with the `flagged` intervals (sorted indices) halved.
 #[cfg(test)]
 fn refine(mesh: &[f64], flagged: &[usize]) -> Vec<f64> {
@@ -53,6 +81,18 @@ pub(super) fn refine_into(mesh: &[f64], pieces: &[(usize, usize)]) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_jump_becomes_a_node() {
+        assert_eq!(
+            with_nodes_at(vec![0.0, 1.0, 2.0], &[0.5]),
+            vec![0.0, 0.5, 1.0, 2.0]
+        );
+        assert_eq!(
+            with_nodes_at(vec![0.0, 1.0, 2.0], &[1.0]),
+            vec![0.0, 1.0, 2.0]
+        );
+    }
 
     #[test]
     fn refine_halves_flagged_intervals() {

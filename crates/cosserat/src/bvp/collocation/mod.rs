@@ -43,7 +43,7 @@ use super::newton::NewtonOptions;
 use crate::equations::{RodEquations, RodSample};
 use grid::{Grid, Scratch};
 use iteration::damped_newton;
-use mesh::{refine_into, rescale_mesh, uniform_mesh};
+use mesh::{refine_into, rescale_mesh, uniform_mesh, with_nodes_at};
 pub(crate) use tableau::Tableau;
 use tableau::{interpolation_nodes, lagrange};
 
@@ -323,6 +323,7 @@ pub fn solve_collocation_from(
         Some(w) if opts.adapt && w.mesh.len() >= 2 => rescale_mesh(&w.mesh, eq.length()),
         _ => uniform_mesh(eq.length(), opts.intervals),
     };
+    mesh = with_nodes_at(mesh, &eq.jumps());
     let mut warm = warm_start.cloned();
     loop {
         let grid = Grid::new(eq, tab.clone(), mesh);

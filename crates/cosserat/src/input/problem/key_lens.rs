@@ -20,7 +20,7 @@ use nalgebra::Vector3;
 
 use crate::continuation::{FamilyError, Lens, Lens2, Parameter, RodLens};
 use crate::input::strict;
-use crate::model::{EnergyCatalog, Rod, RodTangent};
+use crate::model::{DeadLoads, EnergyCatalog, PointForce, Rod, RodTangent};
 
 /// The tables whose numbers make the rod.
 const ROD_TABLES: [&str; 5] = ["rod", "energy", "clamp", "support", "loads"];
@@ -117,6 +117,14 @@ impl KeyLens {
     }
 }
 
+/// (k, j) of `loads.point[k].force[j]`, j < 3.
+fn point_force_component(key: &str) -> Option<(usize, usize)> {
+    let rest = key.strip_prefix("loads.point[")?;
+    let (k, rest) = rest.split_once(']')?;
+    let j = indexed(rest, ".force")?;
+    Some((k.trim().parse().ok()?, j))
+}
+
 /// i of a key `prefix[i]`, i < 3.
 fn indexed(key: &str, prefix: &str) -> Option<usize> {
     let rest = key
@@ -138,7 +146,8 @@ impl Lens for KeyLens {
     /// [`crate::continuation::RodLens`] moves it), the spin of
     /// `clamp.turn.angle` and `support.turn.angle` (the frame turned about
     /// the fixed unit axis), the shift of `support.position[i]` (the held
-    /// position, global); None for every other key (a shear stiffness, a
+    /// position, global), the unit rate of a point force's component
+    /// `loads.point[k].force[j]` at its s_k; None for every other key (a shear stiffness, a
     /// registered energy's parameter, the support's axes), whose F_p is then a central difference
     /// ([`crate::continuation::Family::derivative_method`]).
     fn tangent(&self, p: f64) -> Option<RodTangent> {
@@ -154,6 +163,18 @@ impl Lens for KeyLens {
             return RodTangent::zero()
                 .with_support_shift(Vector3::ith(i, 1.0))
                 .ok();
+        }
+        if let Some((k, j)) = point_force_component(&self.key) {
+            let rod = self.rod_at(p).ok()?;
+            let s = rod.loads().point_forces.get(k)?.s;
+            let rate = DeadLoads {
+                point_forces: vec![PointForce {
+                    s,
+                    force: Vector3::ith(j, 1.0),
+                }],
+                ..DeadLoads::default()
+            };
+            return RodTangent::zero().with_loads(rate).ok();
         }
         let parameter = Parameter::from_key(&self.key).filter(|q| q.is_file_key())?;
         RodLens::new(self.rod_at(p).ok()?, parameter).tangent(p)
@@ -232,5 +253,139 @@ impl Lens2 for KeyPair {
         }
         let file: ProblemFile = strict::from_table(doc).map_err(|e| refused(e.to_string()))?;
         build_rod(&file, &self.first.catalog).map_err(|e| refused(e.to_string()))
+    }
+}
+
+/// One parameter p setting several numeric keys of the rod's tables: the
+/// continued key to p and each linked key to factor·p + offset
+/// (`continuation.link`), e.g. both end turns of a strip by one angle.
+/// The rod at p is the problem reread with every key set; the tangent is
+/// Σ factor_j · (key j's tangent), exact where every key's is, else None
+/// (a central difference, said by the family).
+#[derive(Debug)]
+pub(crate) struct LinkedLens {
+    first: KeyLens,
+    /// Each linked key's own lens (for its tangent), factor and offset.
+    links: Vec<(KeyLens, f64, f64)>,
+}
+
+impl LinkedLens {
+    /// `key` and its `links` ((key, factor, offset)) in the effective
+    /// problem `text`. Refused, naming `continuation.link[i]`: a key that
+    /// is not a number of the rod (as for `continuation.parameter`), a key
+    /// linked twice or linked to itself, a factor or offset that is not
+    /// finite, a zero factor, and a file value that is not the link's at
+    /// p = `start` (the start's rod would not be the file's).
+    pub(super) fn new(
+        key: &str,
+        links: &[(String, f64, f64)],
+        start: f64,
+        text: &str,
+        catalog: &EnergyCatalog,
+    ) -> Result<LinkedLens, ProblemError> {
+        let first = KeyLens::new(key, text, catalog)?;
+        let mut seen = vec![first.key.clone()];
+        let mut out = Vec::with_capacity(links.len());
+        for (i, (link, factor, offset)) in links.iter().enumerate() {
+            let field = format!("continuation.link[{i}]");
+            let lens = KeyLens::new(link, text, catalog).map_err(|e| match e {
+                ProblemError::Invalid { message, .. } => invalid(format!("{field}.key"), message),
+                other => other,
+            })?;
+            if seen.contains(&lens.key) {
+                return Err(invalid(
+                    format!("{field}.key"),
+                    format!(
+                        "`{}` is already set by the parameter or an earlier link; link each key \
+                         once",
+                        lens.key
+                    ),
+                ));
+            }
+            if !(factor.is_finite() && *factor != 0.0) {
+                return Err(invalid(
+                    format!("{field}.factor"),
+                    format!("must be a finite non-zero number, got {factor}"),
+                ));
+            }
+            if !offset.is_finite() {
+                return Err(invalid(
+                    format!("{field}.offset"),
+                    format!("must be a finite number, got {offset}"),
+                ));
+            }
+            let given = match overrides::get_key(&lens.doc, &lens.key) {
+                Some(toml::Value::Float(v)) => *v,
+                Some(toml::Value::Integer(v)) => *v as f64,
+                _ => f64::NAN,
+            };
+            let linked = factor * start + offset;
+            if (given - linked).abs() > 1e-12 * linked.abs().max(1.0) {
+                return Err(invalid(
+                    field,
+                    format!(
+                        "the file gives {} = {given}, the link gives {linked} at the start \
+                         {start}: write the start's value in the file",
+                        lens.key
+                    ),
+                ));
+            }
+            seen.push(lens.key.clone());
+            out.push((lens, *factor, *offset));
+        }
+        Ok(LinkedLens { first, links: out })
+    }
+
+    fn build(&self, p: f64) -> Result<Rod, ProblemError> {
+        let mut doc = self.first.doc.clone();
+        overrides::set_key(&mut doc, &self.first.key, toml::Value::Float(p))
+            .map_err(|m| invalid(&self.first.key, m))?;
+        for (lens, factor, offset) in &self.links {
+            overrides::set_key(&mut doc, &lens.key, toml::Value::Float(factor * p + offset))
+                .map_err(|m| invalid(&lens.key, m))?;
+        }
+        let file: ProblemFile = strict::from_table(doc)?;
+        build_rod(&file, &self.first.catalog)
+    }
+}
+
+impl Lens for LinkedLens {
+    fn key(&self) -> String {
+        self.first.key.clone()
+    }
+
+    /// Σ_j factor_j t_j with t_j the tangent of key j alone at its value
+    /// (each a constant of the key: a unit load rate, a turn's fixed axis,
+    /// the clamp's d2), None unless every key has one.
+    fn tangent(&self, p: f64) -> Option<RodTangent> {
+        let mut t = self.first.tangent(p)?;
+        for (lens, factor, offset) in &self.links {
+            t = t.plus(&lens.tangent(factor * p + offset)?, *factor);
+        }
+        Some(t)
+    }
+
+    fn rod_at(&self, p: f64) -> Result<Rod, FamilyError> {
+        let refused = |reason: String| FamilyError::Refused {
+            parameter: self.first.key.clone(),
+            value: p,
+            reason,
+        };
+        if !p.is_finite() {
+            return Err(refused("not a finite number".into()));
+        }
+        let mut last = self
+            .first
+            .last
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        if let Some((bits, rod)) = last.as_ref() {
+            if *bits == p.to_bits() {
+                return Ok(rod.clone());
+            }
+        }
+        let rod = self.build(p).map_err(|e| refused(e.to_string()))?;
+        *last = Some((p.to_bits(), rod.clone()));
+        Ok(rod)
     }
 }

@@ -123,6 +123,14 @@ impl Problem {
             ));
         }
         let shape = build_shape(&file)?;
+        if shape.is_some() && !rod.loads().point_forces.is_empty() {
+            // The fixed-shape critical load's moments are built from the
+            // tip and distributed loads only.
+            return Err(invalid(
+                "loads.point",
+                "a [shape] (fixed-shape critical load) does not take point forces yet",
+            ));
+        }
         let stability = build_stability(&file.stability)?;
         eigenvalue_count("stability", &stability, &rod)?;
         let continuation = build_continuation(

@@ -13,7 +13,7 @@ use crate::bvp::newton::NewtonOptions;
 use crate::bvp::{Method, SolverOptions, Strategy};
 use std::sync::Arc;
 
-use super::key_lens::{KeyLens, KeyPair};
+use super::key_lens::{KeyLens, KeyPair, LinkedLens};
 use crate::continuation::{
     ContinuationOptions, Family, Lens, Lens2, Parameter, ParameterOn, RodLens,
 };
@@ -61,6 +61,7 @@ pub(super) fn build_continuation(
         check_shape_continuable(shape, rod)?;
     }
     let lens: Arc<dyn Lens> = match Parameter::from_key(&key) {
+        _ if !section.link.is_empty() => Arc::new(linked_lens(section, &key, text, catalog)?),
         Some(parameter) => Arc::new(RodLens::new(native_base(file, rod, parameter)?, parameter)),
         None => Arc::new(KeyLens::new(&key, text, catalog)?),
     };
@@ -84,6 +85,36 @@ pub(super) fn build_continuation(
         .rod_at(opts.start)
         .map_err(|e| invalid("continuation.parameter", e.to_string()))?;
     Ok(Some((family, opts)))
+}
+
+/// The lens of a parameter with `continuation.link`s: file keys only (a
+/// library scaling already moves several numbers), and no curve (its
+/// second parameter would be set without the links).
+fn linked_lens(
+    section: &crate::input::ContinuationSection,
+    key: &str,
+    text: &str,
+    catalog: &EnergyCatalog,
+) -> Result<LinkedLens, ProblemError> {
+    if Parameter::from_key(key).is_some_and(|p| !p.is_file_key()) {
+        return Err(invalid(
+            "continuation.link",
+            format!("`{key}` already scales several numbers; link file keys only"),
+        ));
+    }
+    if section.curve.is_some() {
+        return Err(invalid(
+            "continuation.link",
+            "a [continuation.curve] does not carry the links yet; continue the linked \
+             parameter alone",
+        ));
+    }
+    let links: Vec<(String, f64, f64)> = section
+        .link
+        .iter()
+        .map(|l| (l.key.clone(), l.factor, l.offset))
+        .collect();
+    LinkedLens::new(key, &links, section.start, text, catalog)
 }
 
 /// The `[continuation.curve]` of a continued problem: the family's
@@ -200,6 +231,25 @@ fn check_measures(
                 ),
             ));
         }
+    }
+    let integral = opts.measures.iter().find(|m| {
+        matches!(
+            m,
+            Measure::Turning | Measure::StoredEnergy | Measure::TotalPotentialEnergy
+        )
+    });
+    if let (Some(m), false) = (integral, rod.loads().point_forces.is_empty()) {
+        // The measure's quadrature straddles the jump of n(s), and the
+        // potential has no −F_k·r(s_k) term: refused, not approximate.
+        return Err(invalid(
+            "continuation.measures",
+            format!(
+                "`{}` is not computed with [[loads.point]] yet (its quadrature does not stop \
+                 at the points, and the potential leaves out their work); sample \
+                 `position[i]@σ` instead",
+                m.name()
+            ),
+        ));
     }
     let spins = rod
         .support()

@@ -41,6 +41,21 @@ pub(crate) fn set_key(doc: &mut toml::Table, key: &str, value: toml::Value) -> R
     let (last, parents) = path.split_last().expect("non-empty path");
     let mut table = doc;
     for part in parents {
+        if let Some((name, i)) = indexed(part) {
+            // One table of an array of tables (`loads.point[0].force[1]`):
+            // it must exist.
+            let list = table
+                .get_mut(name)
+                .and_then(toml::Value::as_array_mut)
+                .ok_or_else(|| format!("`{name}` is not an array of tables"))?;
+            let len = list.len();
+            table = list
+                .get_mut(i)
+                .ok_or_else(|| format!("`{name}` has {len} tables, no [{i}]"))?
+                .as_table_mut()
+                .ok_or_else(|| format!("`{part}` is not a table"))?;
+            continue;
+        }
         let entry = table
             .entry((*part).to_string())
             .or_insert_with(|| toml::Value::Table(toml::Table::new()));
@@ -72,7 +87,10 @@ pub(crate) fn get_key<'d>(doc: &'d toml::Table, key: &str) -> Option<&'d toml::V
     let (last, parents) = path.split_last()?;
     let mut table = doc;
     for part in parents {
-        table = table.get(*part)?.as_table()?;
+        table = match indexed(part) {
+            Some((name, i)) => table.get(name)?.as_array()?.get(i)?.as_table()?,
+            None => table.get(*part)?.as_table()?,
+        };
     }
     match indexed(last) {
         Some((name, i)) => table.get(name)?.as_array()?.get(i),

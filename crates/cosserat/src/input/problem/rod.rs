@@ -11,11 +11,11 @@ use std::collections::BTreeMap;
 use std::sync::Arc;
 
 use super::checks::{finite, load_vector, magnitude, vector};
-use super::sections::{ClampSection, EnergySection, ProblemFile, ProfileSpec};
+use super::sections::{ClampSection, EnergySection, PointLoadSection, ProblemFile, ProfileSpec};
 use super::{invalid, ProblemError};
 use crate::model::{
-    Clamp, DeadLoads, EnergyCatalog, EnergySpec, ModelChoice, ModelError, ModelLevel, Profile, Rod,
-    Shearable, StoredEnergy,
+    Clamp, DeadLoads, EnergyCatalog, EnergySpec, ModelChoice, ModelError, ModelLevel, PointForce,
+    Profile, Rod, Shearable, StoredEnergy,
 };
 
 pub(super) fn profile(field: &str, spec: &ProfileSpec) -> Result<Profile, ProblemError> {
@@ -125,11 +125,48 @@ pub(super) fn build_rod(file: &ProblemFile, catalog: &EnergyCatalog) -> Result<R
         tip_force: load_vector("loads.tip_force", file.loads.tip_force)?,
         tip_couple: load_vector("loads.tip_couple", file.loads.tip_couple)?,
         distributed_force: load_vector("loads.distributed_force", file.loads.distributed_force)?,
+        point_forces: point_forces(&file.loads.point, length)?,
     };
     // Every value was checked above with its key and message; a refusal
     // all the same is named by the key it comes from.
     Rod::new(length, energy, clamp, loads, support)
         .map_err(|e| invalid(model_key(&e), e.to_string()))
+}
+
+/// The `[[loads.point]]` tables as point forces: each `s` finite and
+/// inside (0, L), each force a load vector; a non-zero couple is refused by
+/// name (a point couple makes the moment jump, a jump no solver carries
+/// yet — never a load silently dropped).
+fn point_forces(points: &[PointLoadSection], length: f64) -> Result<Vec<PointForce>, ProblemError> {
+    points
+        .iter()
+        .enumerate()
+        .map(|(k, p)| {
+            let key = format!("loads.point[{k}]");
+            let s = finite(&format!("{key}.s"), p.s)?;
+            if !(s > 0.0 && s < length) {
+                return Err(invalid(
+                    format!("{key}.s"),
+                    format!(
+                        "must lie inside the rod, 0 < s < L = {length}, got {s} (a load at an \
+                         end is loads.tip_force, or a reaction of the clamp)"
+                    ),
+                ));
+            }
+            let couple = load_vector(&format!("{key}.couple"), p.couple)?;
+            if couple != nalgebra::Vector3::zeros() {
+                return Err(invalid(
+                    format!("{key}.couple"),
+                    "point couples are not supported yet: a couple makes the bending moment \
+                     jump, which the solvers do not carry; leave it out (or zero)",
+                ));
+            }
+            Ok(PointForce {
+                s,
+                force: load_vector(&format!("{key}.force"), p.force)?,
+            })
+        })
+        .collect()
 }
 
 /// The problem-file key a refused model value comes from.
@@ -145,6 +182,7 @@ fn model_key(e: &ModelError) -> &'static str {
             _ => "support.axis",
         },
         ModelError::Axis { .. } => "support.axis",
+        ModelError::PointLoad { .. } => "loads.point",
         ModelError::Frame { .. } => "clamp.d3",
         _ => "energy",
     }

@@ -258,6 +258,26 @@ pub struct LoadSection {
     /// Uniform force per unit length (N/m), e.g. self-weight ρAg.
     #[serde(default, deserialize_with = "strict::array")]
     pub distributed_force: [f64; 3],
+    /// Dead loads at interior points (`[[loads.point]]`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub point: Vec<PointLoadSection>,
+}
+
+/// One `[[loads.point]]`: a dead force (and, reserved, a couple) at the
+/// interior point `s` of the reference arclength, global components.
+#[derive(Debug, Clone, Default, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct PointLoadSection {
+    /// Reference arclength of the point, 0 < s < L (m).
+    pub s: f64,
+    /// Force (N).
+    #[serde(default, deserialize_with = "strict::array")]
+    pub force: [f64; 3],
+    /// Couple (N·m): accepted only as zero for now (see
+    /// docs/problem-files.md: a couple makes M jump, which the solvers do
+    /// not carry yet).
+    #[serde(default, deserialize_with = "strict::array")]
+    pub couple: [f64; 3],
 }
 
 /// `[solver]`.

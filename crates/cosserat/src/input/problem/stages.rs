@@ -33,6 +33,9 @@ fn stage_text(text: &str, number: usize, held: &[(String, f64)]) -> Result<Strin
         .ok_or_else(missing)?;
     let stages = table.remove("stage").ok_or_else(missing)?;
     table.remove("curve");
+    // The first stage's links belong to its parameter; a stage links its
+    // own keys or none.
+    table.remove("link");
     let stage = stages
         .as_array()
         .and_then(|a| a.get(number.checked_sub(2)?))
