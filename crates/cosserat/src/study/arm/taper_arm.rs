@@ -365,17 +365,17 @@ impl TaperedArm {
             .map(|i| i as f64 / (points - 1) as f64)
             .collect();
         let dphi = derivative(c);
-        let kappa0: Vec<f64> = shape
-            .samples(&rod0, &s)
-            .map_err(|e| ModelError::Profile(e.to_string()))?
-            .iter()
-            .map(|p| polynomial(&dphi, p.s) - design.gamma * p.moment[1] / section.at(p.s).powi(2))
-            .collect();
         let stiffness = [
             section.stiffness(self.arm.b1)?,
             section.stiffness(1.0)?,
             section.stiffness(self.arm.b3)?,
         ];
+        let kappa0: Vec<f64> = shape
+            .samples(&rod0, &s)
+            .map_err(|e| ModelError::Profile(e.to_string()))?
+            .iter()
+            .map(|p| polynomial(&dphi, p.s) - design.gamma * p.moment[1] / stiffness[1].value(p.s))
+            .collect();
         let energy = LinearElastic::new(
             stiffness,
             [
