@@ -44,7 +44,7 @@ use super::{continue_family, sampling, ArmProblem, ArmScene, SearchOptions};
 use crate::continuation::{ContinuationError, Diagram, Family, Parameter, RunState};
 use crate::model::{Clamp, Frame, LinearElastic, ModelLevel, Profile, Rod};
 use crate::numerics::integrator::Tolerances;
-use crate::stability::{critical_load_spatial, SpatialShape};
+use crate::stability::{critical_load_spatial, SpatialShape, TURN_PER_ELEMENT};
 
 /// The spatial arm to design: the planar problem (stiffness ratios,
 /// direction, κ̄2's bounds as c2..cM, mesh) and the bounds of the
@@ -503,6 +503,19 @@ impl SpatialArm {
                 PathVerdict::Undecided("the designed rod could not be built".into()),
             );
         };
+        let elements = self.path_elements(optimum);
+        let Ok(stability) = self.planar.stability.with_elements(elements) else {
+            return (
+                None,
+                PathVerdict::Undecided(format!(
+                    "the path's second variation needs {elements} elements, more than allowed"
+                )),
+            );
+        };
+        let tracked = ArmProblem {
+            stability,
+            ..self.planar.clone()
+        };
         let mut undecided = None;
         let mut reasons = vec![];
         for segments in PATH_SEGMENTS {
@@ -513,7 +526,7 @@ impl SpatialArm {
                 segments,
                 Tolerances::default(),
             );
-            match continue_family(&self.planar, &family, stop) {
+            match continue_family(&tracked, &family, stop) {
                 Ok(d) => {
                     let verdict = path_verdict(&d, optimum, scene);
                     let interrupted = d.stop_reason == RunState::Interrupted;
@@ -532,6 +545,38 @@ impl SpatialArm {
             }
         }
         (undecided, PathVerdict::Undecided(reasons.join("; ")))
+    }
+}
+
+impl SpatialArm {
+    /// Elements of the loading path's tracked second variation: the
+    /// search's, or more where the unloaded (κ̄⁰) or the designed (κ̄)
+    /// shape turns the material frame by more than [`TURN_PER_ELEMENT`]
+    /// per element (rod length 1): the continuation ends a branch whose
+    /// mesh turns it by more than twice that (B̄1 = 16 at 0°: 1.08 rad per
+    /// element on the search's 50 elements at λ = 10⁻³). On the finer mesh
+    /// λ = 1 is γ_crit to that mesh's error (the verdict counts no
+    /// stability loss above 1 − 10⁻³).
+    fn path_elements(&self, optimum: &SpatialOptimum) -> usize {
+        let norm = |k: [f64; 3]| (k[0] * k[0] + k[1] * k[1] + k[2] * k[2]).sqrt();
+        let shape = Self::shape(&optimum.design.curvature_coefficients);
+        let loaded = optimum
+            .points
+            .iter()
+            .map(|s| norm([0, 1, 2].map(|i| shape.curvature[i].value(*s))));
+        let kappa = optimum
+            .intrinsic_curvature
+            .iter()
+            .map(|k| norm(*k))
+            .chain(loaded)
+            .fold(0.0, f64::max);
+        let needed = (kappa / TURN_PER_ELEMENT).ceil();
+        let needed = if needed.is_finite() {
+            needed as usize
+        } else {
+            usize::MAX
+        };
+        self.planar.stability.elements().max(needed)
     }
 }
 
