@@ -41,10 +41,10 @@ use super::design::derivative;
 use super::polish::{box_simplex, polish_in_box};
 use super::resolve::{MeshStudy, Resolution, Verdict, REACH_TOLERANCE};
 use super::{continue_family, sampling, ArmProblem, ArmScene, SearchOptions};
-use crate::continuation::{ContinuationError, Diagram, Family, Parameter};
+use crate::continuation::{ContinuationError, Diagram, Family, Parameter, RunState};
 use crate::model::{Clamp, Frame, LinearElastic, ModelLevel, Profile, Rod};
 use crate::numerics::integrator::Tolerances;
-use crate::stability::{critical_load_spatial, SpatialShape};
+use crate::stability::{critical_load_spatial, SpatialShape, TURN_PER_ELEMENT};
 
 /// The spatial arm to design: the planar problem (stiffness ratios,
 /// direction, κ̄2's bounds as c2..cM, mesh) and the bounds of the
@@ -479,6 +479,18 @@ impl SpatialArm {
     /// The loading path: the designed rod continued (Kirchhoff level, the
     /// Hessian tracked on this problem's mesh) in the load factor from
     /// 10⁻³ to 1 (the design load), and whether it reaches the design.
+    ///
+    /// The run is repeated on finer shooting segments ([`PATH_SEGMENTS`])
+    /// while it ends undecided: a branch that stops short with no fold and
+    /// no loss of stability ("step size below 10⁻⁷: the corrector does not
+    /// converge") has met the noise floor of its residual, not a property
+    /// of the arm. On 32 Kirchhoff segments the integration error carried
+    /// across a segment of a twisted, coiled arm leaves a scaled residual
+    /// above the corrector's τ = 10⁻¹¹ (the 45° optimum of the shipped arm
+    /// stops at λ = 0.0078, the 60° one at 0.26; with τ = 10⁻⁹ both reach
+    /// λ = 1); on 128 segments the same τ is met and the path is followed
+    /// to λ = 1, where its end agrees with the τ = 10⁻⁹ run on 32 segments
+    /// to 10⁻¹⁰ L. A verdict is returned from the first run that decides.
     pub fn loading_path(
         &self,
         scene: &ArmScene,
@@ -491,10 +503,22 @@ impl SpatialArm {
                 PathVerdict::Undecided("the designed rod could not be built".into()),
             );
         };
-        // A strongly curved unloaded arm can defeat the start's shooting on
-        // 32 segments; 64 and 128 are tried before the verdict is undecided.
-        let mut failure = String::new();
-        for segments in [32, 64, 128] {
+        let elements = self.path_elements(optimum);
+        let Ok(stability) = self.planar.stability.with_elements(elements) else {
+            return (
+                None,
+                PathVerdict::Undecided(format!(
+                    "the path's second variation needs {elements} elements, more than allowed"
+                )),
+            );
+        };
+        let tracked = ArmProblem {
+            stability,
+            ..self.planar.clone()
+        };
+        let mut undecided = None;
+        let mut reasons = vec![];
+        for segments in PATH_SEGMENTS {
             let family = Family::new(
                 rod.clone(),
                 Parameter::LoadScale,
@@ -502,18 +526,63 @@ impl SpatialArm {
                 segments,
                 Tolerances::default(),
             );
-            match continue_family(&self.planar, &family, stop) {
+            match continue_family(&tracked, &family, stop) {
                 Ok(d) => {
                     let verdict = path_verdict(&d, optimum, scene);
-                    return (Some(d), verdict);
+                    let interrupted = d.stop_reason == RunState::Interrupted;
+                    match &verdict {
+                        PathVerdict::Undecided(why) if !interrupted => {
+                            reasons.push(format!("{segments} segments: {why}"));
+                            undecided = Some(d);
+                        }
+                        _ => return (Some(d), verdict),
+                    }
                 }
-                Err(e @ ContinuationError::Start { .. }) => failure = path_error(&e),
+                Err(e @ ContinuationError::Start { .. }) => {
+                    reasons.push(format!("{segments} segments: {}", path_error(&e)));
+                }
                 Err(e) => return (None, PathVerdict::Undecided(path_error(&e))),
             }
         }
-        (None, PathVerdict::Undecided(failure))
+        (undecided, PathVerdict::Undecided(reasons.join("; ")))
     }
 }
+
+impl SpatialArm {
+    /// Elements of the loading path's tracked second variation: the
+    /// search's, or more where the unloaded (κ̄⁰) or the designed (κ̄)
+    /// shape turns the material frame by more than [`TURN_PER_ELEMENT`]
+    /// per element (rod length 1): the continuation ends a branch whose
+    /// mesh turns it by more than twice that (B̄1 = 16 at 0°: 1.08 rad per
+    /// element on the search's 50 elements at λ = 10⁻³). On the finer mesh
+    /// λ = 1 is γ_crit to that mesh's error (the verdict counts no
+    /// stability loss above 1 − 10⁻³).
+    fn path_elements(&self, optimum: &SpatialOptimum) -> usize {
+        let norm = |k: [f64; 3]| (k[0] * k[0] + k[1] * k[1] + k[2] * k[2]).sqrt();
+        let shape = Self::shape(&optimum.design.curvature_coefficients);
+        let loaded = optimum
+            .points
+            .iter()
+            .map(|s| norm([0, 1, 2].map(|i| shape.curvature[i].value(*s))));
+        let kappa = optimum
+            .intrinsic_curvature
+            .iter()
+            .map(|k| norm(*k))
+            .chain(loaded)
+            .fold(0.0, f64::max);
+        let needed = (kappa / TURN_PER_ELEMENT).ceil();
+        let needed = if needed.is_finite() {
+            needed as usize
+        } else {
+            usize::MAX
+        };
+        self.planar.stability.elements().max(needed)
+    }
+}
+
+/// The shooting segments of the loading path, tried in turn while the path
+/// ends undecided (see [`SpatialArm::loading_path`]).
+pub const PATH_SEGMENTS: [usize; 3] = [32, 64, 128];
 
 fn path_error(e: &ContinuationError) -> String {
     format!("continuation failed: {e}")
@@ -559,15 +628,12 @@ fn path_verdict(d: &Diagram, optimum: &SpatialOptimum, scene: &ArmScene) -> Path
     if last.parameter < 1.0 - 1e-6 {
         // Stopped short without a fold or a loss of stability: the
         // continuation gave up, which says nothing about the arm.
+        let mut why = vec![branch.stop_reason.to_string()];
+        why.extend(d.warnings.iter().cloned());
         return PathVerdict::Undecided(format!(
-            "the continuation stopped at λ = {:.4} ({}; {})",
+            "the continuation stopped at λ = {:.4} ({})",
             last.parameter,
-            d.stop_reason.name(),
-            if d.warnings.is_empty() {
-                "no reason given".to_owned()
-            } else {
-                d.warnings.join("; ")
-            }
+            why.join("; ")
         ));
     }
     let scale = scene.length(optimum.design.gamma);
@@ -579,7 +645,11 @@ fn path_verdict(d: &Diagram, optimum: &SpatialOptimum, scene: &ArmScene) -> Path
     if miss > 1e-4 {
         return PathVerdict::Misses {
             parameter: last.parameter,
-            reason: format!("it ends on another equilibrium, {miss:.3e} L from the design's tip"),
+            reason: format!(
+                "it ends at λ = 1 on another equilibrium, its tip at ({:.4}, {:.4}, {:.4}) L, \
+                 {miss:.3} L from the design's tip",
+                last.tip.position[0], last.tip.position[1], last.tip.position[2]
+            ),
         };
     }
     PathVerdict::Reaches { miss }
