@@ -10,66 +10,128 @@
 //! implicit differentiation, (I − h A ⊗ J) dK = (J_i Φ0)_i, Φ1 = Φ0 +
 //! h Σ b_i dK_i, with J_i = ∂f/∂y at the stages. The method preserves the
 //! quadratic invariants d_i·d_j exactly, so no projection is needed.
+//!
+//! Cost: the stage equations are solved in flat buffers allocated once per
+//! step, with the small dense LU of collocation compiled for the stage
+//! sizes m·n (`collocation::lu`: the general nalgebra LU of the 36 × 36
+//! spatial stage matrix took 45 % of a collocation continuation run,
+//! `perf`, with its allocations another 8 %); one factorization at the
+//! converged stages gives the sensitivities of every column of Φ0 and of
+//! the parameter (implicit-function theorem: one matrix, many right-hand
+//! sides).
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DMatrix;
 
+use super::collocation::lu::{dense_lu, dense_solve, dense_solve_rows};
 use super::collocation::Tableau;
 use crate::equations::RodEquations;
 use crate::model::RodTangent;
 use crate::numerics::integrator::IntegrationError;
 
-/// The stage Jacobians J_i = ∂f/∂y (n × n each) at the stage states.
-fn stage_jacobians(
-    eq: &dyn RodEquations,
-    tab: &Tableau,
-    s: f64,
-    h: f64,
-    stages: &[Vec<f64>],
-) -> Vec<DMatrix<f64>> {
-    let n = eq.dim();
-    let identity = DMatrix::<f64>::identity(n, n);
-    let (mut dy, mut dphi) = (vec![0.0; n], vec![0.0; n * n]);
-    (0..tab.m)
-        .map(|i| {
-            eq.rhs_linearized(
-                s + tab.c[i] * h,
-                &stages[i],
-                n,
-                identity.as_slice(),
-                &mut dy,
-                &mut dphi,
-            );
-            DMatrix::from_column_slice(n, n, &dphi)
-        })
-        .collect()
+/// The buffers of one Gauss step, sized once (m stages of dimension n).
+struct StageWork {
+    n: usize,
+    m: usize,
+    /// Stage derivatives K_i (m·n).
+    k: Vec<f64>,
+    /// Stage states Y_i = y0 + h Σ_l a_il K_l (m·n).
+    y: Vec<f64>,
+    /// Residual, then Newton correction (m·n).
+    r: Vec<f64>,
+    /// ∂f/∂y at the stages, n × n column-major each.
+    jac: Vec<f64>,
+    /// The n × n identity, column-major (tangents giving ∂f/∂y).
+    ident: Vec<f64>,
+    /// f at a stage (n).
+    f: Vec<f64>,
+    /// The stage matrix I − h (diag J_i)(A ⊗ I), row-major, factored in place.
+    w: Vec<f64>,
+    piv: Vec<usize>,
 }
 
-/// I − h A ⊗ J: the Newton matrix of the stage equations (m n × m n).
-fn stage_matrix(tab: &Tableau, h: f64, jac: &[DMatrix<f64>]) -> DMatrix<f64> {
-    let (m, n) = (tab.m, jac[0].nrows());
-    let mut a = DMatrix::identity(m * n, m * n);
-    for (i, ji) in jac.iter().enumerate() {
-        for l in 0..m {
-            let block = ji * (-h * tab.a(i, l));
-            let mut view = a.view_mut((i * n, l * n), (n, n));
-            view += block;
+impl StageWork {
+    fn new(n: usize, m: usize) -> Self {
+        let mn = m * n;
+        let mut ident = vec![0.0; n * n];
+        ident.iter_mut().step_by(n + 1).for_each(|v| *v = 1.0);
+        StageWork {
+            n,
+            m,
+            k: vec![0.0; mn],
+            y: vec![0.0; mn],
+            r: vec![0.0; mn],
+            jac: vec![0.0; m * n * n],
+            ident,
+            f: vec![0.0; n],
+            w: vec![0.0; mn * mn],
+            piv: vec![0; mn],
         }
     }
-    a
-}
 
-/// The stage states y0 + h Σ_l a_il K_l.
-fn stage_states(tab: &Tableau, h: f64, y0: &[f64], k: &[Vec<f64>]) -> Vec<Vec<f64>> {
-    (0..tab.m)
-        .map(|i| {
-            let mut y = y0.to_vec();
-            for (l, kl) in k.iter().enumerate() {
+    /// The stage states y0 + h Σ_l a_il K_l into `self.y`.
+    fn stage_states(&mut self, tab: &Tableau, h: f64, y0: &[f64]) {
+        let n = self.n;
+        for i in 0..self.m {
+            let yi = &mut self.y[i * n..(i + 1) * n];
+            yi.copy_from_slice(y0);
+            for l in 0..self.m {
                 let w = h * tab.a(i, l);
-                y.iter_mut().zip(kl).for_each(|(a, b)| *a += w * b);
+                let kl = &self.k[l * n..(l + 1) * n];
+                yi.iter_mut().zip(kl).for_each(|(a, b)| *a += w * b);
             }
-            y
-        })
-        .collect()
+        }
+    }
+
+    /// J_i = ∂f/∂y at the stage states (one `rhs_linearized` call each).
+    fn stage_jacobians(&mut self, eq: &dyn RodEquations, tab: &Tableau, s: f64, h: f64) {
+        let (n, nn) = (self.n, self.n * self.n);
+        for i in 0..self.m {
+            eq.rhs_linearized(
+                s + tab.c[i] * h,
+                &self.y[i * n..(i + 1) * n],
+                n,
+                &self.ident,
+                &mut self.f,
+                &mut self.jac[i * nn..(i + 1) * nn],
+            );
+        }
+    }
+
+    /// W = I − h (diag J_i)(A ⊗ I), the Newton matrix of the stage
+    /// equations (block (i, l) = δ_il I − h a_il J_i), factored; false if
+    /// singular.
+    fn factor_stage_matrix(&mut self, tab: &Tableau, h: f64) -> bool {
+        let (n, m) = (self.n, self.m);
+        let (mn, nn) = (m * n, n * n);
+        for i in 0..m {
+            let ji = &self.jac[i * nn..(i + 1) * nn];
+            for l in 0..m {
+                let coef = h * tab.a(i, l);
+                for r in 0..n {
+                    let row = &mut self.w[(i * n + r) * mn + l * n..(i * n + r) * mn + (l + 1) * n];
+                    for (c, v) in row.iter_mut().enumerate() {
+                        let id = if i == l && r == c { 1.0 } else { 0.0 };
+                        *v = id - coef * ji[c * n + r];
+                    }
+                }
+            }
+        }
+        dense_lu(&mut self.w, mn, &mut self.piv)
+    }
+
+    /// The residual K_i − f(s_i, Y_i) into `self.r` (stage states current);
+    /// false if it is not finite.
+    fn residual(&mut self, eq: &dyn RodEquations, tab: &Tableau, s: f64, h: f64) -> bool {
+        let n = self.n;
+        for i in 0..self.m {
+            eq.rhs(s + tab.c[i] * h, &self.y[i * n..(i + 1) * n], &mut self.f);
+            let (ri, ki) = (&mut self.r[i * n..(i + 1) * n], &self.k[i * n..(i + 1) * n]);
+            for ((r, k), f) in ri.iter_mut().zip(ki).zip(&self.f) {
+                *r = k - f;
+            }
+        }
+        self.r.iter().all(|v| v.is_finite())
+    }
 }
 
 /// y(s + h) and Φ(s + h) = ∂y(s + h)/∂(unknowns) from y0 and Φ0 (n × cols,
@@ -91,86 +153,155 @@ pub(crate) fn gauss_step(
     forcing: Option<&RodTangent>,
 ) -> Result<(Vec<f64>, DMatrix<f64>), IntegrationError> {
     let (m, n) = (tab.m, eq.dim());
-    let mut f0 = vec![0.0; n];
-    eq.rhs(s, y0, &mut f0);
-    let mut k: Vec<Vec<f64>> = vec![f0; m];
-    let scale = y0.iter().map(|v| v.abs()).fold(1.0, f64::max);
-    // Simplified Newton: the stage matrix of the first iterate is factored
-    // once and kept while the corrections contract at least twofold (its
-    // error is O(h) in the stages, so the rate is O(h²)); it is refreshed
-    // only where they do not. The fixed point is the same as Newton's.
-    let mut lu = None;
-    let mut previous = f64::INFINITY;
-    let mut converged = false;
-    for _ in 0..30 {
-        let stages = stage_states(tab, h, y0, &k);
-        let mut r = DVector::zeros(m * n);
-        let mut f = vec![0.0; n];
-        for i in 0..m {
-            eq.rhs(s + tab.c[i] * h, &stages[i], &mut f);
-            for j in 0..n {
-                r[i * n + j] = k[i][j] - f[j];
-            }
-        }
-        if r.iter().any(|v| !v.is_finite()) {
-            return Err(IntegrationError::NotFinite { s });
-        }
-        let factors = match lu.take() {
-            Some(factors) => factors,
-            None => stage_matrix(tab, h, &stage_jacobians(eq, tab, s, h, &stages)).lu(),
-        };
-        let Some(dk) = factors.solve(&r) else {
-            return Err(IntegrationError::StepSizeUnderflow { s });
-        };
-        for i in 0..m {
-            for j in 0..n {
-                k[i][j] -= dk[i * n + j];
-            }
-        }
-        let size = h * dk.amax();
-        if size <= 1e-15 * scale {
-            converged = true;
-            break;
-        }
-        if size <= 0.5 * previous {
-            lu = Some(factors);
-        }
-        previous = size;
-    }
-    if !converged {
-        return Err(IntegrationError::StepSizeUnderflow { s });
-    }
+    let mut ws = StageWork::new(n, m);
+    solve_stages(eq, tab, s, h, y0, &mut ws)?;
     let mut y1 = y0.to_vec();
-    for (i, ki) in k.iter().enumerate() {
+    for i in 0..m {
         let w = h * tab.b[i];
+        let ki = &ws.k[i * n..(i + 1) * n];
         y1.iter_mut().zip(ki).for_each(|(a, b)| *a += w * b);
     }
     let cols = phi0.ncols();
     if cols == 0 {
         return Ok((y1, DMatrix::zeros(n, 0)));
     }
-    let stages = stage_states(tab, h, y0, &k);
-    let jac = stage_jacobians(eq, tab, s, h, &stages);
-    let mut rhs = DMatrix::zeros(m * n, cols);
-    let mut fp = vec![0.0; n];
-    for (i, ji) in jac.iter().enumerate() {
-        rhs.view_mut((i * n, 0), (n, cols)).copy_from(&(ji * phi0));
-        if let Some(t) = forcing {
-            // K_i = f(s_i, Y_i) to the stage Newton's 1e-15.
-            eq.rhs_parameter(s + tab.c[i] * h, &stages[i], &k[i], t, &mut fp);
-            for (r, v) in fp.iter().enumerate() {
-                rhs[(i * n + r, cols - 1)] += v;
+    Ok((y1, sensitivity(eq, tab, s, h, phi0, forcing, &mut ws)?))
+}
+
+/// The stage derivatives K of the step into `ws.k` (and their stage
+/// states into `ws.y`), by Newton from
+/// K_i = f(s + c_i h, y0 + c_i h f(s, y0)).
+///
+/// Simplified Newton: the stage matrix of the first iterate is factored
+/// once and kept while the corrections contract at least twofold (its
+/// error is O(h) in the stages, so the rate is O(h²)); it is refreshed
+/// only where they do not. The fixed point is the same as Newton's.
+fn solve_stages(
+    eq: &dyn RodEquations,
+    tab: &Tableau,
+    s: f64,
+    h: f64,
+    y0: &[f64],
+    ws: &mut StageWork,
+) -> Result<(), IntegrationError> {
+    let (m, n) = (tab.m, eq.dim());
+    let mn = m * n;
+    // K_i from the explicit Euler stage state y0 + c_i h f(s, y0): O(h²)
+    // from the solution where f(s, y0) alone is O(h), one Newton
+    // iteration fewer.
+    eq.rhs(s, y0, &mut ws.f);
+    for i in 0..m {
+        let ch = tab.c[i] * h;
+        let yi = &mut ws.y[i * n..(i + 1) * n];
+        yi.iter_mut()
+            .zip(y0)
+            .zip(&ws.f)
+            .for_each(|((y, a), f)| *y = a + ch * f);
+    }
+    for i in 0..m {
+        let r = i * n..(i + 1) * n;
+        eq.rhs(s + tab.c[i] * h, &ws.y[r.clone()], &mut ws.k[r]);
+    }
+    let scale = y0.iter().map(|v| v.abs()).fold(1.0, f64::max);
+    let mut factored = false;
+    let mut previous = f64::INFINITY;
+    for _ in 0..30 {
+        ws.stage_states(tab, h, y0);
+        if !ws.residual(eq, tab, s, h) {
+            return Err(IntegrationError::NotFinite { s });
+        }
+        if !factored {
+            ws.stage_jacobians(eq, tab, s, h);
+            if !ws.factor_stage_matrix(tab, h) {
+                return Err(IntegrationError::StepSizeUnderflow { s });
+            }
+        }
+        dense_solve(&ws.w, mn, &ws.piv, &mut ws.r);
+        let mut size = 0.0f64;
+        for (k, d) in ws.k.iter_mut().zip(&ws.r) {
+            *k -= d;
+            size = size.max(d.abs());
+        }
+        let size = h * size;
+        if !size.is_finite() {
+            return Err(IntegrationError::NotFinite { s });
+        }
+        if size <= 1e-15 * scale {
+            ws.stage_states(tab, h, y0);
+            return Ok(());
+        }
+        factored = size <= 0.5 * previous;
+        previous = size;
+    }
+    Err(IntegrationError::StepSizeUnderflow { s })
+}
+
+/// Φ1 = Φ0 + h Σ_i b_i dK_i with (I − h (diag J_i)(A ⊗ I)) dK = (J_i Φ0)_i
+/// (plus ∂f/∂p in the last column with `forcing`), J_i at the converged
+/// stages: one factorization, a solve per column.
+fn sensitivity(
+    eq: &dyn RodEquations,
+    tab: &Tableau,
+    s: f64,
+    h: f64,
+    phi0: &DMatrix<f64>,
+    forcing: Option<&RodTangent>,
+    ws: &mut StageWork,
+) -> Result<DMatrix<f64>, IntegrationError> {
+    let (m, n, cols) = (tab.m, eq.dim(), phi0.ncols());
+    let (mn, nn) = (m * n, n * n);
+    ws.stage_jacobians(eq, tab, s, h);
+    if !ws.factor_stage_matrix(tab, h) {
+        return Err(IntegrationError::StepSizeUnderflow { s });
+    }
+    // ∂f/∂p at every stage, once: K_i = f(s_i, Y_i) to the stage Newton's 1e-15.
+    let mut fp = vec![0.0; if forcing.is_some() { mn } else { 0 }];
+    if let Some(t) = forcing {
+        for i in 0..m {
+            let r = i * n..(i + 1) * n;
+            eq.rhs_parameter(
+                s + tab.c[i] * h,
+                &ws.y[r.clone()],
+                &ws.k[r.clone()],
+                t,
+                &mut fp[r],
+            );
+        }
+    }
+    // The right-hand sides J_i Φ0 (+ ∂f/∂p), mn × cols row-major.
+    let mut dk = vec![0.0; mn * cols];
+    for i in 0..m {
+        let ji = &ws.jac[i * nn..(i + 1) * nn];
+        for (c, p0) in phi0.row_iter().enumerate() {
+            let col = &ji[c * n..(c + 1) * n];
+            for (r, &j) in col.iter().enumerate() {
+                if j != 0.0 {
+                    let row = &mut dk[(i * n + r) * cols..(i * n + r + 1) * cols];
+                    row.iter_mut().zip(p0.iter()).for_each(|(d, p)| *d += j * p);
+                }
             }
         }
     }
-    let Some(dk) = stage_matrix(tab, h, &jac).lu().solve(&rhs) else {
-        return Err(IntegrationError::StepSizeUnderflow { s });
-    };
+    if forcing.is_some() {
+        for (row, f) in dk.chunks_exact_mut(cols).zip(&fp) {
+            row[cols - 1] += f;
+        }
+    }
+    dense_solve_rows(&ws.w, mn, &ws.piv, &mut dk, cols);
+    if !dk.iter().all(|v| v.is_finite()) {
+        return Err(IntegrationError::NotFinite { s });
+    }
     let mut phi1 = phi0.clone();
     for i in 0..m {
-        phi1 += dk.view((i * n, 0), (n, cols)) * (h * tab.b[i]);
+        let w = h * tab.b[i];
+        for r in 0..n {
+            let row = &dk[(i * n + r) * cols..(i * n + r + 1) * cols];
+            for (q, d) in row.iter().enumerate() {
+                phi1[(r, q)] += w * d;
+            }
+        }
     }
-    Ok((y1, phi1))
+    Ok(phi1)
 }
 
 #[cfg(test)]

@@ -113,13 +113,16 @@ impl BandLu {
             for i in 1..=km {
                 self.data[col + i] /= pivot;
             }
+            // Column c's rows j+1 ..= j+km lie after column j's multipliers
+            // in the storage, so one split gives both as slices: the update
+            // is an axpy without bounds checks, which vectorizes.
             for c in j + 1..=last {
-                let u = self.data[self.at(j, c)];
+                let base = self.at(j, c);
+                let (done, rest) = self.data.split_at_mut(base + 1);
+                let u = done[base];
                 if u != 0.0 {
-                    let base = self.at(j, c);
-                    for i in 1..=km {
-                        self.data[base + i] -= self.data[col + i] * u;
-                    }
+                    let l = &done[col + 1..=col + km];
+                    rest[..km].iter_mut().zip(l).for_each(|(v, l)| *v -= l * u);
                 }
             }
         }

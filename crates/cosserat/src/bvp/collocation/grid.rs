@@ -20,7 +20,26 @@
 use nalgebra::DMatrix;
 
 use super::iteration::{Linearization, NewtonOutcome};
-use super::lu::{dense_lu, dense_solve, BandLu};
+use super::lu::{dense_lu, dense_solve, dense_solve_rows, BandLu};
+
+/// An output slice filled in order (the residual written in place).
+struct Slots<'o> {
+    out: &'o mut [f64],
+    at: usize,
+}
+
+impl Slots<'_> {
+    fn push(&mut self, v: f64) {
+        self.out[self.at] = v;
+        self.at += 1;
+    }
+
+    fn extend_from_slice(&mut self, v: &[f64]) {
+        self.out[self.at..self.at + v.len()].copy_from_slice(v);
+        self.at += v.len();
+    }
+}
+
 use super::{CollocationSolution, Tableau};
 use crate::equations::{RodEquations, RodSample};
 use crate::numerics::integrator::{Dop853, Stops, Tolerances};
@@ -54,6 +73,8 @@ pub(super) struct Scratch {
     pub(super) piv: Vec<usize>,
     /// A stage-sized right-hand side (m·n).
     pub(super) g: Vec<f64>,
+    /// W⁻¹E of one interval (mn × n, row-major).
+    pub(super) z: Vec<f64>,
 }
 
 impl Scratch {
@@ -65,6 +86,7 @@ impl Scratch {
             w: vec![0.0; mn * mn],
             piv: vec![0; mn],
             g: vec![0.0; mn],
+            z: vec![0.0; mn * n],
         }
     }
 }
@@ -282,8 +304,15 @@ impl<'a> Grid<'a> {
     /// The scaled residual: per interval the m·n stage equations and the n
     /// node equations, then the p tip conditions.
     pub(super) fn residual(&self, x: &[f64]) -> Vec<f64> {
+        let mut r = vec![0.0; self.size()];
+        self.residual_into(x, &mut r);
+        r
+    }
+
+    /// [`Self::residual`] into `out` (of the unknowns' size).
+    pub(super) fn residual_into(&self, x: &[f64], out: &mut [f64]) {
         let (n, m, p) = (self.n, self.tab.m, self.p);
-        let mut r = Vec::with_capacity(self.size());
+        let mut r = Slots { out, at: 0 };
         let mut y0 = vec![0.0; n];
         self.eq.initial_state(&x[..p], &mut y0);
         let mut f = vec![0.0; m * n];
@@ -308,7 +337,6 @@ impl<'a> Grid<'a> {
         self.eq
             .tip_residual(self.node_ref(x, &y0, self.intervals()), &mut g);
         r.extend_from_slice(&g);
-        r
     }
 
     /// Storage for the Newton matrix of this mesh.
@@ -318,8 +346,6 @@ impl<'a> Grid<'a> {
         Linearization {
             lu: vec![0.0; k * mn * mn],
             piv: vec![0; k * mn],
-            z: vec![0.0; k * mn * n],
-            hbj: vec![0.0; k * m * n * n],
             band: BandLu::zeros(p + n * k, 2 * n - 1 - p, n + p - 1),
             valid: false,
         }
@@ -370,8 +396,10 @@ impl<'a> Grid<'a> {
     }
 
     /// Condensation of interval i into `lin`: δY = v + Z δy_i with W Z = E
-    /// (stacked identities), and Γ = I + h Σ_j b_j J_j Z_j (AMR §7.2.1),
-    /// into `gamma` (n × n, row-major); false if W is singular.
+    /// (stacked identities), and with the node row less Σ_j d_j times the
+    /// stage rows, y_{i+1} − y_i − Σ_j d_j (Y_j − y_i) (d = A⁻ᵀb, AMR §7.2.1
+    /// with the rows combined), Γ = (1 − Σ_j d_j) I + Σ_j d_j Z_j, into
+    /// `gamma` (n × n, row-major); false if W is singular.
     pub(super) fn condense(
         &self,
         i: usize,
@@ -381,7 +409,7 @@ impl<'a> Grid<'a> {
         gamma: &mut [f64],
     ) -> bool {
         let (n, m, (s, h)) = (self.n, self.tab.m, self.span(i));
-        let (mn, nn) = (m * n, n * n);
+        let mn = m * n;
         self.stage_jacobians(s, h, st, &mut ws.f, &mut ws.jac);
         let lu = &mut lin.lu[i * mn * mn..(i + 1) * mn * mn];
         let piv = &mut lin.piv[i * mn..(i + 1) * mn];
@@ -389,48 +417,36 @@ impl<'a> Grid<'a> {
         if !dense_lu(lu, mn, piv) {
             return false;
         }
-        let z = &mut lin.z[i * mn * n..(i + 1) * mn * n];
-        for c in 0..n {
-            let col = &mut z[c * mn..(c + 1) * mn];
-            col.iter_mut()
+        let z = &mut ws.z;
+        for (r, row) in z.chunks_exact_mut(n).enumerate() {
+            row.iter_mut()
                 .enumerate()
-                .for_each(|(r, v)| *v = if r % n == c { 1.0 } else { 0.0 });
-            dense_solve(lu, mn, piv, col);
+                .for_each(|(c, v)| *v = if r % n == c { 1.0 } else { 0.0 });
         }
+        dense_solve_rows(lu, mn, piv, z, n);
         if !z.iter().all(|v| v.is_finite()) {
             return false;
         }
-        let hbj = &mut lin.hbj[i * m * nn..(i + 1) * m * nn];
-        for j in 0..m {
-            let hb = h * self.tab.b[j];
-            hbj[j * nn..(j + 1) * nn]
-                .iter_mut()
-                .zip(&ws.jac[j * nn..(j + 1) * nn])
-                .for_each(|(a, b)| *a = b * hb);
-        }
-        for r in 0..n {
-            for c in 0..n {
-                gamma[r * n + c] = if r == c { 1.0 } else { 0.0 };
-            }
-        }
-        for j in 0..m {
-            let hb = &hbj[j * nn..(j + 1) * nn];
-            for r in 0..n {
-                for c in 0..n {
-                    let zc = &z[c * mn + j * n..c * mn + (j + 1) * n];
-                    let t: f64 = (0..n).map(|q| hb[q * n + r] * zc[q]).sum();
-                    gamma[r * n + c] += t;
-                }
+        let d = &self.tab.d;
+        let keep = 1.0 - d.iter().sum::<f64>();
+        for (q, g) in gamma.iter_mut().enumerate() {
+            let (r, c) = (q / n, q % n);
+            *g = if r == c { keep } else { 0.0 };
+            for (j, dj) in d.iter().enumerate() {
+                *g += dj * z[(j * n + r) * n + c];
             }
         }
         true
     }
 
-    /// −J⁻¹F for a scaled residual F, in the unknowns' layout.
-    pub(super) fn newton_correction(&self, lin: &Linearization, f: &[f64]) -> Vec<f64> {
+    /// −J⁻¹F for a scaled residual F, in the unknowns' layout: per interval
+    /// v = W⁻¹(−F_stages), the combined node row's right-hand side
+    /// −F_node + Σ_j d_j (F_stage_j − v_j), the banded solve for the nodes,
+    /// then the stages δY = W⁻¹(−F_stages + E δy_i) by a second solve.
+    pub(super) fn newton_correction(&self, lin: &Linearization, f: &[f64], dx: &mut [f64]) {
         let (n, m, p, k) = (self.n, self.tab.m, self.p, self.intervals());
-        let (mn, nn) = (m * n, n * n);
-        let mut dx = vec![0.0; self.size()];
+        let mn = m * n;
+        let d = &self.tab.d;
         let (head, stages) = dx.split_at_mut(p + n * k);
         for i in 0..k {
             let base = i * (m + 1) * n;
@@ -444,13 +460,10 @@ impl<'a> Grid<'a> {
                 &lin.piv[i * mn..(i + 1) * mn],
                 v,
             );
-            let hbj = &lin.hbj[i * m * nn..(i + 1) * m * nn];
             for r in 0..n {
                 let mut acc = -f[base + mn + r] / self.w[r];
-                for j in 0..m {
-                    let hb = &hbj[j * nn..(j + 1) * nn];
-                    let vj = &v[j * n..(j + 1) * n];
-                    acc += (0..n).map(|q| hb[q * n + r] * vj[q]).sum::<f64>();
+                for (j, dj) in d.iter().enumerate() {
+                    acc += dj * (f[base + j * n + r] / self.w[r] + v[j * n + r]);
                 }
                 head[n * i + r] = acc * self.w[r];
             }
@@ -463,20 +476,25 @@ impl<'a> Grid<'a> {
         for (r, d) in dy0.iter_mut().enumerate() {
             *d = (0..p).map(|c| self.sens[(r, c)] * head[c]).sum();
         }
+        let mut g = vec![0.0; mn];
         for i in 0..k {
             let dyi = if i == 0 {
                 &dy0[..]
             } else {
                 &head[p + n * (i - 1)..p + n * i]
             };
-            let z = &lin.z[i * mn * n..(i + 1) * mn * n];
-            let v = &mut stages[i * mn..(i + 1) * mn];
-            for (r, a) in v.iter_mut().enumerate() {
-                let t: f64 = (0..n).map(|c| z[c * mn + r] * dyi[c]).sum();
-                *a += t;
+            for gj in g.chunks_exact_mut(n) {
+                gj.copy_from_slice(dyi);
             }
+            dense_solve(
+                &lin.lu[i * mn * mn..(i + 1) * mn * mn],
+                mn,
+                &lin.piv[i * mn..(i + 1) * mn],
+                &mut g,
+            );
+            let v = &mut stages[i * mn..(i + 1) * mn];
+            v.iter_mut().zip(&g).for_each(|(a, b)| *a += b);
         }
-        dx
     }
 
     /// A weighted Euclidean norm of a correction (δy_0 = S δu, nodes and

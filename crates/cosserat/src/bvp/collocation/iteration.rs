@@ -13,18 +13,16 @@ use super::CollocationError;
 use crate::bvp::newton::NewtonOptions;
 use crate::numerics::newton::{self, NewtonError, System, Trial};
 
-/// The factored Newton matrix: per interval the condensed stage block, in
-/// flat storage reused across Newton iterations.
+/// The factored Newton matrix: per interval the factored stage block, in
+/// flat storage reused across Newton iterations. Nothing else per interval
+/// is kept: the stage corrections' response to δy_i, W⁻¹E, is applied as a
+/// second solve with these factors, and the node rows are combined with
+/// the stage rows so that they hold no Jacobian ([`super::Tableau::d`]).
 pub(super) struct Linearization {
     /// LU factors of the stage matrices W (mn × mn each, row-major).
     pub(super) lu: Vec<f64>,
     /// Their row interchanges.
     pub(super) piv: Vec<usize>,
-    /// W⁻¹E (mn × n each, column-major): the stage corrections' response
-    /// to δy_i.
-    pub(super) z: Vec<f64>,
-    /// h b_j J_j (m blocks of n × n each, column-major).
-    pub(super) hbj: Vec<f64>,
     pub(super) band: BandLu,
     /// Whether the last `linearize` succeeded.
     pub(super) valid: bool,
@@ -70,9 +68,8 @@ impl System for Collocation<'_, '_> {
     }
 
     fn residual(&mut self, x: &[f64], r: &mut [f64]) -> Result<(), NonFinite> {
-        let f = self.grid.residual(x);
-        r.copy_from_slice(&f);
-        let norm = max_norm(&f);
+        self.grid.residual_into(x, r);
+        let norm = max_norm(r);
         if norm.is_finite() {
             Ok(())
         } else {
@@ -85,7 +82,7 @@ impl System for Collocation<'_, '_> {
     }
 
     fn solve(&mut self, f: &[f64], delta: &mut [f64]) -> bool {
-        delta.copy_from_slice(&self.grid.newton_correction(&self.lin, f));
+        self.grid.newton_correction(&self.lin, f, delta);
         true
     }
 
@@ -191,7 +188,8 @@ pub(super) fn polish(
         if !grid.linearize(&x, &mut lin, ws) {
             break;
         }
-        let step = grid.newton_correction(&lin, &f);
+        let mut step = vec![0.0; x.len()];
+        grid.newton_correction(&lin, &f, &mut step);
         let trial: Vec<f64> = x.iter().zip(&step).map(|(a, b)| a + b).collect();
         let f_try = grid.residual(&trial);
         let norm = max_norm(&f_try);

@@ -35,7 +35,7 @@
 mod error_estimate;
 mod grid;
 mod iteration;
-mod lu;
+pub(super) mod lu;
 mod mesh;
 mod tableau;
 

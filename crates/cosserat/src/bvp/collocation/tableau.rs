@@ -18,6 +18,10 @@ pub(crate) struct Tableau {
     /// m × m, row-major.
     a: Vec<f64>,
     pub(crate) b: Vec<f64>,
+    /// d = A⁻ᵀ b: the node equation less Σ_j d_j times stage equation j is
+    /// y_{i+1} − y_i − Σ_j d_j (Y_j − y_i), linear (no f), so the condensed
+    /// Newton step needs no stage Jacobians after the condensation.
+    pub(crate) d: Vec<f64>,
 }
 
 impl Tableau {
@@ -29,8 +33,14 @@ impl Tableau {
         let a = c
             .iter()
             .flat_map(|&cj| integral_weights(&c, &b, cj))
-            .collect();
-        Some(Tableau { m, c, a, b })
+            .collect::<Vec<f64>>();
+        let d = nalgebra::DMatrix::from_row_slice(m, m, &a)
+            .transpose()
+            .lu()
+            .solve(&nalgebra::DVector::from_column_slice(&b))?
+            .as_slice()
+            .to_vec();
+        Some(Tableau { m, c, a, b, d })
     }
 
     pub(crate) fn a(&self, j: usize, l: usize) -> f64 {
