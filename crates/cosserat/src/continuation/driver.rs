@@ -42,14 +42,10 @@ pub(super) fn check_start(
     opts: &ContinuationOptions,
 ) -> Result<(), ContinuationError> {
     let start = family.rod_at(opts.start).map_err(PointError::from)?;
-    crate::stability::check_conservative(&start)
-        .and_then(|()| {
-            crate::stability::check_jumps_on_boundaries(&start, opts.stability.elements())
-        })
-        .map_err(|e| ContinuationError::Start {
-            p: opts.start,
-            message: e.to_string(),
-        })
+    crate::stability::check_conservative(&start).map_err(|e| ContinuationError::Start {
+        p: opts.start,
+        message: e.to_string(),
+    })
 }
 
 /// The diagram of a run from its first point: the first branch (both ways

@@ -366,6 +366,12 @@ impl Family {
         self.base.length()
     }
 
+    /// Where the base rod's internal force jumps (its interior point
+    /// loads, [`crate::model::DeadLoads::jumps`]).
+    pub fn base_jumps(&self) -> Vec<f64> {
+        self.base.loads().jumps()
+    }
+
     /// The model level.
     pub fn level(&self) -> ModelLevel {
         self.level

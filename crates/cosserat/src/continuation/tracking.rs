@@ -65,6 +65,8 @@ pub struct Tracker {
     blocks: Vec<Block>,
     opts: StabilityOptions,
     base_length: f64,
+    /// The base rod's interior point loads: element boundaries there.
+    base_breaks: Vec<f64>,
     /// Equally spaced points of the stored shape (≥ 2; the last is the tip).
     shape_points: usize,
     previous: Option<Modes>,
@@ -86,6 +88,7 @@ impl Tracker {
             blocks,
             opts,
             base_length,
+            base_breaks: family.base_jumps(),
             shape_points: 21,
             previous: None,
             previous_values: None,
@@ -118,7 +121,9 @@ impl Tracker {
 
     /// Finite-element nodes of the modes (at the base length).
     pub fn nodes(&self) -> Vec<f64> {
-        FiniteElements::new(self.base_length, self.opts.elements(), self.opts.order()).nodes()
+        FiniteElements::new(self.base_length, self.opts.elements(), self.opts.order())
+            .with_breaks(&self.base_breaks)
+            .nodes()
     }
 
     /// Forget the previous eigenvectors (a new branch starts).
@@ -136,6 +141,7 @@ impl Tracker {
     ) -> Result<(FiniteElements, Vec<BlockMatrices>, f64, Vec<RodSample>), PointError> {
         let rod = family.rod_at(p)?;
         let fe = FiniteElements::new(rod.length(), self.opts.elements(), self.opts.order())
+            .with_breaks(&rod.loads().jumps())
             .with_hinged_base(rod.clamp().hinge);
         // One integration for the quadrature points and the shape points
         // (the last is the tip).

@@ -271,27 +271,6 @@ pub fn check_conservative(rod: &Rod) -> Result<(), StabilityError> {
     Ok(())
 }
 
-/// Refuses elements across which n(s) jumps: a point force at s_k must lie
-/// on an element boundary (s_k N / L an integer to 1e-9), so that no
-/// element's quadrature straddles the jump of the coefficient C(n) (which
-/// would cost the elements' order, silently). The uniform elements put
-/// s = L/2 on a boundary for any even N; [`decide`]'s doublings keep it.
-/// A dead point force enters δ²V through n(s) only (it has a potential,
-/// −F·r(s_k)), so nothing else changes.
-pub fn check_jumps_on_boundaries(rod: &Rod, elements: usize) -> Result<(), StabilityError> {
-    let n = elements as f64;
-    for s in rod.loads().jumps() {
-        let x = s / rod.length() * n;
-        if (x - x.round()).abs() > 1e-9 * n.max(1.0) {
-            return Err(StabilityError::Unsupported(format!(
-                "the point force at s = {s} lies inside an element of the {elements} equal \
-                 elements: choose stability.elements so that s·elements/L is an integer"
-            )));
-        }
-    }
-    Ok(())
-}
-
 /// The constraints of `rod`'s tip support on a block (none for a free
 /// tip); `samples` at the quadrature points, `tip` at s = L.
 pub fn support_constraints(
@@ -315,8 +294,8 @@ pub fn analyze(
     opts: &StabilityOptions,
 ) -> Result<Stability, StabilityError> {
     check_conservative(rod)?;
-    check_jumps_on_boundaries(rod, opts.elements)?;
     let fe = FiniteElements::new(rod.length(), opts.elements, opts.order)
+        .with_breaks(&rod.loads().jumps())
         .with_hinged_base(rod.clamp().hinge);
     let mut points = fe.quadrature_points();
     points.push(rod.length());
@@ -417,13 +396,6 @@ pub fn decide(
         ));
     }
     if needed > opts.elements {
-        // A multiple of the asked count keeps point forces on element
-        // boundaries (check_jumps_on_boundaries) where the asked count does.
-        let needed = if rod.loads().point_forces.is_empty() {
-            needed
-        } else {
-            needed.div_ceil(opts.elements) * opts.elements
-        };
         opts = opts.with_elements(needed)?;
     }
     let first = opts.elements;

@@ -208,11 +208,15 @@ impl Block {
     }
 }
 
-/// Lagrange elements of order p on a uniform mesh of [0, L].
+/// Lagrange elements of order p on a mesh of [0, L]: uniform, or uniform
+/// on each piece between break points (interior point loads, where the
+/// coefficients jump: an element straddling a jump would lose the
+/// elements' order, silently).
 #[derive(Debug, Clone, PartialEq)]
 pub struct FiniteElements {
     length: f64,
-    elements: usize,
+    /// The element boundaries 0 = b_0 < … < b_E = L.
+    boundaries: Vec<f64>,
     order: usize,
     /// A hinged base: ω2(0) is free (the in-plane block keeps node 0).
     hinged: bool,
@@ -222,6 +226,26 @@ pub struct FiniteElements {
 fn gauss(m: usize) -> (Vec<f64>, Vec<f64>) {
     let m = if matches!(m, 2 | 3) { m } else { 4 };
     crate::numerics::quadrature::gauss_legendre(m, 0.0, 1.0).expect("tabulated")
+}
+
+/// The elements of each piece [ends[j], ends[j+1]] when `total` are shared
+/// in proportion to the pieces' lengths: the floors of the exact shares,
+/// then one more to the largest remainders (the first of equal ones), and
+/// at least one each (the total grows where a piece would get none).
+fn shares(ends: &[f64], total: usize) -> Vec<usize> {
+    let length = ends[ends.len() - 1] - ends[0];
+    let exact: Vec<f64> = ends
+        .windows(2)
+        .map(|w| (w[1] - w[0]) / length * total as f64)
+        .collect();
+    let mut counts: Vec<usize> = exact.iter().map(|x| x.floor() as usize).collect();
+    let mut order: Vec<usize> = (0..exact.len()).collect();
+    order.sort_by(|&i, &j| (exact[j] - exact[j].floor()).total_cmp(&(exact[i] - exact[i].floor())));
+    let missing = total.saturating_sub(counts.iter().sum());
+    for &i in order.iter().take(missing) {
+        counts[i] += 1;
+    }
+    counts.iter().map(|&n| n.max(1)).collect()
 }
 
 impl FiniteElements {
@@ -234,12 +258,62 @@ impl FiniteElements {
             elements >= 1 && (1..=3).contains(&order),
             "finite elements: {elements} elements of order {order}; need ≥ 1 of order 1 to 3"
         );
+        // L·(e/E): the last boundary is L exactly, never an ulp beyond it.
+        let boundaries = (0..=elements)
+            .map(|e| length * (e as f64 / elements as f64))
+            .collect();
         FiniteElements {
             length,
-            elements,
+            boundaries,
             order,
             hinged: false,
         }
+    }
+
+    /// The same number of elements (at least one per piece) with every
+    /// break point in (0, L) on an element boundary: each piece between
+    /// consecutive breaks gets its share of the elements in proportion to
+    /// its length (largest remainders, at least one), uniform within the
+    /// piece. No break leaves the mesh as it was. The element sizes stay
+    /// within a factor 1 + O(1/E) of L/E where the pieces are long, so the
+    /// convergence order and a Richardson estimate on doubled meshes keep
+    /// their meaning (the pieces' shares differ from E·ℓ/L by less than
+    /// one element).
+    #[must_use]
+    pub fn with_breaks(self, breaks: &[f64]) -> Self {
+        let mut cuts: Vec<f64> = breaks
+            .iter()
+            .copied()
+            .filter(|s| *s > 0.0 && *s < self.length)
+            .collect();
+        if cuts.is_empty() {
+            return self;
+        }
+        cuts.sort_by(f64::total_cmp);
+        cuts.dedup();
+        let ends: Vec<f64> = std::iter::once(0.0)
+            .chain(cuts)
+            .chain(std::iter::once(self.length))
+            .collect();
+        let counts = shares(&ends, self.elements());
+        let mut boundaries = vec![0.0];
+        for (piece, &n) in ends.windows(2).zip(&counts) {
+            let (a, b) = (piece[0], piece[1]);
+            boundaries.extend((1..n).map(|i| a + (b - a) * (i as f64 / n as f64)));
+            boundaries.push(b);
+        }
+        FiniteElements { boundaries, ..self }
+    }
+
+    /// The number of elements.
+    pub fn elements(&self) -> usize {
+        self.boundaries.len() - 1
+    }
+
+    /// Start and size of element `e`.
+    fn element(&self, e: usize) -> (f64, f64) {
+        let (a, b) = (self.boundaries[e], self.boundaries[e + 1]);
+        (a, b - a)
     }
 
     /// The same elements for a base that is a hinge about d2(0) (true) or a
@@ -256,30 +330,34 @@ impl FiniteElements {
         usize::from(!(self.hinged && block == Block::InPlane))
     }
 
-    /// Element size.
+    /// The largest element size.
     pub fn h(&self) -> f64 {
-        self.length / self.elements as f64
+        (0..self.elements())
+            .map(|e| self.element(e).1)
+            .fold(0.0, f64::max)
     }
 
-    /// All nodes s_0 = 0, …, s_{pE} = L.
+    /// All nodes s_0 = 0, …, s_{pE} = L (each element's boundaries exact,
+    /// so the last node is L, never an ulp beyond it).
     pub fn nodes(&self) -> Vec<f64> {
-        let n = self.elements * self.order;
-        // L·(i/n): the last node is L exactly, never an ulp beyond it.
-        (0..=n)
-            .map(|i| self.length * (i as f64 / n as f64))
-            .collect()
+        let p = self.order;
+        let mut nodes = vec![0.0];
+        for e in 0..self.elements() {
+            let (a, h) = self.element(e);
+            nodes.extend((1..p).map(|i| a + h * (i as f64 / p as f64)));
+            nodes.push(self.boundaries[e + 1]);
+        }
+        nodes
     }
 
     /// The quadrature points in increasing order (where the equilibrium
     /// must be sampled).
     pub fn quadrature_points(&self) -> Vec<f64> {
         let (x, _) = gauss(self.order + 1);
-        let h = self.h();
-        (0..self.elements)
+        (0..self.elements())
             .flat_map(|e| {
-                x.iter()
-                    .map(move |xi| (e as f64 + xi) * h)
-                    .collect::<Vec<_>>()
+                let (a, h) = self.element(e);
+                x.iter().map(move |xi| a + xi * h).collect::<Vec<_>>()
             })
             .collect()
     }
@@ -307,7 +385,7 @@ impl FiniteElements {
     /// Number of unknowns of a block (the clamp node is fixed, unless the
     /// base is hinged and the block is in-plane).
     pub fn size(&self, block: Block) -> usize {
-        block.components().len() * (self.elements * self.order + 1 - self.first_node(block))
+        block.components().len() * (self.elements() * self.order + 1 - self.first_node(block))
     }
 
     /// K for the coefficients at the quadrature points (in the order of
@@ -315,7 +393,7 @@ impl FiniteElements {
     pub fn stiffness(&self, coeffs: &[FormCoefficients], block: Block) -> SymmetricBanded {
         assert_eq!(
             coeffs.len(),
-            self.elements * (self.order + 1),
+            self.elements() * (self.order + 1),
             "one set per quadrature point"
         );
         self.assemble(block, |q, a, da, b, db, ci, cj| {
@@ -349,9 +427,9 @@ impl FiniteElements {
         let mut k = SymmetricBanded::zeros(self.size(block), nc * (p + 1) - 1);
         let first = self.first_node(block);
         let (xs, ws) = gauss(p + 1);
-        let h = self.h();
         let shapes: Vec<_> = xs.iter().map(|&x| self.shape(x)).collect();
-        for e in 0..self.elements {
+        for e in 0..self.elements() {
+            let (_, h) = self.element(e);
             for (g, ((val, der), w)) in shapes.iter().zip(&ws).enumerate() {
                 let q = e * (p + 1) + g;
                 for a in 0..=p {
@@ -383,9 +461,11 @@ impl FiniteElements {
     /// [`Self::quadrature_points`].
     pub fn quadrature_weights(&self) -> Vec<f64> {
         let (_, w) = gauss(self.order + 1);
-        let h = self.h();
-        (0..self.elements)
-            .flat_map(|_| w.iter().map(move |wi| wi * h).collect::<Vec<_>>())
+        (0..self.elements())
+            .flat_map(|e| {
+                let (_, h) = self.element(e);
+                w.iter().map(move |wi| wi * h).collect::<Vec<_>>()
+            })
             .collect()
     }
 
@@ -394,10 +474,11 @@ impl FiniteElements {
     pub fn interpolate(&self, block: Block, v: &[f64]) -> Vec<(Vector3<f64>, Vector3<f64>)> {
         let nodal = self.nodal_rotations(block, v);
         let (xs, _) = gauss(self.order + 1);
-        let (p, h) = (self.order, self.h());
-        let mut out = Vec::with_capacity(self.elements * xs.len());
+        let p = self.order;
+        let mut out = Vec::with_capacity(self.elements() * xs.len());
         let shapes: Vec<_> = xs.iter().map(|&x| self.shape(x)).collect();
-        for e in 0..self.elements {
+        for e in 0..self.elements() {
+            let (_, h) = self.element(e);
             for (val, der) in &shapes {
                 let mut w = Vector3::zeros();
                 let mut dw = Vector3::zeros();
@@ -439,7 +520,7 @@ impl FiniteElements {
             Freedom::Fixed => (0..3).map(|j| Vector3::ith(j, 1.0)).collect(),
             Freedom::Axial(a) => across(&a).map(|b| frame.transpose() * b).to_vec(),
         };
-        let last = self.elements * self.order - self.first_node(block);
+        let last = self.elements() * self.order - self.first_node(block);
         for v in turns {
             let mut row = DVector::zeros(n);
             for (x, &c) in block.components().iter().enumerate() {
@@ -455,9 +536,9 @@ impl FiniteElements {
         let comps = block.components();
         let p = self.order;
         let (xs, ws) = gauss(p + 1);
-        let h = self.h();
         let mut row = DVector::zeros(self.size(block));
-        for e in 0..self.elements {
+        for e in 0..self.elements() {
+            let (_, h) = self.element(e);
             for (g, (&x, w)) in xs.iter().zip(&ws).enumerate() {
                 let sample = &samples[e * (p + 1) + g];
                 let d = &sample.directors;
@@ -480,7 +561,7 @@ impl FiniteElements {
     pub fn nodal_rotations(&self, block: Block, v: &[f64]) -> Vec<Vector3<f64>> {
         let comps = block.components();
         let first = self.first_node(block);
-        let mut out = vec![Vector3::zeros(); self.elements * self.order + 1];
+        let mut out = vec![Vector3::zeros(); self.elements() * self.order + 1];
         for (node, w) in out.iter_mut().enumerate().skip(first) {
             for (x, &c) in comps.iter().enumerate() {
                 w[c] = v[(node - first) * comps.len() + x];
