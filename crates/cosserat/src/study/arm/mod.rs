@@ -48,10 +48,12 @@ pub use taper_arm::{loading_verdict, LoadingVerdict, TaperedArm, TaperedOptimum}
 mod warm_start;
 
 mod design;
+mod gradient;
 mod search;
 mod straight;
 
 use design::{derivative, polynomial};
+pub use gradient::ReachSlope;
 pub use straight::{StraightArm, StraightLimit};
 
 /// The arm to design.

@@ -16,7 +16,7 @@ use crate::model::Profile;
 use crate::stability::{critical_load, FixedShape};
 
 use super::design::{intrinsic_shape, least_squares_polynomial};
-use super::polish::{box_simplex, polish_in_box};
+use super::polish::{ascend_in_box, box_simplex, polish_in_box, AscentEnd};
 use super::{
     derivative, polynomial, ArmDesign, ArmOptimum, ArmProblem, ArmScene, SearchOptions,
     SearchProgress, REACH_TOLERANCE,
@@ -184,7 +184,23 @@ impl ArmProblem {
         box_simplex(start, &self.bounds, fraction)
     }
 
-    /// Nelder–Mead from `start` on −R̂ (projected into the bounds).
+    /// The local optimum of R̂ from the shape c2..cM `start` on this
+    /// problem's mesh, as the search polishes its leaders (below); the
+    /// evaluations used. For checks on other meshes.
+    pub fn polished(
+        &self,
+        scene: &ArmScene,
+        start: &[f64],
+        iterations: u64,
+    ) -> (Option<ArmDesign>, usize) {
+        self.polish(scene, start, iterations, &|| false)
+    }
+
+    /// The local optimum from `start`: projected BFGS on R̂ with its exact
+    /// gradient ([`ascend_in_box`], at most `iterations` steps), and where
+    /// the reach has no gradient on the way (a double critical load, an
+    /// actuator limit) Nelder–Mead on −R̂ from where it stopped, at most
+    /// `iterations` more.
     pub(super) fn polish(
         &self,
         scene: &ArmScene,
@@ -192,7 +208,25 @@ impl ArmProblem {
         iterations: u64,
         stop: &dyn Fn() -> bool,
     ) -> (Option<ArmDesign>, usize) {
-        self.nelder_mead(scene, self.simplex(start), iterations, stop)
+        let ascent = ascend_in_box(
+            start,
+            &self.bounds,
+            usize::try_from(iterations).unwrap_or(usize::MAX),
+            &|x| {
+                self.reach_slope(scene, x)
+                    .map(|r| (r.design.reach, r.gradient))
+            },
+            stop,
+        );
+        let from = match (&ascent.end, &ascent.best) {
+            (AscentEnd::Stopped, _) => return (None, ascent.evaluations),
+            (AscentEnd::NoGradient, Some((x, _))) => x.clone(),
+            (AscentEnd::Infeasible, _) => start.to_vec(),
+            (_, Some((x, _))) => return (self.design_in(scene, x), ascent.evaluations + 1),
+            (_, None) => start.to_vec(),
+        };
+        let (design, used) = self.nelder_mead(scene, self.simplex(&from), iterations, stop);
+        (design, ascent.evaluations + used)
     }
 
     /// Nelder–Mead on −R̂ from a simplex; the polished design and the
