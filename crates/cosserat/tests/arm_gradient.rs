@@ -44,7 +44,10 @@ fn difference_study(
             };
             let values = [h, h / 2.0, h / 4.0].map(d);
             let errors = values.map(|v| (v - exact[i]).abs());
-            let order = ((errors[0] / errors[1]).log2() + (errors[1] / errors[2]).log2()) / 2.0;
+            let order = f64::midpoint(
+                (errors[0] / errors[1]).log2(),
+                (errors[1] / errors[2]).log2(),
+            );
             Differences {
                 values,
                 errors,

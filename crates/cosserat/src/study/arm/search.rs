@@ -1,8 +1,10 @@
 //! The search for the farthest-reaching design: Owen-scrambled Sobol'
-//! samples of the box of c2..cM (the global stage), then Nelder–Mead
-//! (argmin) from the best few (the polish) on the cost −R̂, points outside
-//! the box projected into it and charged their squared distance; with the
-//! progress kept so that an interrupted search can be resumed.
+//! samples of the box of c2..cM (the global stage), then projected BFGS on
+//! R̂ with its exact gradient from the best few (the polish, `polish.rs`
+//! `ascend_in_box`; where R̂ has no gradient — a double critical load, an
+//! actuator limit — Nelder–Mead (argmin) on −R̂ goes on from there, points
+//! outside the box projected into it and charged their squared distance);
+//! with the progress kept so that an interrupted search can be resumed.
 //!
 //! Samples and polishes run in parallel (rayon), each on its own data, and
 //! are folded in their sequence order: the optimum is the same bit for bit
@@ -221,9 +223,10 @@ impl ArmProblem {
         let from = match (&ascent.end, &ascent.best) {
             (AscentEnd::Stopped, _) => return (None, ascent.evaluations),
             (AscentEnd::NoGradient, Some((x, _))) => x.clone(),
-            (AscentEnd::Infeasible, _) => start.to_vec(),
+            // An infeasible start: the simplex may find feasible designs
+            // around it.
+            (AscentEnd::Infeasible, _) | (_, None) => start.to_vec(),
             (_, Some((x, _))) => return (self.design_in(scene, x), ascent.evaluations + 1),
-            (_, None) => start.to_vec(),
         };
         let (design, used) = self.nelder_mead(scene, self.simplex(&from), iterations, stop);
         (design, ascent.evaluations + used)
