@@ -153,7 +153,9 @@ impl ArmProblem {
     /// limit, which sits where the limit and λ_crit meet: a finer mesh
     /// lowers λ_crit a little, and the design itself may have no load its
     /// actuators can hold there. With `iterations` = 0 (a design not
-    /// chosen for its reach) the values are the design's own reach.
+    /// chosen for its reach), and in a scene with an actuator limit (no
+    /// gradient: a re-polish would be a whole Nelder–Mead) where the design
+    /// is feasible on 2N and 4N, the values are the design's own reach.
     pub fn mesh_study(
         &self,
         scene: &ArmScene,
@@ -162,9 +164,17 @@ impl ArmProblem {
     ) -> (MeshStudy, usize) {
         let n = self.stability.elements();
         let rest = &design.shape_coefficients[1..];
-        if iterations == 0 {
-            let reach = |m: usize| self.on_mesh(m).design_in(scene, rest).map(|d| d.reach);
-            let (r2, r4) = (reach(2 * n), reach(4 * n));
+        // Without a gradient (an actuator limit) a re-polish is a whole
+        // Nelder–Mead per mesh: the design's own reach is kept where it
+        // exists, as before the gradient polish.
+        let own = iterations == 0 || scene.max_curvature.is_some();
+        let reach = |m: usize| self.on_mesh(m).design_in(scene, rest).map(|d| d.reach);
+        let (r2, r4) = if own {
+            (reach(2 * n), reach(4 * n))
+        } else {
+            (None, None)
+        };
+        if iterations == 0 || (r2.is_some() && r4.is_some()) {
             // NaN marks a reach that does not exist (never read as a value:
             // `resolved` refuses it).
             let study = MeshStudy {
@@ -174,7 +184,7 @@ impl ArmProblem {
             };
             return (study, 2);
         }
-        let mut evaluations = 0;
+        let mut evaluations = if own { 2 } else { 0 };
         let mut polished = |m: usize| {
             let (d, used) = self.on_mesh(m).polish(scene, rest, iterations, &|| false);
             evaluations += used;
