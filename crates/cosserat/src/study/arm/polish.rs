@@ -324,3 +324,44 @@ fn bfgs_update(b: &mut DMatrix<f64>, s: &[f64], y: &[f64]) {
     }
     *b += &y * y.transpose() / sy - &bs * bs.transpose() / sbs;
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An ill-conditioned concave quadratic, f = 3 − ½ (x − t)ᵀ Q (x − t),
+    /// whose unconstrained maximum t lies outside the box in x0: the
+    /// box-constrained maximum is at x0 = 1 (its bound) with x1 maximizing
+    /// f along it, x1 = t1 − Q10 (1 − t0)/Q11 (closed form, the KKT point:
+    /// ∂f/∂x0 = −(Q(x − t))0 > 0 there, pushing out).
+    #[test]
+    fn ascent_reaches_the_box_constrained_maximum_of_a_quadratic() {
+        let q = [[1.0, 0.999], [0.999, 1.0]];
+        let t = [2.0, -1.0];
+        let slope = |x: &[f64]| -> Option<Slope> {
+            let d = [x[0] - t[0], x[1] - t[1]];
+            let qd = [
+                q[0][0] * d[0] + q[0][1] * d[1],
+                q[1][0] * d[0] + q[1][1] * d[1],
+            ];
+            let f = 3.0 - 0.5 * (d[0] * qd[0] + d[1] * qd[1]);
+            Some((f, Some(vec![-qd[0], -qd[1]])))
+        };
+        let bounds = [(-1.0, 1.0), (-4.0, 4.0)];
+        let ascent = ascend_in_box(&[0.0, 0.0], &bounds, 200, &slope, &|| false);
+        assert_eq!(ascent.end, AscentEnd::Converged, "{ascent:?}");
+        let (x, _) = ascent.best.expect("a point");
+        let x1 = t[1] - q[1][0] * (1.0 - t[0]) / q[1][1];
+        assert_eq!(x[0], 1.0);
+        assert!((x[1] - x1).abs() < 1e-6, "{x:?} against (1, {x1})");
+    }
+
+    /// A value without a gradient ends the ascent there, said so.
+    #[test]
+    fn ascent_stops_where_there_is_no_gradient() {
+        let slope = |x: &[f64]| -> Option<Slope> { Some((-x[0].abs(), None)) };
+        let ascent = ascend_in_box(&[0.5], &[(-1.0, 1.0)], 10, &slope, &|| false);
+        assert_eq!(ascent.end, AscentEnd::NoGradient);
+        assert_eq!(ascent.iterations, 0);
+    }
+}
