@@ -486,7 +486,10 @@ fn report_mesh(opt: &ArmOptimum) {
         );
     }
     if s.local_optima {
-        println!("          (on the finer meshes: the optima near the design, infeasible there)");
+        println!(
+            "          (on the finer meshes: the optima re-polished from the design there, so the \
+             limit is the converged optimum's)"
+        );
     }
     for (n, coarse, fine) in &r.rejected {
         eprintln!(

@@ -142,33 +142,7 @@ pub fn critical_load(
     shape: &FixedShape,
     opts: &StabilityOptions,
 ) -> Result<CriticalLoad, StabilityError> {
-    if !rod.energy().is_quadratic() {
-        return Err(StabilityError::FixedShape(format!(
-            "the {} energy's Hessian depends on the load through κ − κ⁰, so K(λ) is not linear in λ; \
-             use the linear energy",
-            rod.energy().name()
-        )));
-    }
-    if rod.loads().tip_couple.norm() > 0.0 {
-        return Err(StabilityError::NonConservative(
-            "a fixed-shape scene takes forces only".into(),
-        ));
-    }
-    if rod.clamp().hinge || rod.support().is_some() || rod.energy().strain_energy().is_some() {
-        return Err(StabilityError::FixedShape(
-            "a fixed shape is a clamped, free-tipped Kirchhoff cantilever (paper Sec. 3); \
-             remove clamp.hinge, [support] and energy.shear"
-                .into(),
-        ));
-    }
-    let normal = rod.clamp().director(1);
-    let off_plane =
-        rod.loads().tip_force.dot(&normal).abs() + rod.loads().distributed_force.dot(&normal).abs();
-    if off_plane > 0.0 {
-        return Err(StabilityError::FixedShape(
-            "the loads must lie in the plane of d1(0), d3(0)".into(),
-        ));
-    }
+    check_scene(rod)?;
     let fe = FiniteElements::new(rod.length(), opts.elements, opts.order);
     let samples = shape.samples(rod, &fe.quadrature_points())?;
     let (c0, c1) = split_coefficients(rod, &samples);
@@ -199,4 +173,38 @@ pub fn critical_load(
         blocks,
         nodes: fe.nodes(),
     })
+}
+
+/// Refuses a rod that is not a fixed-shape scene: a quadratic energy (H
+/// independent of the load), forces only, a clamped free-tipped Kirchhoff
+/// cantilever with its loads in the plane of the shape.
+pub(super) fn check_scene(rod: &Rod) -> Result<(), StabilityError> {
+    if !rod.energy().is_quadratic() {
+        return Err(StabilityError::FixedShape(format!(
+            "the {} energy's Hessian depends on the load through κ − κ⁰, so K(λ) is not linear in λ; \
+             use the linear energy",
+            rod.energy().name()
+        )));
+    }
+    if rod.loads().tip_couple.norm() > 0.0 {
+        return Err(StabilityError::NonConservative(
+            "a fixed-shape scene takes forces only".into(),
+        ));
+    }
+    if rod.clamp().hinge || rod.support().is_some() || rod.energy().strain_energy().is_some() {
+        return Err(StabilityError::FixedShape(
+            "a fixed shape is a clamped, free-tipped Kirchhoff cantilever (paper Sec. 3); \
+             remove clamp.hinge, [support] and energy.shear"
+                .into(),
+        ));
+    }
+    let normal = rod.clamp().director(1);
+    let off_plane =
+        rod.loads().tip_force.dot(&normal).abs() + rod.loads().distributed_force.dot(&normal).abs();
+    if off_plane > 0.0 {
+        return Err(StabilityError::FixedShape(
+            "the loads must lie in the plane of d1(0), d3(0)".into(),
+        ));
+    }
+    Ok(())
 }

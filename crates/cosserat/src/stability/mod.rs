@@ -8,10 +8,12 @@
 pub use crate::numerics::{banded, constrained, eigen};
 pub mod factored;
 mod fixed_shape;
+mod fixed_shape_gradient;
 mod fixed_shape_spatial;
 mod second_variation;
 
 pub use fixed_shape::{critical_load, CriticalLoad, FixedShape};
+pub use fixed_shape_gradient::{critical_load_gradient, LoadGradient, SIMPLE_GAP};
 pub use fixed_shape_spatial::{critical_load_spatial, SpatialShape};
 pub use second_variation::{Block, FiniteElements, FormCoefficients};
 

@@ -12,8 +12,10 @@
 //! moment of the unit tip load on the shape.
 //!
 //! The search is deterministic: an Owen-scrambled Sobol' set over the box
-//! of c2..cM (the global stage, the private `study/arm/sampling.rs`), then Nelder–Mead (argmin)
-//! from the best few (the polish).
+//! of c2..cM (the global stage, the private `study/arm/sampling.rs`), then
+//! projected BFGS on R̂ with its exact gradient (`gradient`,
+//! [`crate::stability::critical_load_gradient`]) from the best few (the
+//! polish; Nelder–Mead (argmin) only where R̂ has no gradient).
 //!
 //! Submodules: `design` (a design's reach), `search` (the sampled search
 //! and its polish), `straight` (the intrinsically straight arm R̂0),
@@ -48,10 +50,12 @@ pub use taper_arm::{loading_verdict, LoadingVerdict, TaperedArm, TaperedOptimum}
 mod warm_start;
 
 mod design;
+mod gradient;
 mod search;
 mod straight;
 
 use design::{derivative, polynomial};
+pub use gradient::ReachSlope;
 pub use straight::{StraightArm, StraightLimit};
 
 /// The arm to design.

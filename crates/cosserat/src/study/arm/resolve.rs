@@ -35,8 +35,7 @@ pub struct MeshStudy {
     /// R̂ on each (NaN where none was found).
     pub reach: [f64; 3],
     /// Whether the values on 2N and 4N are the optima polished from the
-    /// design on those meshes (the design itself infeasible there), not
-    /// the design's own reach.
+    /// design on those meshes, not the design's own reach.
     pub local_optima: bool,
 }
 
@@ -145,12 +144,18 @@ impl ArmProblem {
     /// R̂ of the design c2..cM on N (its value `reach`, already known), 2N
     /// and 4N elements, N = this problem's mesh; the evaluations used.
     ///
-    /// An optimum on an actuator limit sits where the limit and λ_crit meet;
-    /// a finer mesh lowers λ_crit a little, and the design itself may then
-    /// have no load its actuators can hold. Then the values on 2N and 4N
-    /// are the optima polished from the design on each mesh (`iterations`
-    /// at most), marked [`MeshStudy::local_optima`]: R* converges where the
-    /// design's own reach does not exist.
+    /// With `iterations` > 0 the design is an optimum on N, and the values
+    /// on 2N and 4N are the optima polished from it on each mesh (warm: a
+    /// few exact-gradient steps, `iterations` at most), marked
+    /// [`MeshStudy::local_optima`], so that Richardson's limit is that of
+    /// the optimum R*, not of one design's reach (which the finer meshes
+    /// no longer maximize). This also covers an optimum on an actuator
+    /// limit, which sits where the limit and λ_crit meet: a finer mesh
+    /// lowers λ_crit a little, and the design itself may have no load its
+    /// actuators can hold there. With `iterations` = 0 (a design not
+    /// chosen for its reach), and in a scene with an actuator limit (no
+    /// gradient: a re-polish would be a whole Nelder–Mead) where the design
+    /// is feasible on 2N and 4N, the values are the design's own reach.
     pub fn mesh_study(
         &self,
         scene: &ArmScene,
@@ -159,11 +164,19 @@ impl ArmProblem {
     ) -> (MeshStudy, usize) {
         let n = self.stability.elements();
         let rest = &design.shape_coefficients[1..];
+        // Without a gradient (an actuator limit) a re-polish is a whole
+        // Nelder–Mead per mesh: the design's own reach is kept where it
+        // exists, as before the gradient polish.
+        let own = iterations == 0 || scene.max_curvature.is_some();
         let reach = |m: usize| self.on_mesh(m).design_in(scene, rest).map(|d| d.reach);
-        let (r2, r4) = (reach(2 * n), reach(4 * n));
-        // NaN marks a reach that does not exist (never read as a value:
-        // `resolved` refuses it).
+        let (r2, r4) = if own {
+            (reach(2 * n), reach(4 * n))
+        } else {
+            (None, None)
+        };
         if iterations == 0 || (r2.is_some() && r4.is_some()) {
+            // NaN marks a reach that does not exist (never read as a value:
+            // `resolved` refuses it).
             let study = MeshStudy {
                 elements: [n, 2 * n, 4 * n],
                 reach: [design.reach, r2.unwrap_or(f64::NAN), r4.unwrap_or(f64::NAN)],
@@ -171,7 +184,7 @@ impl ArmProblem {
             };
             return (study, 2);
         }
-        let mut evaluations = 2;
+        let mut evaluations = if own { 2 } else { 0 };
         let mut polished = |m: usize| {
             let (d, used) = self.on_mesh(m).polish(scene, rest, iterations, &|| false);
             evaluations += used;

@@ -1,8 +1,10 @@
 //! The search for the farthest-reaching design: Owen-scrambled Sobol'
-//! samples of the box of c2..cM (the global stage), then Nelder–Mead
-//! (argmin) from the best few (the polish) on the cost −R̂, points outside
-//! the box projected into it and charged their squared distance; with the
-//! progress kept so that an interrupted search can be resumed.
+//! samples of the box of c2..cM (the global stage), then projected BFGS on
+//! R̂ with its exact gradient from the best few (the polish, `polish.rs`
+//! `ascend_in_box`; where R̂ has no gradient — a double critical load, an
+//! actuator limit — Nelder–Mead (argmin) on −R̂ goes on from there, points
+//! outside the box projected into it and charged their squared distance);
+//! with the progress kept so that an interrupted search can be resumed.
 //!
 //! Samples and polishes run in parallel (rayon), each on its own data, and
 //! are folded in their sequence order: the optimum is the same bit for bit
@@ -16,7 +18,7 @@ use crate::model::Profile;
 use crate::stability::{critical_load, FixedShape};
 
 use super::design::{intrinsic_shape, least_squares_polynomial};
-use super::polish::{box_simplex, polish_in_box};
+use super::polish::{ascend_in_box, box_simplex, polish_in_box, AscentEnd};
 use super::{
     derivative, polynomial, ArmDesign, ArmOptimum, ArmProblem, ArmScene, SearchOptions,
     SearchProgress, REACH_TOLERANCE,
@@ -184,7 +186,23 @@ impl ArmProblem {
         box_simplex(start, &self.bounds, fraction)
     }
 
-    /// Nelder–Mead from `start` on −R̂ (projected into the bounds).
+    /// The local optimum of R̂ from the shape c2..cM `start` on this
+    /// problem's mesh, as the search polishes its leaders (below); the
+    /// evaluations used. For checks on other meshes.
+    pub fn polished(
+        &self,
+        scene: &ArmScene,
+        start: &[f64],
+        iterations: u64,
+    ) -> (Option<ArmDesign>, usize) {
+        self.polish(scene, start, iterations, &|| false)
+    }
+
+    /// The local optimum from `start`: projected BFGS on R̂ with its exact
+    /// gradient ([`ascend_in_box`], at most `iterations` steps), and where
+    /// the reach has no gradient on the way (a double critical load, an
+    /// actuator limit) Nelder–Mead on −R̂ from where it stopped, at most
+    /// `iterations` more.
     pub(super) fn polish(
         &self,
         scene: &ArmScene,
@@ -192,7 +210,26 @@ impl ArmProblem {
         iterations: u64,
         stop: &dyn Fn() -> bool,
     ) -> (Option<ArmDesign>, usize) {
-        self.nelder_mead(scene, self.simplex(start), iterations, stop)
+        let ascent = ascend_in_box(
+            start,
+            &self.bounds,
+            usize::try_from(iterations).unwrap_or(usize::MAX),
+            &|x| {
+                self.reach_slope(scene, x)
+                    .map(|r| (r.design.reach, r.gradient))
+            },
+            stop,
+        );
+        let from = match (&ascent.end, &ascent.best) {
+            (AscentEnd::Stopped, _) => return (None, ascent.evaluations),
+            (AscentEnd::NoGradient, Some((x, _))) => x.clone(),
+            // An infeasible start: the simplex may find feasible designs
+            // around it.
+            (AscentEnd::Infeasible, _) | (_, None) => start.to_vec(),
+            (_, Some((x, _))) => return (self.design_in(scene, x), ascent.evaluations + 1),
+        };
+        let (design, used) = self.nelder_mead(scene, self.simplex(&from), iterations, stop);
+        (design, ascent.evaluations + used)
     }
 
     /// Nelder–Mead on −R̂ from a simplex; the polished design and the
