@@ -66,11 +66,13 @@ fn spatial_optimum_file_holds_design_shapes_and_verdict() {
     for (path, description) in described(&out) {
         assert_ne!(description, "undescribed", "{path}");
     }
-    // The spatial search is seeded with the planar optimum.
+    // The spatial search is seeded with the planar optimum, which stdout
+    // prints to six decimals: the planar R* is at least the printed value
+    // less half its last unit.
     let planar: f64 = field(&text, "planar    R* = ");
     assert!(
-        reach >= planar * (1.0 - 1e-12),
-        "spatial {reach} < planar {planar}"
+        reach >= planar - 0.5e-6,
+        "spatial {reach} < planar {planar} (printed to 1e-6)"
     );
     assert!(std::fs::metadata(&chart).unwrap().len() > 1000);
     std::fs::remove_dir_all(dir).unwrap();

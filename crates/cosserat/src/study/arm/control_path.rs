@@ -20,7 +20,7 @@
 
 use std::sync::Arc;
 
-use super::{continue_family, continue_to_design, derivative, designed_rod, polynomial};
+use super::{continue_refining, continue_to_design, derivative, designed_rod, polynomial};
 use super::{ArmDesign, ArmProblem, ArmScene};
 use crate::continuation::{ContinuationError, Diagram, Family, Parameter};
 use crate::model::{LinearElastic, ModelLevel, Profile};
@@ -49,7 +49,7 @@ pub fn control_path_until(
     stop: &dyn Fn() -> bool,
 ) -> Result<Diagram, ContinuationError> {
     let rod = designed_rod(problem, scene, design, points).map_err(|e| not_built(&e))?;
-    continue_to_design(problem, rod, Parameter::ControlScale, stop)
+    continue_to_design(problem, &rod, Parameter::ControlScale, stop)
 }
 
 /// The loading path ([`super::loading_path`]) of a design in a scene: κ⁰
@@ -73,7 +73,7 @@ pub fn loading_path_until(
     stop: &dyn Fn() -> bool,
 ) -> Result<Diagram, ContinuationError> {
     let rod = designed_rod(problem, scene, design, points).map_err(|e| not_built(&e))?;
-    continue_to_design(problem, rod, Parameter::LoadScale, stop)
+    continue_to_design(problem, &rod, Parameter::LoadScale, stop)
 }
 
 /// The shape-holding control: the loads raised from 0 to the design's
@@ -118,14 +118,19 @@ pub fn shape_holding_path_until(
     )
     .map_err(|e| not_built(&e))?;
     let base = target.clone().with_energy(Arc::new(unloaded));
-    let family = Family::towards(
-        base,
-        target.energy().clone(),
-        ModelLevel::Planar,
-        32,
-        crate::numerics::integrator::Tolerances::default(),
-    );
-    continue_family(problem, &family, stop)
+    continue_refining(
+        problem,
+        |segments| {
+            Family::towards(
+                base.clone(),
+                target.energy().clone(),
+                ModelLevel::Planar,
+                segments,
+                crate::numerics::integrator::Tolerances::default(),
+            )
+        },
+        stop,
+    )
 }
 
 /// A designed rod that cannot be built: continuation cannot start.

@@ -198,18 +198,56 @@ pub fn designed_rod(
 /// that λ = 1 is its γ_crit.
 pub(crate) fn continue_to_design(
     problem: &ArmProblem,
-    rod: Rod,
+    rod: &Rod,
     parameter: crate::continuation::Parameter,
     stop: &dyn Fn() -> bool,
 ) -> Result<crate::continuation::Diagram, crate::continuation::ContinuationError> {
-    let family = crate::continuation::Family::new(
-        rod,
-        parameter,
-        crate::model::ModelLevel::Planar,
-        32,
-        crate::numerics::integrator::Tolerances::default(),
-    );
-    continue_family(problem, &family, stop)
+    continue_refining(
+        problem,
+        |segments| {
+            crate::continuation::Family::new(
+                rod.clone(),
+                parameter,
+                crate::model::ModelLevel::Planar,
+                segments,
+                crate::numerics::integrator::Tolerances::default(),
+            )
+        },
+        stop,
+    )
+}
+
+/// The shooting segments of a design's path, tried in turn while its
+/// branch stops short because the corrector cannot converge.
+pub const PATH_SEGMENTS: [usize; 3] = [32, 64, 128];
+
+/// [`continue_family`] on the family `on(segments)` for each of
+/// [`PATH_SEGMENTS`] while the branch ends with its step below the
+/// smallest (`BranchEnd::StepTooSmall`: no fold, no loss of stability —
+/// the corrector has met its residual's noise floor, which on 32 segments
+/// lies above its tolerance for a strongly coiled arm: the Sec. 4.4
+/// optimum's loading path stopped at λ = 0.974). The first diagram that
+/// ends otherwise is returned; if every one stops short, the last (whose
+/// branch says so).
+fn continue_refining(
+    problem: &ArmProblem,
+    on: impl Fn(usize) -> crate::continuation::Family,
+    stop: &dyn Fn() -> bool,
+) -> Result<crate::continuation::Diagram, crate::continuation::ContinuationError> {
+    use crate::continuation::BranchEnd;
+    let mut last = None;
+    for segments in PATH_SEGMENTS {
+        let d = continue_family(problem, &on(segments), stop)?;
+        let short = d
+            .branches
+            .first()
+            .is_some_and(|b| matches!(b.stop_reason, BranchEnd::StepTooSmall(_)));
+        if !short || stop() {
+            return Ok(d);
+        }
+        last = Some(d);
+    }
+    Ok(last.expect("at least one segment count"))
 }
 
 /// Continues `family` from p = 10⁻³ to 1 with the design's own mesh,

@@ -40,6 +40,7 @@ use nalgebra::{Matrix3, Rotation3, Unit, Vector3};
 use super::design::derivative;
 use super::polish::{box_simplex, polish_in_box};
 use super::resolve::{MeshStudy, Resolution, Verdict, REACH_TOLERANCE};
+use super::PATH_SEGMENTS;
 use super::{continue_family, sampling, ArmProblem, ArmScene, SearchOptions};
 use crate::continuation::{ContinuationError, Diagram, Family, Parameter, RunState};
 use crate::model::{Clamp, Frame, LinearElastic, ModelLevel, Profile, Rod};
@@ -579,10 +580,6 @@ impl SpatialArm {
         self.planar.stability.elements().max(needed)
     }
 }
-
-/// The shooting segments of the loading path, tried in turn while the path
-/// ends undecided (see [`SpatialArm::loading_path`]).
-pub const PATH_SEGMENTS: [usize; 3] = [32, 64, 128];
 
 fn path_error(e: &ContinuationError) -> String {
     format!("continuation failed: {e}")

@@ -423,7 +423,7 @@ impl TaperedArm {
         // right side) does not control. The verdict stays undecided (said
         // so) until the equations are integrated with stops at the
         // section's knots or the section is smooth.
-        let diagram = continue_to_design(&self.arm, rod, Parameter::LoadScale, stop)?;
+        let diagram = continue_to_design(&self.arm, &rod, Parameter::LoadScale, stop)?;
         let verdict = loading_verdict(&diagram, optimum);
         Ok((diagram, verdict))
     }
