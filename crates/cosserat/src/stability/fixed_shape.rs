@@ -179,6 +179,22 @@ pub fn critical_load(
 /// independent of the load), forces only, a clamped free-tipped Kirchhoff
 /// cantilever with its loads in the plane of the shape.
 pub(super) fn check_scene(rod: &Rod) -> Result<(), StabilityError> {
+    check_cantilever(rod)?;
+    let normal = rod.clamp().director(1);
+    let off_plane =
+        rod.loads().tip_force.dot(&normal).abs() + rod.loads().distributed_force.dot(&normal).abs();
+    if off_plane > 0.0 {
+        return Err(StabilityError::FixedShape(
+            "the loads must lie in the plane of d1(0), d3(0)".into(),
+        ));
+    }
+    Ok(())
+}
+
+/// The scene checks a planar and a spatial fixed shape share: the linear
+/// energy (H independent of the load), forces only, a clamped
+/// free-tipped Kirchhoff cantilever (no shear or extension).
+pub(super) fn check_cantilever(rod: &Rod) -> Result<(), StabilityError> {
     if !rod.energy().is_quadratic() {
         return Err(StabilityError::FixedShape(format!(
             "the {} energy's Hessian depends on the load through κ − κ⁰, so K(λ) is not linear in λ; \
@@ -191,19 +207,13 @@ pub(super) fn check_scene(rod: &Rod) -> Result<(), StabilityError> {
             "a fixed-shape scene takes forces only".into(),
         ));
     }
-    if rod.clamp().hinge || rod.support().is_some() || rod.energy().strain_energy().is_some() {
+    let strained =
+        rod.energy().strain_energy().is_some() || rod.energy().shear_stiffness(0.0).is_some();
+    if rod.clamp().hinge || rod.support().is_some() || strained {
         return Err(StabilityError::FixedShape(
             "a fixed shape is a clamped, free-tipped Kirchhoff cantilever (paper Sec. 3); \
              remove clamp.hinge, [support] and energy.shear"
                 .into(),
-        ));
-    }
-    let normal = rod.clamp().director(1);
-    let off_plane =
-        rod.loads().tip_force.dot(&normal).abs() + rod.loads().distributed_force.dot(&normal).abs();
-    if off_plane > 0.0 {
-        return Err(StabilityError::FixedShape(
-            "the loads must lie in the plane of d1(0), d3(0)".into(),
         ));
     }
     Ok(())

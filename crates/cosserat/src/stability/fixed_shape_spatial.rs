@@ -157,32 +157,6 @@ impl SpatialShape {
     }
 }
 
-/// The scene checks of a fixed shape (as for the planar one): the linear
-/// energy, forces only, a clamped free-tipped Kirchhoff rod. The loads may
-/// point anywhere.
-fn check_scene(rod: &Rod) -> Result<(), StabilityError> {
-    if !rod.energy().is_quadratic() {
-        return Err(StabilityError::FixedShape(format!(
-            "the {} energy's Hessian depends on the load through κ − κ⁰, so K(λ) is not linear in λ; \
-             use the linear energy",
-            rod.energy().name()
-        )));
-    }
-    if rod.loads().tip_couple.norm() > 0.0 {
-        return Err(StabilityError::NonConservative(
-            "a fixed-shape scene takes forces only".into(),
-        ));
-    }
-    if rod.clamp().hinge || rod.support().is_some() || rod.energy().shear_stiffness(0.0).is_some() {
-        return Err(StabilityError::FixedShape(
-            "a fixed shape is a clamped, free-tipped Kirchhoff cantilever (paper Sec. 3); \
-             remove clamp.hinge, [support] and energy.shear"
-                .into(),
-        ));
-    }
-    Ok(())
-}
-
 /// The critical load of the spatial `shape` under `rod.loads` scaled by λ:
 /// the smallest positive λ with K0 + λK1 singular on the single 3-D block
 /// ([`Block::Full`]). `gamma` is λ|P|L²/B2(0) (λ|f|L³/B2(0) with a
@@ -192,7 +166,7 @@ pub fn critical_load_spatial(
     shape: &SpatialShape,
     opts: &StabilityOptions,
 ) -> Result<CriticalLoad, StabilityError> {
-    check_scene(rod)?;
+    super::fixed_shape::check_cantilever(rod)?;
     let fe = FiniteElements::new(rod.length(), opts.elements(), opts.order());
     let samples = shape.samples(rod, &fe.quadrature_points())?;
     let (c0, c1) = split_coefficients(rod, &samples);

@@ -108,6 +108,36 @@ impl KeyLens {
         (norm.is_finite() && norm > 0.0).then(|| axis / norm)
     }
 
+    /// The rod at p by `build`, or the last one built if p is the same
+    /// number (the residual and the Jacobian's columns at one p read the
+    /// problem once); a non-finite p or a refused build named by the key.
+    fn cached(
+        &self,
+        p: f64,
+        build: impl FnOnce(f64) -> Result<Rod, ProblemError>,
+    ) -> Result<Rod, FamilyError> {
+        let refused = |reason: String| FamilyError::Refused {
+            parameter: self.key.clone(),
+            value: p,
+            reason,
+        };
+        if !p.is_finite() {
+            return Err(refused("not a finite number".into()));
+        }
+        let mut last = self
+            .last
+            .lock()
+            .unwrap_or_else(std::sync::PoisonError::into_inner);
+        if let Some((bits, rod)) = last.as_ref() {
+            if *bits == p.to_bits() {
+                return Ok(rod.clone());
+            }
+        }
+        let rod = build(p).map_err(|e| refused(e.to_string()))?;
+        *last = Some((p.to_bits(), rod.clone()));
+        Ok(rod)
+    }
+
     fn build(&self, p: f64) -> Result<Rod, ProblemError> {
         let mut doc = self.doc.clone();
         overrides::set_key(&mut doc, &self.key, toml::Value::Float(p))
@@ -181,26 +211,7 @@ impl Lens for KeyLens {
     }
 
     fn rod_at(&self, p: f64) -> Result<Rod, FamilyError> {
-        let refused = |reason: String| FamilyError::Refused {
-            parameter: self.key.clone(),
-            value: p,
-            reason,
-        };
-        if !p.is_finite() {
-            return Err(refused("not a finite number".into()));
-        }
-        let mut last = self
-            .last
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner);
-        if let Some((bits, rod)) = last.as_ref() {
-            if *bits == p.to_bits() {
-                return Ok(rod.clone());
-            }
-        }
-        let rod = self.build(p).map_err(|e| refused(e.to_string()))?;
-        *last = Some((p.to_bits(), rod.clone()));
-        Ok(rod)
+        self.cached(p, |p| self.build(p))
     }
 }
 
@@ -366,26 +377,6 @@ impl Lens for LinkedLens {
     }
 
     fn rod_at(&self, p: f64) -> Result<Rod, FamilyError> {
-        let refused = |reason: String| FamilyError::Refused {
-            parameter: self.first.key.clone(),
-            value: p,
-            reason,
-        };
-        if !p.is_finite() {
-            return Err(refused("not a finite number".into()));
-        }
-        let mut last = self
-            .first
-            .last
-            .lock()
-            .unwrap_or_else(std::sync::PoisonError::into_inner);
-        if let Some((bits, rod)) = last.as_ref() {
-            if *bits == p.to_bits() {
-                return Ok(rod.clone());
-            }
-        }
-        let rod = self.build(p).map_err(|e| refused(e.to_string()))?;
-        *last = Some((p.to_bits(), rod.clone()));
-        Ok(rod)
+        self.first.cached(p, |p| self.build(p))
     }
 }
