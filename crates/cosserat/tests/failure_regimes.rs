@@ -125,7 +125,9 @@ fn long_rod_single_shooting_fails_others_recover() {
     // be the loading branch (the looped equilibrium lies 1e-2 away), to the
     // accuracy single shooting's conditioning allows: its sensitivities
     // grow like e^{L√(F/B)} = e^16 ≈ 9·10⁶, so integrator rtol 1e-12 bounds
-    // the tip error near 10⁻⁵ (measured 9.0e-9; the other methods 1e-9).
+    // the tip error by about 10⁻⁵ — the bound asserted, three decades below
+    // the looped equilibrium's 1e-2, so it still tells the branches apart
+    // (measured 9.0e-9 on this machine; the other methods 1e-9).
     match run(&rod, Method::Shooting, Strategy::Auto) {
         Ok(eq) => {
             let err = cantilever_error(&eq, length, force);
@@ -133,7 +135,7 @@ fn long_rod_single_shooting_fails_others_recover() {
                 "ramped single shooting: relative tip error {err:.2e}, {} steps",
                 eq.load_steps
             );
-            assert!(err <= 1e-8, "{err:e}");
+            assert!(err <= 1e-5, "{err:e}");
         }
         Err(e) => {
             assert_clear_failure(Err(e), "shooting");
