@@ -15,6 +15,8 @@
 //! difference (h = 1e-4) carries ~1e-8 truncation error and would not
 //! pass.
 
+mod support;
+
 use std::sync::Arc;
 
 use cosserat::continuation::{DerivativeMethod, Family, Parameter};
@@ -23,6 +25,7 @@ use cosserat::model::{
 };
 use cosserat::numerics::integrator::Tolerances;
 use nalgebra::{DVector, Vector3};
+use support::parameter_derivative::richardson_parameter_derivative;
 
 const TIGHT: Tolerances = Tolerances {
     rtol: 1e-13,
@@ -104,21 +107,6 @@ fn value(rod: &Rod, parameter: Parameter) -> f64 {
     }
 }
 
-/// Richardson-extrapolated central differences of F in p (h, h/2, h/4).
-fn reference(family: &Family, x: &[f64], p: f64, h: f64) -> DVector<f64> {
-    let n = x.len();
-    let central = |h: f64| {
-        let (mut up, mut down) = (DVector::zeros(n), DVector::zeros(n));
-        family.residual_only(x, p + h, &mut up).unwrap();
-        family.residual_only(x, p - h, &mut down).unwrap();
-        (up - down) / (2.0 * h)
-    };
-    let d = [central(h), central(h / 2.0), central(h / 4.0)];
-    let r1 = (&d[1] * 4.0 - &d[0]) / 3.0;
-    let r2 = (&d[2] * 4.0 - &d[1]) / 3.0;
-    (r2 * 16.0 - r1) / 15.0
-}
-
 /// Unknowns off the solution: the straight-rod guess integrated on the
 /// rod at a nearby value p + δ, so that every matching residual and the
 /// tip residuals, and hence their units' rates, enter F_p at p. The
@@ -156,7 +144,7 @@ fn check(rod: &Rod, level: ModelLevel, parameters: &[Parameter]) {
             );
             let x = unknowns(&family, p);
             let exact = family.parameter_derivative(&x, p).unwrap();
-            let fd = reference(&family, &x, p, h);
+            let fd = richardson_parameter_derivative(&family, &x, p, h);
             let err = (&exact - &fd).amax();
             // F_p carried by the integration of F and F_x at (x, p).
             let n = x.len();
@@ -275,7 +263,7 @@ fn the_central_difference_misses_the_reference() {
     let family = Family::collocation(rod, Parameter::Length, ModelLevel::Kirchhoff, 12, 3, TIGHT);
     let p = 1.2;
     let x = unknowns(&family, p);
-    let fd = reference(&family, &x, p, 1e-2 * p);
+    let fd = richardson_parameter_derivative(&family, &x, p, 1e-2 * p);
     let exact = (&family.parameter_derivative(&x, p).unwrap() - &fd).amax();
     let central = (&family.central_difference(&x, p).unwrap() - &fd).amax();
     assert!(central > 1e-10 * fd.amax(), "{central:e}");
@@ -323,7 +311,7 @@ fn file_keys_are_exact_where_the_tangent_covers_them() {
             *v += 0.3 * (1.0 + i as f64).sin();
         }
         let exact = family.parameter_derivative(&x, p).unwrap();
-        let fd = reference(&family, &x, p, 1e-2 * p.abs().max(1.0));
+        let fd = richardson_parameter_derivative(&family, &x, p, 1e-2 * p.abs().max(1.0));
         let err = (&exact - &fd).amax();
         assert!(
             err <= 1e-10 * fd.amax(),

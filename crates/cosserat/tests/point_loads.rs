@@ -7,14 +7,15 @@ mod support;
 
 use cosserat::bvp::{solve, Equilibrium, Method, SolverOptions};
 use cosserat::continuation::{
-    continuation, DerivativeMethod, Diagram, Family, Location, SpecialKind, SpecialPoint,
+    continuation, DerivativeMethod, Diagram, Location, SpecialKind, SpecialPoint,
 };
 use cosserat::input::{Problem, ProblemError};
 use cosserat::model::{DeadLoads, ModelChoice, ModelLevel, PointForce, Rod};
 use cosserat::references::CantileverTip;
 use cosserat::references::{arch_elastica_folds, strip_elastica_fold};
 use cosserat::stability::StabilityOptions;
-use nalgebra::{DVector, Vector3};
+use nalgebra::Vector3;
+use support::parameter_derivative::richardson_parameter_derivative;
 
 /// Every method; 8 segments and the default collocation mesh put no node at
 /// s₀ = 0.61 of their own.
@@ -202,22 +203,6 @@ fn full_strip_turned_by_a_linked_parameter_folds_as_the_half_model() {
     assert!(-points[lost].parameter < alpha);
 }
 
-/// Richardson-extrapolated central differences of F in p (h, h/2, h/4):
-/// the independent reference of F_p.
-fn central_reference(family: &Family, x: &[f64], p: f64, h: f64) -> DVector<f64> {
-    let n = x.len();
-    let central = |h: f64| {
-        let (mut up, mut down) = (DVector::zeros(n), DVector::zeros(n));
-        family.residual_only(x, p + h, &mut up).unwrap();
-        family.residual_only(x, p - h, &mut down).unwrap();
-        (up - down) / (2.0 * h)
-    };
-    let d = [central(h), central(h / 2.0), central(h / 4.0)];
-    let r1 = (&d[1] * 4.0 - &d[0]) / 3.0;
-    let r2 = (&d[2] * 4.0 - &d[1]) / 3.0;
-    (r2 * 16.0 - r1) / 15.0
-}
-
 /// A point force's component and a linked parameter are differentiated
 /// exactly (the sensitivity equations carried across the jump; the sum of
 /// the linked keys' partials), against extrapolated central differences
@@ -253,7 +238,7 @@ fn point_force_and_linked_parameters_have_exact_derivatives() {
                 *v += 0.1 * (1.0 + i as f64).sin();
             }
             let exact = family.parameter_derivative(&x, p).unwrap();
-            let fd = central_reference(&family, &x, p, 1e-2);
+            let fd = richardson_parameter_derivative(&family, &x, p, 1e-2);
             let err = (&exact - &fd).amax();
             assert!(
                 err <= 1e-9 * fd.amax(),

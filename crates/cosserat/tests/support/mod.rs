@@ -6,5 +6,6 @@
 pub mod columns;
 pub mod fuzz;
 pub mod methods;
+pub mod parameter_derivative;
 pub mod quadrature;
 pub mod rods;
