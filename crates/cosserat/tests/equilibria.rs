@@ -6,33 +6,15 @@ mod support;
 use std::f64::consts::TAU;
 use std::sync::Arc;
 
-use cosserat::bvp::{solve, Equilibrium, Method, SolverOptions, Strategy};
+use cosserat::bvp::{solve, Method, SolverOptions, Strategy};
 use cosserat::model::{
     Clamp, DeadLoads, LinearElastic, ModelChoice, ModelLevel, QuarticStiffening, Rod,
 };
 use cosserat::references::CantileverTip;
 use nalgebra::{Matrix3, Vector3};
+use support::methods::{solve_with, EVERY_METHOD, UNSHEARABLE_LEVELS};
 use support::quadrature::simpson;
 use support::rods::cantilever;
-
-fn solve_with(rod: &Rod, level: ModelLevel, method: Method) -> Equilibrium {
-    let choice = ModelChoice::forced(rod, level).unwrap();
-    let opts = SolverOptions {
-        method,
-        ..Default::default()
-    };
-    solve(rod, &choice, &opts).unwrap_or_else(|e| panic!("{level:?} {method:?}: {e}"))
-}
-
-/// Every method: single and multiple shooting, and collocation of orders 4
-/// and 6 (adaptive, to its default tolerance 1e-10).
-const METHODS: [Method; 4] = [
-    Method::Shooting,
-    Method::MultipleShooting { segments: 8 },
-    Method::Collocation { stages: 2 },
-    Method::Collocation { stages: 3 },
-];
-const LEVELS: [ModelLevel; 2] = [ModelLevel::Planar, ModelLevel::Kirchhoff];
 
 #[test]
 fn cantilever_tip_matches_elliptic_integrals() {
@@ -40,8 +22,8 @@ fn cantilever_tip_matches_elliptic_integrals() {
         let reference = CantileverTip::at(k);
         let rod = cantilever(k);
         assert_eq!(ModelChoice::for_rod(&rod).level, ModelLevel::Planar);
-        for level in LEVELS {
-            for method in METHODS {
+        for level in UNSHEARABLE_LEVELS {
+            for method in EVERY_METHOD {
                 let eq = solve_with(&rod, level, method);
                 let tip = eq.tip();
                 let d3 = tip.directors[2];
@@ -90,8 +72,8 @@ fn end_couple_rolls_the_rod_into_a_circle() {
     let mut loads = rod.loads().clone();
     loads.tip_couple = Vector3::new(0.0, TAU * b2 / rod.length(), 0.0);
     let rod = rod.with_loads(loads).unwrap();
-    for level in LEVELS {
-        for method in METHODS {
+    for level in UNSHEARABLE_LEVELS {
+        for method in EVERY_METHOD {
             let eq = solve_with(&rod, level, method);
             let tip = eq.tip();
             assert!(
@@ -135,7 +117,7 @@ fn unloaded_rod_with_constant_intrinsic_curvature_is_a_helix() {
     .unwrap();
     let choice = ModelChoice::for_rod(&rod);
     assert_eq!(choice.level, ModelLevel::Kirchhoff, "{}", choice.reason);
-    for method in METHODS {
+    for method in EVERY_METHOD {
         let eq = solve_with(&rod, ModelLevel::Kirchhoff, method);
         for p in &eq.samples {
             let exact = helix_position(kappa0, p.s);
@@ -185,7 +167,7 @@ fn single_and_multiple_shooting_agree() {
         )
         .unwrap();
         let single = solve_with(&rod, ModelLevel::Kirchhoff, Method::Shooting);
-        let multi = solve_with(&rod, ModelLevel::Kirchhoff, METHODS[1]);
+        let multi = solve_with(&rod, ModelLevel::Kirchhoff, EVERY_METHOD[1]);
         for (a, b) in single.samples.iter().zip(&multi.samples) {
             assert!((a.position - b.position).norm() <= 1e-9, "s = {}", a.s);
         }
@@ -198,7 +180,7 @@ fn single_and_multiple_shooting_agree() {
 fn large_load_follows_the_loading_branch() {
     let k = 30.0;
     let reference = CantileverTip::at(k);
-    for method in METHODS {
+    for method in EVERY_METHOD {
         let eq = solve_with(&cantilever(k), ModelLevel::Planar, method);
         assert!(eq.load_steps > 0, "{method:?} should ramp at k = {k}");
         let tip = eq.tip().position;
@@ -234,7 +216,7 @@ fn single_shooting_fails_clearly_where_multiple_shooting_recovers() {
     assert!(message.contains("shooting"), "{message}");
     assert!(message.contains("did not converge"), "{message}");
     let reference = CantileverTip::at(k);
-    for method in [Method::Shooting, METHODS[1]] {
+    for method in [Method::Shooting, EVERY_METHOD[1]] {
         let eq = solve_with(&rod, ModelLevel::Planar, method);
         let tip = eq.tip().position;
         assert!(eq.load_steps > 0, "{method:?}");
@@ -363,7 +345,7 @@ fn tabulated_intrinsic_curvature_gives_its_intrinsic_shape() {
     };
     let x = simpson(|s| phi(s).sin(), 0.0, 0.4) + simpson(|s| phi(s).sin(), 0.4, 1.0);
     let z = simpson(|s| phi(s).cos(), 0.0, 0.4) + simpson(|s| phi(s).cos(), 0.4, 1.0);
-    for level in LEVELS {
+    for level in UNSHEARABLE_LEVELS {
         let eq = solve_with(&rod, level, Method::Shooting);
         let tip = eq.tip().position;
         assert!(

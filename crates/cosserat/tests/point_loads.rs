@@ -5,7 +5,7 @@
 //! an exact check that every method stops at the jump of n(s).
 mod support;
 
-use cosserat::bvp::{solve, Equilibrium, Method, SolverOptions};
+use cosserat::bvp::Method;
 use cosserat::continuation::{
     continuation, DerivativeMethod, Diagram, Location, SpecialKind, SpecialPoint,
 };
@@ -15,17 +15,8 @@ use cosserat::references::CantileverTip;
 use cosserat::references::{arch_elastica_folds, strip_elastica_fold};
 use cosserat::stability::StabilityOptions;
 use nalgebra::Vector3;
+use support::methods::{options, solve_with, EVERY_METHOD, UNSHEARABLE_LEVELS};
 use support::parameter_derivative::richardson_parameter_derivative;
-
-/// Every method; 8 segments and the default collocation mesh put no node at
-/// s₀ = 0.61 of their own.
-const METHODS: [Method; 4] = [
-    Method::Shooting,
-    Method::MultipleShooting { segments: 8 },
-    Method::Collocation { stages: 2 },
-    Method::Collocation { stages: 3 },
-];
-const LEVELS: [ModelLevel; 2] = [ModelLevel::Planar, ModelLevel::Kirchhoff];
 
 /// L = 1, B = (10, 1, 10), the paper's clamp (d1(0) = e1 down), the force
 /// F e1 at s₀.
@@ -38,18 +29,6 @@ fn loaded_at(s0: f64, force: f64) -> Rod {
         ..Default::default()
     };
     support::rods::uniform(1.0, [10.0, 1.0, 10.0], loads)
-}
-
-fn options(method: Method) -> SolverOptions {
-    SolverOptions {
-        method,
-        ..Default::default()
-    }
-}
-
-fn solve_with(rod: &Rod, level: ModelLevel, method: Method) -> Equilibrium {
-    let choice = ModelChoice::forced(rod, level).unwrap();
-    solve(rod, &choice, &options(method)).unwrap_or_else(|e| panic!("{level:?} {method:?}: {e}"))
 }
 
 /// The angle of d3 from e3 towards e1.
@@ -68,8 +47,8 @@ fn a_cantilever_loaded_inside_is_bisshopp_drucker_up_to_the_load() {
         let tip = at_load + d3 * (1.0 - s0);
         let rod = loaded_at(s0, force);
         assert_eq!(ModelChoice::for_rod(&rod).level, ModelLevel::Planar);
-        for level in LEVELS {
-            for method in METHODS {
+        for level in UNSHEARABLE_LEVELS {
+            for method in EVERY_METHOD {
                 let eq = solve_with(&rod, level, method);
                 let samples = eq.resample(&rod, &options(method), &[s0, 1.0]).unwrap();
                 let (load, end) = (&samples[0], &samples[1]);
