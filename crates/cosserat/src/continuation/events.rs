@@ -1,8 +1,9 @@
 //! Folds and branch points between two points of a branch: detection,
 //! location by regula falsi (Illinois) in the arclength on a test function
-//! with a simple root — for a fold then refined by Newton on Govaerts'
-//! minimally augmented system (`fold.rs`) —, classification, and branch
-//! switching.
+//! with a simple root — for a fold or a simple branch point then refined by
+//! Newton on a minimally augmented system (`fold.rs`, `branch_point.rs`);
+//! for a mode the model does not see, extrapolated from three
+//! finite-element meshes —, classification, and branch switching.
 //!
 //! A fold is decided by the tangent's parameter component τ_p changing
 //! sign, always, whatever the eigenvalues do; a branch point by a change
@@ -21,14 +22,17 @@
 //! when dim ker F_x = m. An entry of G that changes sign has a simple
 //! root, where det F_x has a root of order m (a double root for the pair
 //! of an isotropic rod, which bisection on the determinant cannot see).
-//! A simple branch point (m = 1) is located on det F_x itself, whose root
-//! is then simple; modes the model's Jacobian does not see (out of the
-//! plane of a planar model) on the block's eigenvalue nearest zero.
+//! A simple branch point (m = 1) is bracketed on det F_x itself, whose
+//! root is then simple; modes the model's Jacobian does not see (out of the
+//! plane of a planar model) on the block's eigenvalue nearest zero, on
+//! three meshes ([`Run::extrapolated_crossing`]).
 
 use nalgebra::{DMatrix, DVector};
 
 use super::corrector::DENSE_UP_TO;
+use super::engine;
 use super::kernel::BandedJacobian;
+use super::Tracker;
 use super::{Location, Point, Run, SpecialKind, SpecialPoint};
 use crate::model::ModelLevel;
 use crate::numerics::scalar::{End, Illinois};
@@ -37,6 +41,9 @@ use crate::stability::Block;
 
 /// A test function along the step from a point: f(σ) and the point there.
 type Located = (f64, Vec<f64>, f64, Vec<f64>);
+
+/// A converged point of a location and its arclength σ from the start.
+type Anchor = (f64, Located);
 
 /// The function whose sign change locates an event.
 enum Test {
@@ -54,6 +61,9 @@ enum Test {
     /// The block's eigenvalue nearest zero (modes the model's Jacobian
     /// does not see; accurate to the finite-element mesh).
     Eigenvalue(Block),
+    /// The same on a finer mesh than the run's (the Richardson meshes of
+    /// [`Run::extrapolated_crossing`]).
+    EigenvalueOn(Block, Box<Tracker>),
 }
 
 /// An event to locate: its kind, block and multiplicity.
@@ -80,7 +90,10 @@ impl Run<'_> {
                 missed.extend(note);
                 located
             } else {
-                self.locate(a, b, sign, (branch, index), (kind, block, multiplicity))
+                let (located, notes) =
+                    self.locate(a, b, sign, (branch, index), (kind, block, multiplicity));
+                missed.extend(notes);
+                located
             };
             match located.len() {
                 0 => missed.push(format!(
@@ -170,9 +183,18 @@ impl Run<'_> {
         )
     }
 
-    /// The test function at arclength σ from `a`, and the point there.
-    fn test_at(&self, a: &Point, sign: f64, sigma: f64, test: &Test) -> Option<Located> {
-        let (x, p, tangent, _) = self.step(a, sign, sigma).ok()??;
+    /// The test function at arclength σ from `a`, and the point there,
+    /// corrected from the converged point `near` of the same location
+    /// when there is one (see [`Self::point_at`]).
+    fn test_at(
+        &self,
+        a: &Point,
+        sign: f64,
+        sigma: f64,
+        near: Option<&Anchor>,
+        test: &Test,
+    ) -> Option<Located> {
+        let (x, p, tangent) = self.point_at(a, sign, sigma, near)?;
         let n = x.len();
         let value = match test {
             Test::Fold => tangent[n],
@@ -184,8 +206,54 @@ impl Run<'_> {
                     .ok()?
                     .0
             }
+            Test::EigenvalueOn(block, tracker) => {
+                tracker.nearest_zero(self.family, &x, p, *block).ok()?.0
+            }
         };
         Some((value, x, p, tangent))
+    }
+
+    /// The point where the plane τ_aᵀ(z − z_a) = σ cuts the branch. From
+    /// `a` the predictor is z_a + σ τ_a; from a converged point `near` of
+    /// the same plane family (at σ_n, tangent τ_n) it is
+    /// z_n + (σ − σ_n)/(τ_aᵀτ_n) τ_n, which lies on the same plane. Near a
+    /// branch point the bordered matrix [F_x F_p; τ_aᵀ] is nearly singular
+    /// and Newton's basin shrinks with the distance to it: a predictor a
+    /// whole step long leaves it (the full bistable strip's and the full
+    /// arch's asymmetric branch points were bracketed but never located),
+    /// one from the nearer bracket end does not. None where the corrector
+    /// does not converge.
+    fn point_at(
+        &self,
+        a: &Point,
+        sign: f64,
+        sigma: f64,
+        near: Option<&Anchor>,
+    ) -> Option<(Vec<f64>, f64, Vec<f64>)> {
+        let travel = |t: &[f64]| -> Vec<f64> { t.iter().map(|v| v * sign).collect() };
+        let t_a = travel(&a.tangent);
+        let anchored = near
+            .filter(|_| !self.sliced)
+            .and_then(|(sigma_n, (_, x, p, t))| {
+                let t_n = travel(t);
+                let cosine: f64 = t_a.iter().zip(&t_n).map(|(u, v)| u * v).sum();
+                (cosine > 0.5).then(|| {
+                    let along = (sigma - sigma_n) / cosine;
+                    x.iter()
+                        .chain([p])
+                        .zip(&t_n)
+                        .map(|(z, t)| z + along * t)
+                        .collect::<Vec<f64>>()
+                })
+            });
+        let Some(pred) = anchored else {
+            let (x, p, tangent, _) = self.step(a, sign, sigma).ok()??;
+            return Some((x, p, tangent));
+        };
+        let (z, _, fu) = self.correct(&pred, &t_a).ok()??;
+        let n = z.len() - 1;
+        let t = engine::tangent_from(self.family, &fu, &z[..n], z[n], &t_a).ok()?;
+        Some((z[..n].to_vec(), z[n], travel(&t)))
     }
 
     fn jacobian(&self, x: &[f64], p: f64) -> Option<DMatrix<f64>> {
@@ -357,7 +425,7 @@ impl Run<'_> {
         sign: f64,
         (branch, index): (usize, usize),
         (kind, block, multiplicity): Wanted,
-    ) -> Vec<SpecialPoint> {
+    ) -> (Vec<SpecialPoint>, Vec<String>) {
         let span = span_of(a, b, sign);
         let test = match kind {
             SpecialKind::Fold => Test::Fold,
@@ -368,23 +436,92 @@ impl Run<'_> {
                 .unwrap_or(Test::Eigenvalue(block)),
         };
         let Some((sigma, best)) = self.root(a, (sign, b.parameter), (0.0, span), &test) else {
-            return vec![];
+            if matches!(test, Test::Determinant) {
+                return self.unbracketed_branch_point(
+                    a,
+                    b,
+                    sign,
+                    (branch, index),
+                    (kind, block, 1),
+                );
+            }
+            return (vec![], vec![]);
         };
         if let Test::Bordered { right, left, .. } = &test {
             if !self.degenerate(a, b, &best, right, left) {
                 return self.separate(a, b, sign, (sigma, best), (branch, index), block);
             }
         }
-        self.special_point(
+        let wanted = (kind, block, multiplicity);
+        if let Test::Eigenvalue(block) = test {
+            let (point, note) = self.extrapolated_crossing(
+                a,
+                b,
+                sign,
+                (sigma, best),
+                (branch, index),
+                (wanted, block),
+            );
+            return (point.into_iter().collect(), note.into_iter().collect());
+        }
+        if matches!(test, Test::Determinant) {
+            let (point, note) =
+                self.refined_branch_point(a, b, sign, best, (branch, index), wanted);
+            return (point.into_iter().collect(), note.into_iter().collect());
+        }
+        let point = self.special_point(
             a,
             b,
             sign,
             best,
             (branch, index),
-            ((kind, block, multiplicity), Location::Bracketed),
-        )
-        .into_iter()
-        .collect()
+            (wanted, Location::Bracketed),
+        );
+        (point.into_iter().collect(), vec![])
+    }
+
+    /// The simple branch point bracketed at `best` on det F_x, refined by
+    /// Newton on the minimally augmented system (`branch_point.rs`). Where
+    /// Newton fails the bracketed root is kept, recorded as
+    /// [`Location::Bracketed`], with a note saying why; on a branch of
+    /// symmetric copies (`slice.rs`, F_x keeps the copies' null vector) it
+    /// is not tried.
+    fn refined_branch_point(
+        &self,
+        a: &Point,
+        b: &Point,
+        sign: f64,
+        best: Located,
+        (branch, index): (usize, usize),
+        wanted: Wanted,
+    ) -> (Option<SpecialPoint>, Option<String>) {
+        if self.sliced {
+            let point = self.special_point(
+                a,
+                b,
+                sign,
+                best,
+                (branch, index),
+                (wanted, Location::Bracketed),
+            );
+            return (point, None);
+        }
+        let radius = span_of(a, b, sign).abs().max(distance(a, b));
+        let (located, location, note) = match self.refine_branch_point(&best.1, best.2, radius) {
+            Ok((x, p, _)) => ((0.0, x, p, best.3), Location::Augmented, None),
+            Err(why) => {
+                let note = format!(
+                    "branch {branch}: the branch point between points {index} and {} is located \
+                     only as the bracketed root of det F_x, at parameter {:.12}: the minimally \
+                     augmented Newton failed: {why}",
+                    index + 1,
+                    best.2
+                );
+                (best, Location::Bracketed, Some(note))
+            }
+        };
+        let point = self.special_point(a, b, sign, located, (branch, index), (wanted, location));
+        (point, note)
     }
 
     /// Locates the fold between `a` and `b`: the root of τ_p bracketed by
@@ -443,6 +580,147 @@ impl Run<'_> {
         (point.into_iter().collect(), note)
     }
 
+    /// A simple branch point between `a` and `b` whose bracket could not
+    /// be narrowed (the corrector fails near it: a branch crossing
+    /// another close to the crossing, where Newton's basin on the
+    /// pseudo-arclength system shrinks): Newton on the minimally augmented
+    /// system, which is regular there, from each end (the nearer-singular
+    /// first), kept where it lands between them.
+    fn unbracketed_branch_point(
+        &self,
+        a: &Point,
+        b: &Point,
+        sign: f64,
+        (branch, index): (usize, usize),
+        wanted: Wanted,
+    ) -> (Vec<SpecialPoint>, Vec<String>) {
+        if self.sliced {
+            return (vec![], vec![]);
+        }
+        let radius = span_of(a, b, sign).abs().max(distance(a, b));
+        let singularity = |e: &Point| {
+            self.det(&e.unknowns, e.parameter)
+                .map_or(f64::INFINITY, f64::abs)
+        };
+        let mut ends = [a, b];
+        ends.sort_by(|x, y| singularity(x).total_cmp(&singularity(y)));
+        let (lo, hi) = (a.parameter.min(b.parameter), a.parameter.max(b.parameter));
+        for end in ends {
+            let Ok((x, p, _)) = self.refine_branch_point(&end.unknowns, end.parameter, radius)
+            else {
+                continue;
+            };
+            if !(lo..=hi).contains(&p) {
+                continue;
+            }
+            let located = (0.0, x, p, end.tangent.iter().map(|t| t * sign).collect());
+            let point = self.special_point(
+                a,
+                b,
+                sign,
+                located,
+                (branch, index),
+                (wanted, Location::Augmented),
+            );
+            return (point.into_iter().collect(), vec![]);
+        }
+        (vec![], vec![])
+    }
+
+    /// A crossing the model's BVP does not see, located on the block's
+    /// finite-element eigenvalue — whose crossing carries the elements'
+    /// error O(h^{2k}), k their order — on the run's mesh (σ₁, at
+    /// `first`) and on two and four times its elements (σ₂, σ₄), then
+    /// extrapolated: σ* = σ₄ + (σ₄ − σ₂)/(2^{2k} − 1), the point there by
+    /// the corrector. The parameter's error estimate is the difference of
+    /// the extrapolations from (σ₂, σ₄) and from (σ₁, σ₂) in p, a bound
+    /// of the first's error by the second's; where the measured order of
+    /// the three crossings is not 2k ± 1 (a crossing converged to the
+    /// event tolerance already, or not yet in the asymptotic range) the
+    /// finest crossing is kept with |p₄ − p₂| as its error; either error
+    /// adds the event tolerance each crossing is located to. With a note
+    /// where the finer meshes could not be used: the run's crossing is
+    /// then reported as located on its own mesh, error unknown.
+    fn extrapolated_crossing(
+        &self,
+        a: &Point,
+        b: &Point,
+        sign: f64,
+        first: (f64, Located),
+        (branch, index): (usize, usize),
+        (wanted, block): (Wanted, Block),
+    ) -> (Option<SpecialPoint>, Option<String>) {
+        let span = span_of(a, b, sign);
+        let finer: Option<Vec<(f64, Located)>> = [2, 4]
+            .into_iter()
+            .map(|factor| {
+                let tracker = Box::new(self.tracker.refined(factor)?);
+                let test = Test::EigenvalueOn(block, tracker);
+                self.root(a, (sign, b.parameter), (0.0, span), &test)
+            })
+            .collect();
+        let at = (branch, index);
+        let Some(finer) = finer else {
+            let note = format!(
+                "branch {branch}: the {} branch point between points {index} and {} is located \
+                 on the {}-element mesh only (the finer meshes of its extrapolation failed): \
+                 parameter {:.10}, error not estimated",
+                block.name(),
+                index + 1,
+                self.opts.stability.elements(),
+                first.1 .2
+            );
+            let point = self.special_point(a, b, sign, first.1, at, (wanted, Location::Bracketed));
+            return (point, Some(note));
+        };
+        let p1 = first.1 .2;
+        let (s2, p2) = (finer[0].0, finer[0].1 .2);
+        let (s4, p4) = (finer[1].0, finer[1].1 .2);
+        let q = 2.0 * self.tracker.order() as f64;
+        let r = 2f64.powf(q) - 1.0;
+        let measured = ((p1 - p2) / (p2 - p4)).abs().log2();
+        // Each crossing is itself located to the event tolerance.
+        let resolution = self.opts.event_tolerance * p4.abs().max(1.0);
+        let (sigma, error) = if (measured - q).abs() <= 1.0 {
+            let fine = p4 + (p4 - p2) / r;
+            let coarse = p2 + (p2 - p1) / r;
+            (s4 + (s4 - s2) / r, (fine - coarse).abs() + resolution)
+        } else {
+            (s4, (p4 - p2).abs() + resolution)
+        };
+        let near = &finer[1];
+        let Some((x, p, tangent)) = self.point_at(a, sign, sigma, Some(near)) else {
+            let point = self
+                .special_point(
+                    a,
+                    b,
+                    sign,
+                    finer[1].1.clone(),
+                    at,
+                    (wanted, Location::Extrapolated),
+                )
+                .map(|mut sp| {
+                    sp.parameter_error = Some((p4 - p2).abs() + resolution);
+                    sp
+                });
+            return (point, None);
+        };
+        let point = self
+            .special_point(
+                a,
+                b,
+                sign,
+                (0.0, x, p, tangent),
+                at,
+                (wanted, Location::Extrapolated),
+            )
+            .map(|mut sp| {
+                sp.parameter_error = Some(error);
+                sp
+            });
+        (point, None)
+    }
+
     /// Whether the whole of G vanishes at the located point (relative to
     /// its change over the step): the kernel of F_x there has the full
     /// dimension m, not one crossing of several at distinct parameters.
@@ -476,7 +754,7 @@ impl Run<'_> {
         (sigma, best): (f64, Located),
         at: (usize, usize),
         block: Block,
-    ) -> Vec<SpecialPoint> {
+    ) -> (Vec<SpecialPoint>, Vec<String>) {
         let bi = self.tracker.blocks().iter().position(|&x| x == block);
         let morse = |x: &[f64], p: f64| -> Option<usize> {
             let s = self.tracker.evaluate(self.family, x, p).ok()?;
@@ -487,10 +765,10 @@ impl Run<'_> {
             morse(&best.1, best.2),
             morse(&b.unknowns, b.parameter),
         ) else {
-            return vec![];
+            return (vec![], vec![]);
         };
         let span = (sigma, span_of(a, b, sign));
-        let mut found = vec![];
+        let (mut found, mut notes) = (vec![], vec![]);
         for (range, jump) in [((0.0, span.0), lo.abs_diff(mid)), (span, mid.abs_diff(hi))] {
             if jump != 1 {
                 continue;
@@ -500,13 +778,18 @@ impl Run<'_> {
                 continue;
             };
             let wanted = (SpecialKind::BranchPoint, block, 1);
-            found.extend(self.special_point(a, b, sign, root, at, (wanted, Location::Bracketed)));
+            let (point, note) = self.refined_branch_point(a, b, sign, root, at, wanted);
+            found.extend(point);
+            notes.extend(note);
         }
-        found
+        (found, notes)
     }
 
     /// The root σ of the test function on σ ∈ (lo, hi) by Illinois, to
-    /// the event tolerance on the parameter, and the point there.
+    /// the event tolerance on the parameter, and the point there. Each
+    /// iterate is corrected from the converged bracket end nearer to it
+    /// ([`Self::point_at`]), so the predictor stays short as the bracket
+    /// closes on the root; where that corrector fails, from `a`.
     fn root(
         &self,
         a: &Point,
@@ -515,28 +798,43 @@ impl Run<'_> {
         test: &Test,
     ) -> Option<(f64, Located)> {
         let span = hi - lo;
-        let f_lo = self.test_at(a, sign, lo + 1e-12 * span, test)?.0;
-        let f_hi = self.test_at(a, sign, hi, test)?.0;
-        let mut bracket = Illinois::new(lo, hi, f_lo, f_hi)?;
-        let mut sigma = 0.5 * (lo + hi);
-        let mut best = self.test_at(a, sign, sigma, test)?;
+        let start = lo + 1e-12 * span;
+        let lower = self.test_at(a, sign, start, None, test)?;
+        let upper = self.test_at(a, sign, hi, None, test)?;
+        let mut bracket = Illinois::new(lo, hi, lower.0, upper.0)?;
         let (mut p_lo, mut p_hi) = (a.parameter, p_b);
+        let mut ends: [Anchor; 2] = [(start, lower), (hi, upper)];
+        let mut sigma = 0.5 * (lo + hi);
+        let mut best = None;
         for _ in 0..80 {
             sigma = bracket.next_point();
-            best = self.test_at(a, sign, sigma, test)?;
-            match bracket.update(sigma, best.0) {
-                End::Lower => p_lo = best.2,
-                End::Upper => p_hi = best.2,
-            }
-            let tol = self.opts.event_tolerance * best.2.abs().max(1.0);
-            if (p_hi - p_lo).abs() <= tol && bracket.width() <= 1e3 * tol
-                || best.0 == 0.0
-                || bracket.width() <= 1e-15 * span
-            {
+            let near = ends
+                .iter()
+                .min_by(|x, y| (x.0 - sigma).abs().total_cmp(&(y.0 - sigma).abs()));
+            let here = self
+                .test_at(a, sign, sigma, near, test)
+                .or_else(|| self.test_at(a, sign, sigma, None, test))?;
+            let end = match bracket.update(sigma, here.0) {
+                End::Lower => {
+                    p_lo = here.2;
+                    0
+                }
+                End::Upper => {
+                    p_hi = here.2;
+                    1
+                }
+            };
+            ends[end] = (sigma, here.clone());
+            let tol = self.opts.event_tolerance * here.2.abs().max(1.0);
+            let done = (p_hi - p_lo).abs() <= tol && bracket.width() <= 1e3 * tol
+                || here.0 == 0.0
+                || bracket.width() <= 1e-15 * span;
+            best = Some(here);
+            if done {
                 break;
             }
         }
-        Some((sigma, best))
+        Some((sigma, best?))
     }
 
     /// The special point at the located `best`: its spectrum, null mode
@@ -576,6 +874,7 @@ impl Run<'_> {
             singularity: ((det_here / det_scale).abs(), eigenvalue),
             multiplicity,
             location,
+            parameter_error: None,
         })
     }
 

@@ -72,7 +72,7 @@ pub(super) fn bordered(
 /// need only complement the kernel and the range, and at a bracketed fold
 /// F_x's smallest singular value is far below the next, so one step
 /// already isolates the null vectors.
-fn null_vectors(fx: &DMatrix<f64>) -> Option<(DVector<f64>, DVector<f64>)> {
+pub(super) fn null_vectors(fx: &DMatrix<f64>) -> Option<(DVector<f64>, DVector<f64>)> {
     let n = fx.nrows();
     let start = DVector::from_fn(n, |i, _| 1.0 + (0.618_033_988_75 * i as f64).fract());
     let (lu, lu_t) = (fx.clone().lu(), fx.transpose().lu());

@@ -106,6 +106,30 @@ impl Tracker {
         }
     }
 
+    /// The same tracker on `factor` times the elements (same order and
+    /// eigenvalue count; no remembered vectors, a fresh mass cache): the
+    /// finer meshes of a crossing located by Richardson extrapolation.
+    /// None where the finer mesh is refused.
+    pub fn refined(&self, factor: usize) -> Option<Tracker> {
+        let opts = self
+            .opts
+            .with_elements(self.opts.elements() * factor)
+            .ok()?;
+        Some(Tracker {
+            opts,
+            previous: None,
+            previous_values: None,
+            masses: RefCell::new(None),
+            ..self.clone()
+        })
+    }
+
+    /// The Lagrange order of the elements: the eigenvalues converge at
+    /// order 2·order in the element size.
+    pub fn order(&self) -> usize {
+        self.opts.order()
+    }
+
     /// The blocks, in the order of the eigenvalue columns.
     pub fn blocks(&self) -> &[Block] {
         &self.blocks
