@@ -218,10 +218,11 @@ impl Tracker {
             .iter()
             .zip(masses)
             .map(|(&b, g)| {
-                let constraints = support_constraints(&rod, &fe, b, &samples, tip);
-                (fe.stiffness(&c, b), g, constraints)
+                let constraints = support_constraints(&rod, &fe, b, &samples, tip)
+                    .map_err(|e| PointError::Eigen(e.to_string()))?;
+                Ok((fe.stiffness(&c, b), g, constraints))
             })
-            .collect();
+            .collect::<Result<_, PointError>>()?;
         Ok((fe, mats, norm, shape))
     }
 
@@ -381,7 +382,7 @@ impl Tracker {
             .previous
             .as_ref()
             .and_then(|prev| prev.get(bi))
-            .filter(|_| constraints.count() == 0)
+            .filter(|_| constraints.is_empty())
             .and_then(|start| lowest_eigenpairs_from(k, g, count, start));
         match warm {
             Some(pairs) => Ok(pairs),
