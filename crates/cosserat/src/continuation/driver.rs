@@ -213,7 +213,7 @@ impl<'a> Run<'a> {
             .map_err(|e| start_err(e.to_string()))?;
         let mut forward = vec![0.0; x.len()];
         forward.push(1.0);
-        let tangent = self.tangent(&x, p, &forward)?;
+        let tangent = self.start_tangent(&x, p, &forward)?;
         self.tracker.reset();
         self.point(x, p, tangent)
     }
