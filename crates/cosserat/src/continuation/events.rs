@@ -45,6 +45,14 @@ type Located = (f64, Vec<f64>, f64, Vec<f64>);
 /// A converged point of a location and its arclength σ from the start.
 type Anchor = (f64, Located);
 
+/// A root of a test function along a step: its arclength σ, the point
+/// there, and the width of the parameter bracket it ended with.
+struct Root {
+    sigma: f64,
+    located: Located,
+    spread: f64,
+}
+
 /// The function whose sign change locates an event.
 enum Test {
     /// The tangent's parameter component τ_p (folds).
@@ -232,24 +240,33 @@ impl Run<'_> {
     ) -> Option<(Vec<f64>, f64, Vec<f64>)> {
         let travel = |t: &[f64]| -> Vec<f64> { t.iter().map(|v| v * sign).collect() };
         let t_a = travel(&a.tangent);
-        let anchored = near
-            .filter(|_| !self.sliced)
-            .and_then(|(sigma_n, (_, x, p, t))| {
-                let t_n = travel(t);
-                let cosine: f64 = t_a.iter().zip(&t_n).map(|(u, v)| u * v).sum();
-                (cosine > 0.5).then(|| {
-                    let along = (sigma - sigma_n) / cosine;
-                    x.iter()
-                        .chain([p])
-                        .zip(&t_n)
-                        .map(|(z, t)| z + along * t)
-                        .collect::<Vec<f64>>()
-                })
-            });
+        let anchored = near.and_then(|(sigma_n, (_, x, p, t))| {
+            let t_n = travel(t);
+            let cosine: f64 = t_a.iter().zip(&t_n).map(|(u, v)| u * v).sum();
+            (cosine > 0.5).then(|| {
+                let along = (sigma - sigma_n) / cosine;
+                x.iter()
+                    .chain([p])
+                    .zip(&t_n)
+                    .map(|(z, t)| z + along * t)
+                    .collect::<Vec<f64>>()
+            })
+        });
         let Some(pred) = anchored else {
             let (x, p, tangent, _) = self.step(a, sign, sigma).ok()??;
             return Some((x, p, tangent));
         };
+        if self.sliced {
+            // The slice through `a` (its copies' null vectors), as the
+            // step from `a` itself would use.
+            let kernel = self.symmetric_kernel(&a.unknowns, a.parameter)?;
+            let (z, _) = self
+                .correct_sliced(&a.unknowns, &pred, &t_a, &kernel)
+                .ok()??;
+            let n = z.len() - 1;
+            let t = self.sliced_tangent(&z[..n], z[n], &kernel, &t_a).ok()?;
+            return Some((z[..n].to_vec(), z[n], travel(&t)));
+        }
         let (z, _, fu) = self.correct(&pred, &t_a).ok()??;
         let n = z.len() - 1;
         let t = engine::tangent_from(self.family, &fu, &z[..n], z[n], &t_a).ok()?;
@@ -381,6 +398,11 @@ impl Run<'_> {
     /// back on the eigenvalue).
     fn bordered_test(&self, a: &Point, b: &Point, m: usize) -> Option<Test> {
         let n = a.unknowns.len();
+        // On a branch of symmetric copies F_x keeps the copies' null
+        // vector everywhere: the borders must complement it too, or the
+        // bordered matrix is singular at the branch point (a twisted ring's
+        // Michell point: the copies' direction and the pair that crosses).
+        let m = m + usize::from(self.sliced);
         if m == 0 || m >= n {
             return None;
         }
@@ -435,7 +457,7 @@ impl Run<'_> {
                 .bordered_test(a, b, multiplicity)
                 .unwrap_or(Test::Eigenvalue(block)),
         };
-        let Some((sigma, best)) = self.root(a, (sign, b.parameter), (0.0, span), &test) else {
+        let Some(root) = self.root(a, (sign, b.parameter), (0.0, span), &test) else {
             if matches!(test, Test::Determinant) {
                 return self.unbracketed_branch_point(
                     a,
@@ -447,9 +469,19 @@ impl Run<'_> {
             }
             return (vec![], vec![]);
         };
+        // A bracket that could not be closed cannot tell one multiple
+        // crossing from several simple ones: it is reported with its spread.
+        let resolved = self.unresolved(&root, "", (branch, index)).is_none();
         if let Test::Bordered { right, left, .. } = &test {
-            if !self.degenerate(a, b, &best, right, left) {
-                return self.separate(a, b, sign, (sigma, best), (branch, index), block);
+            if resolved && !self.degenerate(a, b, &root.located, right, left) {
+                return self.separate(
+                    a,
+                    b,
+                    sign,
+                    (root.sigma, root.located),
+                    (branch, index),
+                    block,
+                );
             }
         }
         let wanted = (kind, block, multiplicity);
@@ -458,7 +490,7 @@ impl Run<'_> {
                 a,
                 b,
                 sign,
-                (sigma, best),
+                (root.sigma, root.located),
                 (branch, index),
                 (wanted, block),
             );
@@ -466,18 +498,24 @@ impl Run<'_> {
         }
         if matches!(test, Test::Determinant) {
             let (point, note) =
-                self.refined_branch_point(a, b, sign, best, (branch, index), wanted);
+                self.refined_branch_point(a, b, sign, root, (branch, index), wanted);
             return (point.into_iter().collect(), note.into_iter().collect());
         }
-        let point = self.special_point(
-            a,
-            b,
-            sign,
-            best,
-            (branch, index),
-            (wanted, Location::Bracketed),
-        );
-        (point.into_iter().collect(), vec![])
+        let note = self.unresolved(&root, kind.name(), (branch, index));
+        let point = self
+            .special_point(
+                a,
+                b,
+                sign,
+                root.located,
+                (branch, index),
+                (wanted, Location::Bracketed),
+            )
+            .map(|mut sp| {
+                sp.parameter_error = note.is_some().then_some(root.spread);
+                sp
+            });
+        (point.into_iter().collect(), note.into_iter().collect())
     }
 
     /// The simple branch point bracketed at `best` on det F_x, refined by
@@ -491,24 +529,46 @@ impl Run<'_> {
         a: &Point,
         b: &Point,
         sign: f64,
-        best: Located,
+        root: Root,
         (branch, index): (usize, usize),
         wanted: Wanted,
     ) -> (Option<SpecialPoint>, Option<String>) {
+        let bracketed = |root: Root, note: Option<String>| {
+            let unresolved = self.unresolved(&root, "branch point", (branch, index));
+            let spread = root.spread;
+            let point = self
+                .special_point(
+                    a,
+                    b,
+                    sign,
+                    root.located,
+                    (branch, index),
+                    (wanted, Location::Bracketed),
+                )
+                .map(|mut sp| {
+                    sp.parameter_error = unresolved.is_some().then_some(spread);
+                    sp
+                });
+            (point, note.or(unresolved))
+        };
         if self.sliced {
-            let point = self.special_point(
-                a,
-                b,
-                sign,
-                best,
-                (branch, index),
-                (wanted, Location::Bracketed),
-            );
-            return (point, None);
+            return bracketed(root, None);
         }
+        let best = root.located.clone();
         let radius = span_of(a, b, sign).abs().max(distance(a, b));
-        let (located, location, note) = match self.refine_branch_point(&best.1, best.2, radius) {
-            Ok((x, p, _)) => ((0.0, x, p, best.3), Location::Augmented, None),
+        match self.refine_branch_point(&best.1, best.2, radius) {
+            Ok((x, p, _)) => {
+                let located = (0.0, x, p, best.3);
+                let point = self.special_point(
+                    a,
+                    b,
+                    sign,
+                    located,
+                    (branch, index),
+                    (wanted, Location::Augmented),
+                );
+                (point, None)
+            }
             Err(why) => {
                 let note = format!(
                     "branch {branch}: the branch point between points {index} and {} is located \
@@ -517,11 +577,9 @@ impl Run<'_> {
                     index + 1,
                     best.2
                 );
-                (best, Location::Bracketed, Some(note))
+                bracketed(root, Some(note))
             }
-        };
-        let point = self.special_point(a, b, sign, located, (branch, index), (wanted, location));
-        (point, note)
+        }
     }
 
     /// Locates the fold between `a` and `b`: the root of τ_p bracketed by
@@ -538,9 +596,10 @@ impl Run<'_> {
         wanted: Wanted,
     ) -> (Vec<SpecialPoint>, Option<String>) {
         let span = span_of(a, b, sign);
-        let Some((_, best)) = self.root(a, (sign, b.parameter), (0.0, span), &Test::Fold) else {
+        let Some(root) = self.root(a, (sign, b.parameter), (0.0, span), &Test::Fold) else {
             return (vec![], None);
         };
+        let best = root.located;
         // On a branch of symmetric copies F_x keeps the copies' null vector,
         // so its kernel at a fold is two-dimensional and the one-bordered
         // system singular: the fold is the bracketed root, and its record
@@ -657,6 +716,7 @@ impl Run<'_> {
                 let tracker = Box::new(self.tracker.refined(factor)?);
                 let test = Test::EigenvalueOn(block, tracker);
                 self.root(a, (sign, b.parameter), (0.0, span), &test)
+                    .map(|r| (r.sigma, r.located))
             })
             .collect();
         let at = (branch, index);
@@ -773,8 +833,7 @@ impl Run<'_> {
             if jump != 1 {
                 continue;
             }
-            let Some((_, root)) = self.root(a, (sign, b.parameter), range, &Test::Determinant)
-            else {
+            let Some(root) = self.root(a, (sign, b.parameter), range, &Test::Determinant) else {
                 continue;
             };
             let wanted = (SpecialKind::BranchPoint, block, 1);
@@ -789,14 +848,20 @@ impl Run<'_> {
     /// the event tolerance on the parameter, and the point there. Each
     /// iterate is corrected from the converged bracket end nearer to it
     /// ([`Self::point_at`]), so the predictor stays short as the bracket
-    /// closes on the root; where that corrector fails, from `a`.
+    /// closes on the root; where that corrector fails, from `a`, and then
+    /// at points halfway towards the nearer end ([`Self::test_near`]):
+    /// close to a branch point the corrector's basin shrinks, and the
+    /// false position lands right on it. Where no point closer to the root
+    /// can be corrected the bracket stops there: the root is the best
+    /// point so far, its `spread` (the parameter bracket) wider than the
+    /// event tolerance, which the caller reports.
     fn root(
         &self,
         a: &Point,
         (sign, p_b): (f64, f64),
         (lo, hi): (f64, f64),
         test: &Test,
-    ) -> Option<(f64, Located)> {
+    ) -> Option<Root> {
         let span = hi - lo;
         let start = lo + 1e-12 * span;
         let lower = self.test_at(a, sign, start, None, test)?;
@@ -804,16 +869,12 @@ impl Run<'_> {
         let mut bracket = Illinois::new(lo, hi, lower.0, upper.0)?;
         let (mut p_lo, mut p_hi) = (a.parameter, p_b);
         let mut ends: [Anchor; 2] = [(start, lower), (hi, upper)];
-        let mut sigma = 0.5 * (lo + hi);
-        let mut best = None;
+        let mut best: Option<Anchor> = None;
         for _ in 0..80 {
-            sigma = bracket.next_point();
-            let near = ends
-                .iter()
-                .min_by(|x, y| (x.0 - sigma).abs().total_cmp(&(y.0 - sigma).abs()));
-            let here = self
-                .test_at(a, sign, sigma, near, test)
-                .or_else(|| self.test_at(a, sign, sigma, None, test))?;
+            let Some((sigma, here)) = self.test_near(a, sign, bracket.next_point(), &ends, test)
+            else {
+                break;
+            };
             let end = match bracket.update(sigma, here.0) {
                 End::Lower => {
                     p_lo = here.2;
@@ -829,12 +890,75 @@ impl Run<'_> {
             let done = (p_hi - p_lo).abs() <= tol && bracket.width() <= 1e3 * tol
                 || here.0 == 0.0
                 || bracket.width() <= 1e-15 * span;
-            best = Some(here);
+            best = Some((sigma, here));
             if done {
                 break;
             }
         }
-        Some((sigma, best?))
+        // Without an interior point, the end with the smaller test value.
+        let (sigma, located) = best.unwrap_or_else(|| {
+            let [l, u] = ends;
+            if l.1 .0.abs() <= u.1 .0.abs() {
+                l
+            } else {
+                u
+            }
+        });
+        Some(Root {
+            sigma,
+            located,
+            spread: (p_hi - p_lo).abs(),
+        })
+    }
+
+    /// The test function at σ, or — where the corrector fails there — at
+    /// up to three points each halfway from the last try towards the
+    /// nearer bracket end; the σ used and the value. None where all fail.
+    fn test_near(
+        &self,
+        a: &Point,
+        sign: f64,
+        sigma: f64,
+        ends: &[Anchor; 2],
+        test: &Test,
+    ) -> Option<(f64, Located)> {
+        let nearer = |s: f64| {
+            ends.iter()
+                .min_by(|x, y| (x.0 - s).abs().total_cmp(&(y.0 - s).abs()))
+                .expect("two ends")
+        };
+        let mut s = sigma;
+        for _ in 0..4 {
+            let near = nearer(s);
+            if let Some(here) = self
+                .test_at(a, sign, s, Some(near), test)
+                .or_else(|| self.test_at(a, sign, s, None, test))
+            {
+                return Some((s, here));
+            }
+            s = 0.5 * (s + near.0);
+        }
+        None
+    }
+
+    /// Whether a root's parameter bracket closed to the event tolerance;
+    /// else a note naming the bracket it reached.
+    fn unresolved(
+        &self,
+        root: &Root,
+        what: &str,
+        (branch, index): (usize, usize),
+    ) -> Option<String> {
+        let tol = self.opts.event_tolerance * root.located.2.abs().max(1.0);
+        (root.spread > tol).then(|| {
+            format!(
+                "branch {branch}: the {what} between points {index} and {} is located at \
+                 parameter {:.12} only to ±{:.1e} (the corrector fails closer to it)",
+                index + 1,
+                root.located.2,
+                root.spread
+            )
+        })
     }
 
     /// The special point at the located `best`: its spectrum, null mode
