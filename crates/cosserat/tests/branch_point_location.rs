@@ -157,9 +157,16 @@ fn full_strip_asymmetric_branch_point_is_located() {
 
 /// The full shallow arch under its crown load: the asymmetric branch
 /// points on the symmetric branch (P = 4.1067 after the fold, 1.9366 on
-/// the way back), and the asymmetric branch that joins them, which meets
-/// the symmetric branch again at the second: located from both branches,
-/// the same point to the location's tolerance.
+/// the way back), and the asymmetric branch that joins them — a closed
+/// loop through both, mirror image on the way back — which meets the
+/// symmetric branch again at each: located from both branches, the same
+/// point to the location's tolerance. Every switched branch is asymmetric
+/// (the switch leaves the branch it was on: a tangent taken at the located
+/// point, inside the null plane, once sent both directions back along the
+/// symmetric branch), turns at the branch points as a pitchfork's side
+/// branch does (located as branch points, not as folds of a singular
+/// fold system), and ends when it comes round ("closed"), not at
+/// `max_points`.
 #[test]
 #[cfg_attr(debug_assertions, ignore = "three continuations: seconds in release")]
 fn full_arch_asymmetric_branch_points_are_located_from_both_branches() {
@@ -178,6 +185,26 @@ fn full_arch_asymmetric_branch_points_are_located_from_both_branches() {
         .map(|s| s.point.parameter)
         .collect();
     eprintln!("primary {first}, {second}; from the other branches {crossings:?}");
+    assert!(d
+        .special_points
+        .iter()
+        .all(|s| s.kind == SpecialKind::BranchPoint || s.branch == 0 || s.point.parameter < 1.9));
+    for b in d.branches.iter().skip(1) {
+        assert!(
+            b.stop_reason.to_string().starts_with("closed"),
+            "{}",
+            b.stop_reason
+        );
+        // x at s = L/4 and 3L/4 (the shape's 21 points: 5 and 15) differ on
+        // an asymmetric shape away from the branch points (by 0.038 at most
+        // here; on the symmetric branch to round-off).
+        let asymmetry = b
+            .points
+            .iter()
+            .map(|p| (p.shape[5].position[0] - p.shape[15].position[0]).abs())
+            .fold(0.0, f64::max);
+        assert!(asymmetry > 0.01, "{asymmetry}");
+    }
     for p in &crossings {
         let nearest = [first, second]
             .iter()

@@ -193,7 +193,7 @@ impl Run<'_> {
 /// The x-part of [A column; rowᵀ 0] [y; s] = [rhs; 0]: the solution of
 /// A y = rhs in the complement of the (near) kernel of A, whatever A's
 /// (near) singularity.
-fn bordered_solve(
+pub(super) fn bordered_solve(
     matrix: &DMatrix<f64>,
     column: &DVector<f64>,
     row: &DVector<f64>,

@@ -599,6 +599,23 @@ impl Run<'_> {
         let Some(root) = self.root(a, (sign, b.parameter), (0.0, span), &Test::Fold) else {
             return (vec![], None);
         };
+        let radius = span.abs().max(distance(a, b));
+        if !self.sliced && self.turns_at_branch_point(&root.located) {
+            let best = &root.located;
+            if let Ok((x, p, _)) = self.refine_branch_point(&best.1, best.2, radius) {
+                let located = (0.0, x, p, best.3.clone());
+                let bp = (SpecialKind::BranchPoint, wanted.1, 1);
+                let point = self.special_point(
+                    a,
+                    b,
+                    sign,
+                    located,
+                    (branch, index),
+                    (bp, Location::Augmented),
+                );
+                return (point.into_iter().collect(), None);
+            }
+        }
         let best = root.located;
         // On a branch of symmetric copies F_x keeps the copies' null vector,
         // so its kernel at a fold is two-dimensional and the one-bordered
@@ -615,7 +632,6 @@ impl Run<'_> {
             );
             return (point.into_iter().collect(), None);
         }
-        let radius = span.abs().max(distance(a, b));
         let refined = self
             .refine_fold(&best.1, best.2, radius)
             .and_then(|(x, p, _)| {
@@ -637,6 +653,60 @@ impl Run<'_> {
         };
         let point = self.special_point(a, b, sign, located, (branch, index), (wanted, location));
         (point.into_iter().collect(), note)
+    }
+
+    /// The direction of the branch through a simple branch point (x, p):
+    /// `reference` (the tangent at the branch's last regular point)
+    /// projected on the null plane of [F_x F_p] there, spanned by (φ, 0)
+    /// and (v₀, 1), [F_x b; cᵀ 0][v₀; s] = [−F_p; 0] (φ = c, b the near
+    /// null vectors). Dense systems only; None above
+    /// [`super::fold::FOLD_DENSE_UP_TO`] unknowns or where a solve fails.
+    fn branch_direction(&self, x: &[f64], p: f64, reference: &[f64]) -> Option<Vec<f64>> {
+        let n = x.len();
+        if n > super::fold::FOLD_DENSE_UP_TO || self.sliced {
+            return None;
+        }
+        let (_, fx) = self.dense_jacobian(x, p).ok()?;
+        let fp = self.family.parameter_derivative(x, p).ok()?;
+        let (c, b) = super::fold::null_vectors(&fx)?;
+        let v0 = super::branch_point::bordered_solve(&fx, &b, &c, &(-&fp))?;
+        let e1 = DVector::from_iterator(n + 1, c.iter().copied().chain([0.0])).normalize();
+        let mut e2 = DVector::from_iterator(n + 1, v0.iter().copied().chain([1.0]));
+        e2 -= &e1 * e1.dot(&e2);
+        let e2 = e2.normalize();
+        let r = DVector::from_column_slice(reference);
+        let t = &e1 * e1.dot(&r) + &e2 * e2.dot(&r);
+        let norm = t.norm();
+        (norm.is_finite() && norm > 0.0).then(|| (t / norm).as_slice().to_vec())
+    }
+
+    /// Whether the branch may turn back (τ_p changes sign) at a branch
+    /// point rather than at a fold: F_p nearly in the range of the singular
+    /// F_x (|ψᵀF_p| ≤ 1e-2 |F_p|, ψ its left null vector; at a fold it is of
+    /// the order of |F_p|, at a branch point of the distance to it). A
+    /// branch that bifurcated at a pitchfork meets the branch it left there
+    /// again and turns with p'(σ) = 0 (the parabola p − p* ∝ a²): the full
+    /// shallow arch's asymmetric branch at both of its ends. There the
+    /// fold's augmented system is singular — it did not converge, or
+    /// converged 7e-8 off — while the branch point's is regular, so the
+    /// caller tries the branch point's system first and keeps it only where
+    /// it converges (μ = 0: a fold never satisfies it). Dense, as the
+    /// fold's system.
+    fn turns_at_branch_point(&self, best: &Located) -> bool {
+        let (x, p) = (&best.1, best.2);
+        if x.len() > super::fold::FOLD_DENSE_UP_TO {
+            return false;
+        }
+        let (Ok((_, fx)), Ok(fp)) = (
+            self.dense_jacobian(x, p),
+            self.family.parameter_derivative(x, p),
+        ) else {
+            return false;
+        };
+        let Some((_, left)) = super::fold::null_vectors(&fx) else {
+            return false;
+        };
+        left.dot(&fp).abs() <= 1e-2 * fp.norm()
     }
 
     /// A simple branch point between `a` and `b` whose bracket could not
@@ -972,7 +1042,19 @@ impl Run<'_> {
         (branch, index): (usize, usize),
         ((kind, block, multiplicity), location): (Wanted, Location),
     ) -> Option<SpecialPoint> {
-        let stored: Vec<f64> = tangent.iter().map(|v| v * sign).collect();
+        // At a branch point the null space of [F_x F_p] is a plane, and the
+        // tangent computed at a point that close to it may lie anywhere in
+        // it — along the crossing branch, so that switching, which removes
+        // the stored tangent from that plane, followed the branch it was on
+        // (the pinned arch's asymmetric point). A simple one stores the
+        // branch's own direction: its last regular point's, projected on
+        // that plane ([`Self::branch_direction`]).
+        let stored: Vec<f64> = match kind {
+            SpecialKind::BranchPoint if multiplicity == 1 => self
+                .branch_direction(&x, p, &a.tangent)
+                .unwrap_or_else(|| tangent.iter().map(|v| v * sign).collect()),
+            _ => tangent.iter().map(|v| v * sign).collect(),
+        };
         let (eigenvalue, null_mode) = self.tracker.nearest_zero(self.family, &x, p, block).ok()?;
         // |det F_x| relative to its size at the two neighbours; NaN (not a
         // default) where a determinant cannot be evaluated.
