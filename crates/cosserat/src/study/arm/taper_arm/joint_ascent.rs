@@ -263,6 +263,9 @@ pub fn ascend(
         return run;
     };
     let mut hessian = initial_hessian(scales, &g);
+    // Whether the model is the first diagonal (a scaled projected
+    // gradient step), where a failed line search means flat indeed.
+    let mut fresh = true;
     loop {
         run.projected_gradient = feasible.projected_gradient(&x, &g);
         if run.projected_gradient <= tolerance * f.abs() {
@@ -278,11 +281,20 @@ pub fn ascend(
         let Some((next, fnext, gnext)) =
             line_search(feasible, &x, f, &g, &d, slope, stop, &mut run)
         else {
-            if run.end != JointEnd::Stopped {
-                run.end = JointEnd::Flat;
+            if run.end == JointEnd::Stopped {
+                return run;
             }
-            return run;
+            if fresh {
+                run.end = JointEnd::Flat;
+                return run;
+            }
+            // The model's direction found no rise (an ill-conditioned
+            // model after steps across bounds): start it again.
+            hessian = initial_hessian(scales, &g);
+            fresh = true;
+            continue;
         };
+        fresh = false;
         run.best = Some((next.clone(), fnext));
         let Some(gnext) = gnext else {
             run.projected_gradient = f64::NAN;
