@@ -61,7 +61,7 @@ const ASCENT_ITERATIONS: usize = 1000;
 /// to its largest value there or 1/L ([`TaperedArm::designed_rod`]): a few
 /// ulps above the rounding of the shape's moment (DOP853 at 10⁻¹²,
 /// [`FixedShape::samples`]).
-pub const KAPPA0_TOLERANCE: f64 = 1e-13;
+const KAPPA0_TOLERANCE: f64 = 1e-13;
 
 /// Points of the reported shapes (as for the prismatic arm).
 const SHAPE_POINTS: usize = 101;
@@ -486,7 +486,7 @@ impl TaperedArm {
     /// The rod of a tapered design at its design load: stiffness B_i A²
     /// exactly ([`Section::stiffness`], quadratic between the knots),
     /// κ̄⁰2 = φ' − γ m̄2/(B2 A²) interpolated between the knots to
-    /// [`KAPPA0_TOLERANCE`] ([`Profile::piecewise_interpolant`]; smooth
+    /// `KAPPA0_TOLERANCE` ([`Profile::piecewise_interpolant`]; smooth
     /// there, kinked at the knots with A²), the clamp turned by c1, the
     /// tip load scaled by γ. The solvers stop at the knots, so the right
     /// side is smooth on every piece they integrate, and the designed
