@@ -355,3 +355,76 @@ fn the_vertical_optimum_reaches_its_design() {
     };
     assert!(miss < 1e-8, "{miss}");
 }
+
+/// The round section's horizontal optimum (B̄1 = 1, B̄3 = 2/3, the M = 8
+/// box, α = 0; its design vector as the long-box search found it, a planar
+/// shape): its loading path loses stability out of the plane before the
+/// design load (a symmetry-breaking branch point near λ = 0.834), by a
+/// small margin. Checked independently of the continuation: the
+/// equilibrium at λ = 0.9 solved by a load ramp (multiple shooting) has a
+/// negative lowest eigenvalue of the second variation on 100 and 200
+/// elements (−1.0e-3), the one at λ = 0.7 a positive one.
+#[test]
+#[cfg_attr(
+    debug_assertions,
+    ignore = "a continuation of the loading path: run in release"
+)]
+fn the_round_horizontal_optimum_loses_stability_on_its_path() {
+    use cosserat::bvp::{solve, Method, SolverOptions, Strategy};
+    use cosserat::model::{ModelChoice, ModelLevel};
+    let half = (-0.5, 0.5);
+    let arm = SpatialArm {
+        planar: ArmProblem {
+            b1: 1.0,
+            b3: 2.0 / 3.0,
+            alpha: 0.0,
+            bounds: vec![(-4.0, 4.0), (-2.0, 2.0), half, half, half, half, half],
+            stability: StabilityOptions::new(50, 2, 1).unwrap(),
+        },
+        bend_bounds: vec![(-2.0, 2.0), (-2.0, 2.0), (-1.0, 1.0)],
+        twist_bounds: vec![(-8.0, 8.0), (-4.0, 4.0), (-2.0, 2.0)],
+        roll_bounds: Some((-PI, PI)),
+        directions: vec![],
+    };
+    let mut p = vec![
+        1.626666611098695,
+        0.6808503495364213,
+        -0.5,
+        -0.5,
+        -0.5,
+        -0.0898931666723902,
+        0.5,
+    ];
+    p.extend([0.0; 7]);
+    let optimum = spatial_optimum(&arm, &p);
+    let (_, verdict) = arm.loading_path(&ArmScene::default(), &optimum, &|| false);
+    let cosserat::study::arm::PathVerdict::Misses { parameter, reason } = &verdict else {
+        panic!("{verdict:?}");
+    };
+    assert!(reason.contains("unstable"), "{reason}");
+    assert!((0.8..0.9).contains(parameter), "{parameter}");
+    let rod = arm
+        .designed_rod(&ArmScene::default(), &optimum.design)
+        .unwrap();
+    let lowest = |lambda: f64, elements: usize| {
+        let r = rod.with_load_factor(lambda).unwrap();
+        let opts = SolverOptions {
+            method: Method::MultipleShooting { segments: 64 },
+            strategy: Strategy::Ramp,
+            ..Default::default()
+        };
+        let model = ModelChoice {
+            level: ModelLevel::Kirchhoff,
+            reason: String::new(),
+        };
+        let eq = solve(&r, &model, &opts).unwrap();
+        let so = StabilityOptions::new(elements, 2, 1).unwrap();
+        let st = cosserat::stability::analyze(&r, &eq, &opts, &so).unwrap();
+        st.blocks[0].eigenvalues[0]
+    };
+    assert!(lowest(0.7, 100) > 1e-3);
+    for elements in [100, 200] {
+        let e = lowest(0.9, elements);
+        assert!(e < -5e-4, "{elements} elements: {e}");
+    }
+}
