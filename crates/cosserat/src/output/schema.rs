@@ -99,6 +99,7 @@ fn entry(parent: &str, name: &str) -> (&'static str, &'static str) {
         (_, "section_knots") => ("1", "arc length of the section's knots per rod length"),
         (_, "min_section") => ("1", "lower bound A_min of the section, in units of the prismatic section"),
         (_, "loading_path_value") => ("1", "the loading path's number: load factor of the loss of stability, tip miss per L, or where it ended"),
+        (_, "projected_gradient") => ("1", "max_i |x_i − P(x + ∇R̂)_i| of the joint ascent at the optimum (its stationarity)"),
         (_, "section_profile") => ("1", "section area A at the shape points, in units of the prismatic section"),
         // Sweeps.
         ("grid", "keys") => ("", "the --set key of each axis"),

@@ -325,7 +325,7 @@ pub fn analyze(
 ) -> Result<Stability, StabilityError> {
     check_conservative(rod)?;
     let fe = FiniteElements::new(rod.length(), opts.elements, opts.order)
-        .with_breaks(&rod.loads().jumps())
+        .with_breaks(&rod.breaks())
         .with_hinged_base(rod.clamp().hinge);
     let mut points = fe.quadrature_points();
     points.push(rod.length());
