@@ -81,6 +81,36 @@ fn euler_column_branch_points_to_1e_10() {
     check_column(&d, PI * PI / 4.0, PI * PI / 4.0);
 }
 
+/// The same columns on large systems — collocation on 400 intervals and
+/// multiple shooting on 400 segments, ≈ 1600 unknowns each — where the
+/// augmented system is solved in F_x's band shape
+/// (`continuation/bordering.rs`; it was dense up to 1000 unknowns and the
+/// bracketed root was kept beyond): both branch points to 1e-10.
+#[test]
+#[cfg_attr(
+    debug_assertions,
+    ignore = "four large diagrams, ≈ 5 s in release: run with --release"
+)]
+fn large_systems_locate_branch_points_on_the_augmented_system() {
+    for method in [
+        [
+            "solver.method=\"collocation\"",
+            "continuation.intervals=400",
+        ],
+        ["solver.method=\"multiple-shooting\"", "solver.segments=400"],
+    ] {
+        let mut sets: Vec<String> = method.iter().map(|s| (*s).to_string()).collect();
+        sets.push("continuation.switch_depth=0".into());
+        let d = diagram(EULER, &sets);
+        let size = d.branches[0].points[0].unknowns.len();
+        eprintln!("{method:?}: {size} unknowns");
+        assert!(size > 1500, "{size} unknowns");
+        check_column(&d, PI * PI / 4.0, PI * PI / 4.0);
+        let d = diagram(GUIDED, &sets);
+        check_column(&d, 4.0 * PI * PI, 8.0 * PI * PI);
+    }
+}
+
 /// The guided column (B1 = 2 B2): 4π² in the plane, 8π² out of it
 /// (Timoshenko & Gere, Sec. 2.3), on elements of order 3.
 #[test]

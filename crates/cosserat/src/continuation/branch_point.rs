@@ -42,12 +42,16 @@
 //! needs), the second derivatives by central differences of the exact
 //! F_x and F_p along v, v₀ and p. They steer Newton only: the equations it
 //! solves — and so the located point — are exact to the corrector's
-//! tolerance. Dense, once per branch point, up to
-//! [`super::fold::FOLD_DENSE_UP_TO`] unknowns, as for folds.
+//! tolerance. Every solve is in F_x's shape (`bordering.rs`): in the
+//! unknowns' order (x, μ, p) the Newton matrix differs from
+//! diag(K, 1), K = [F_x b; cᵀ 0], by the column F_p and the rows of g and
+//! h — a rank-three Woodbury correction of K's factors, O(N) per
+//! iteration on multiple shooting and collocation.
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 
-use super::fold::{bordered, null_vectors, FOLD_DENSE_UP_TO};
+use super::bordering::{low_rank_solve, null_vectors, BorderedJacobian};
+use super::fold::unit;
 use super::Run;
 
 /// Newton iterations before the augmented system is given up.
@@ -57,10 +61,13 @@ const MAX_ITERATIONS: usize = 12;
 /// parameter and the Newton iterations it took.
 pub(super) type Located = (Vec<f64>, f64, usize);
 
-/// The pieces of the augmented system at one iterate.
+/// The augmented system at one iterate z = (x, p, μ): the residual
+/// (F + μb, g, h), the Newton correction (in the same order) and the
+/// norms of ∇g and ∇h (scales for their tolerances).
 struct Augmented {
     residual: DVector<f64>,
-    jacobian: DMatrix<f64>,
+    step: DVector<f64>,
+    gradients: (f64, f64),
 }
 
 impl Run<'_> {
@@ -78,36 +85,23 @@ impl Run<'_> {
         radius: f64,
     ) -> Result<Located, String> {
         let n = x0.len();
-        if n > FOLD_DENSE_UP_TO {
-            return Err(format!(
-                "{n} unknowns: the augmented system is solved dense up to {FOLD_DENSE_UP_TO}"
-            ));
-        }
-        let fx0 = self.dense_jacobian(x0, p0).map_err(|e| e.to_string())?.1;
+        let fx0 = self.linearization(x0, p0).map_err(|e| e.to_string())?.1;
         let (c, b) = null_vectors(&fx0).ok_or("F_x: no null vectors by inverse iteration")?;
         let mut z = DVector::from_iterator(n + 2, x0.iter().copied().chain([p0, 0.0]));
         let start = z.rows(0, n + 1).into_owned();
+        let mut here = self.branch_system(&z, &b, &c)?;
         for iteration in 1..=MAX_ITERATIONS {
-            let here = self.branch_system(&z, &b, &c)?;
-            let dz = here
-                .jacobian
-                .lu()
-                .solve(&here.residual)
-                .filter(|d| d.iter().all(|v| v.is_finite()))
-                .ok_or("the augmented Jacobian is singular (not a simple branch point)")?;
-            z -= &dz;
+            z -= &here.step;
             if (z.rows(0, n + 1) - &start).norm() > radius {
                 return Err(format!(
                     "Newton left the step (|Δz| > {radius:.3e}) at iteration {iteration}"
                 ));
             }
-            let p = z[n];
+            let (p, dp) = (z[n], here.step[n]);
+            here = self.branch_system(&z, &b, &c)?;
             let tol_p = self.opts.event_tolerance * p.abs().max(1.0);
-            if dz[n].abs() <= tol_p {
-                let at = self.branch_system(&z, &b, &c)?;
-                if self.branch_converged(&at, z[n + 1] * b.amax()) {
-                    return Ok((z.rows(0, n).iter().copied().collect(), p, iteration));
-                }
+            if dp.abs() <= tol_p && self.branch_converged(&here, z[n + 1] * b.amax()) {
+                return Ok((z.rows(0, n).iter().copied().collect(), p, iteration));
             }
         }
         Err(format!(
@@ -122,11 +116,12 @@ impl Run<'_> {
         let r = &at.residual;
         r.rows(0, n).amax() <= tol
             && unfolding.abs() <= tol
-            && r[n].abs() <= tol * at.jacobian.row(n).norm()
-            && r[n + 1].abs() <= tol * at.jacobian.row(n + 1).norm()
+            && r[n].abs() <= tol * at.gradients.0
+            && r[n + 1].abs() <= tol * at.gradients.1
     }
 
-    /// The residual (F + μb, g, h) at z = (x, p, μ) and its Jacobian.
+    /// The residual (F + μb, g, h) at z = (x, p, μ) and the Newton
+    /// correction.
     fn branch_system(
         &self,
         z: &DVector<f64>,
@@ -134,20 +129,28 @@ impl Run<'_> {
         c: &DVector<f64>,
     ) -> Result<Augmented, String> {
         let n = z.len() - 2;
-        let (x, p, mu) = (z.as_slice()[..n].to_vec(), z[n], z[n + 1]);
+        let (x, p, mu) = (&z.as_slice()[..n], z[n], z[n + 1]);
         let fail = |e: super::PointError| e.to_string();
-        let (f, fx) = self.dense_jacobian(&x, p).map_err(fail)?;
-        let fp = self.family.parameter_derivative(&x, p).map_err(fail)?;
+        let (f, fx) = self.linearization(x, p).map_err(fail)?;
+        let fp = self.family.parameter_derivative(x, p).map_err(fail)?;
         let singular = "the bordered matrix [F_x b; cᵀ 0] is singular";
-        let (g, v) = bordered(&fx, b, c).ok_or(singular)?;
-        let (_, w) = bordered(&fx.transpose(), c, b).ok_or(singular)?;
-        let v0 = bordered_solve(&fx, b, c, &(-&fp)).ok_or(singular)?;
-        // Directional differences of F_x along v and v₀, and of F_x, F_p in p.
-        let along = |d: &DVector<f64>| -> Result<DMatrix<f64>, String> {
+        let mut k = BorderedJacobian::new(fx, b.clone(), c.clone()).ok_or(singular)?;
+        let e = unit(n + 1, n);
+        let vg = k.solve(&e).ok_or(singular)?;
+        let (v, g) = (vg.rows(0, n).into_owned(), vg[n]);
+        let w = k
+            .solve_transposed(&e)
+            .ok_or(singular)?
+            .rows(0, n)
+            .into_owned();
+        let minus_fp = DVector::from_iterator(n + 1, fp.iter().map(|v| -v).chain([0.0]));
+        let v0 = k.solve(&minus_fp).ok_or(singular)?.rows(0, n).into_owned();
+        // wᵀ F_xx[d, ·] by a central difference of wᵀF_x along d (zero
+        // along a zero direction: v₀ = 0 where F_p = 0, e.g. a straight
+        // column in its load).
+        let along = |d: &DVector<f64>| -> Result<DVector<f64>, String> {
             if d.amax() == 0.0 {
-                // F_x does not move along a zero direction (v₀ = 0 where
-                // F_p = 0, e.g. a straight column in its load).
-                return Ok(DMatrix::zeros(n, n));
+                return Ok(DVector::zeros(n));
             }
             let eps = 1e-6 * x.iter().fold(1.0f64, |m, v| m.max(v.abs())) / d.amax();
             let shifted = |sign: f64| -> Vec<f64> {
@@ -156,58 +159,73 @@ impl Run<'_> {
                     .map(|(a, e)| a + sign * eps * e)
                     .collect()
             };
-            let up = self.dense_jacobian(&shifted(1.0), p).map_err(fail)?.1;
-            let down = self.dense_jacobian(&shifted(-1.0), p).map_err(fail)?.1;
+            let up = self
+                .transposed_product(&shifted(1.0), p, &w)
+                .map_err(fail)?;
+            let down = self
+                .transposed_product(&shifted(-1.0), p, &w)
+                .map_err(fail)?;
             Ok((up - down) / (2.0 * eps))
         };
-        let fxx_v = along(&v)?;
-        let fxx_v0 = along(&v0)?;
         let h = 1e-6 * p.abs().max(1.0);
-        let fxp = (self.dense_jacobian(&x, p + h).map_err(fail)?.1
-            - self.dense_jacobian(&x, p - h).map_err(fail)?.1)
+        let (plus, minus) = (
+            self.linearization(x, p + h).map_err(fail)?.1,
+            self.linearization(x, p - h).map_err(fail)?.1,
+        );
+        // wᵀ F_xp (a row), F_xp v, F_xp v₀ and F_pp.
+        let wt_fxp = (plus.mul_transposed(&w) - minus.mul_transposed(&w)) / (2.0 * h);
+        let fxp = |d: &DVector<f64>| (plus.mul(d) - minus.mul(d)) / (2.0 * h);
+        let fpp = (self.family.parameter_derivative(x, p + h).map_err(fail)?
+            - self.family.parameter_derivative(x, p - h).map_err(fail)?)
             / (2.0 * h);
-        let fpp = (self.family.parameter_derivative(&x, p + h).map_err(fail)?
-            - self.family.parameter_derivative(&x, p - h).map_err(fail)?)
-            / (2.0 * h);
-        let wt = w.transpose();
-        let gx = -(&wt * &fxx_v);
-        let gp = -w.dot(&(&fxp * &v));
-        let hx = &wt * &fxx_v0 + &wt * &fxp;
-        let hp = w.dot(&(&fxp * &v0)) + w.dot(&fpp);
-        let mut jacobian = DMatrix::zeros(n + 2, n + 2);
-        jacobian.view_mut((0, 0), (n, n)).copy_from(&fx);
-        jacobian.view_mut((0, n), (n, 1)).copy_from(&fp);
-        jacobian.view_mut((0, n + 1), (n, 1)).copy_from(b);
-        jacobian.view_mut((n, 0), (1, n)).copy_from(&gx);
-        jacobian[(n, n)] = gp;
-        jacobian.view_mut((n + 1, 0), (1, n)).copy_from(&hx);
-        jacobian[(n + 1, n)] = hp;
-        let mut residual = DVector::zeros(n + 2);
+        let gx = -along(&v)?;
+        let gp = -w.dot(&fxp(&v));
+        let hx = along(&v0)? + wt_fxp;
+        let hp = w.dot(&fxp(&v0)) + w.dot(&fpp);
+        // In the order (x, μ, p): the Newton matrix is diag(K, 1) plus the
+        // column F_p (rows of F), the row (g_x − c, 0, g_p) in K's border
+        // row and the row (h_x, 0, h_p − 1) in the identity's.
+        let m = n + 2;
+        let mut residual = DVector::zeros(m);
         residual.rows_mut(0, n).copy_from(&(f + b * mu));
         residual[n] = g;
         residual[n + 1] = w.dot(&fp);
-        Ok(Augmented { residual, jacobian })
+        let column = DVector::from_iterator(m, fp.iter().copied().chain([0.0, 0.0]));
+        let g_row = DVector::from_iterator(m, (&gx - c).iter().copied().chain([0.0, gp]));
+        let h_row = DVector::from_iterator(m, hx.iter().copied().chain([0.0, hp - 1.0]));
+        let solve_k = |r: &DVector<f64>| -> Option<DVector<f64>> {
+            let mut y = k.solve(&r.rows(0, n + 1).into_owned())?;
+            y = y.push(r[n + 1]);
+            Some(y)
+        };
+        let (en, ep) = (unit(m, n), unit(m, n + 1));
+        let step = low_rank_solve(
+            solve_k,
+            &[column, en, ep.clone()],
+            &[ep, g_row, h_row],
+            &residual,
+        )
+        .ok_or("the augmented Jacobian is singular (not a simple branch point)")?;
+        // Back to the order (x, p, μ).
+        let mut step = step;
+        step.swap_rows(n, n + 1);
+        let gradients = (
+            (gx.norm_squared() + gp * gp).sqrt(),
+            (hx.norm_squared() + hp * hp).sqrt(),
+        );
+        Ok(Augmented {
+            residual,
+            step,
+            gradients,
+        })
     }
 }
 
-/// The x-part of [A column; rowᵀ 0] [y; s] = [rhs; 0]: the solution of
-/// A y = rhs in the complement of the (near) kernel of A, whatever A's
-/// (near) singularity.
-pub(super) fn bordered_solve(
-    matrix: &DMatrix<f64>,
-    column: &DVector<f64>,
-    row: &DVector<f64>,
-    rhs: &DVector<f64>,
-) -> Option<DVector<f64>> {
-    let n = matrix.nrows();
-    let mut m = DMatrix::zeros(n + 1, n + 1);
-    m.view_mut((0, 0), (n, n)).copy_from(matrix);
-    m.view_mut((0, n), (n, 1)).copy_from(column);
-    m.view_mut((n, 0), (1, n)).copy_from(&row.transpose());
-    let mut full = DVector::zeros(n + 1);
-    full.rows_mut(0, n).copy_from(rhs);
-    m.lu()
-        .solve(&full)
-        .filter(|s| s.iter().all(|v| v.is_finite()))
-        .map(|s| s.rows(0, n).into_owned())
+/// The x-part of [F_x column; rowᵀ 0] [y; s] = [rhs; 0]: the solution of
+/// F_x y = rhs in the complement of the (near) kernel of F_x, whatever
+/// its (near) singularity.
+pub(super) fn bordered_solve(k: &mut BorderedJacobian, rhs: &DVector<f64>) -> Option<DVector<f64>> {
+    let n = rhs.len();
+    let full = DVector::from_iterator(n + 1, rhs.iter().copied().chain([0.0]));
+    Some(k.solve(&full)?.rows(0, n).into_owned())
 }

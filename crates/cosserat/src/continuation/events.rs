@@ -659,17 +659,18 @@ impl Run<'_> {
     /// `reference` (the tangent at the branch's last regular point)
     /// projected on the null plane of [F_x F_p] there, spanned by (φ, 0)
     /// and (v₀, 1), [F_x b; cᵀ 0][v₀; s] = [−F_p; 0] (φ = c, b the near
-    /// null vectors). Dense systems only; None above
-    /// [`super::fold::FOLD_DENSE_UP_TO`] unknowns or where a solve fails.
+    /// null vectors), in F_x's shape (`bordering.rs`). None on a branch of
+    /// symmetric copies or where a solve fails.
     fn branch_direction(&self, x: &[f64], p: f64, reference: &[f64]) -> Option<Vec<f64>> {
         let n = x.len();
-        if n > super::fold::FOLD_DENSE_UP_TO || self.sliced {
+        if self.sliced {
             return None;
         }
-        let (_, fx) = self.dense_jacobian(x, p).ok()?;
+        let (_, fx) = self.linearization(x, p).ok()?;
         let fp = self.family.parameter_derivative(x, p).ok()?;
-        let (c, b) = super::fold::null_vectors(&fx)?;
-        let v0 = super::branch_point::bordered_solve(&fx, &b, &c, &(-&fp))?;
+        let (c, b) = super::bordering::null_vectors(&fx)?;
+        let mut k = super::bordering::BorderedJacobian::new(fx, b, c.clone())?;
+        let v0 = super::branch_point::bordered_solve(&mut k, &(-&fp))?;
         let e1 = DVector::from_iterator(n + 1, c.iter().copied().chain([0.0])).normalize();
         let mut e2 = DVector::from_iterator(n + 1, v0.iter().copied().chain([1.0]));
         e2 -= &e1 * e1.dot(&e2);
@@ -690,20 +691,17 @@ impl Run<'_> {
     /// fold's augmented system is singular — it did not converge, or
     /// converged 7e-8 off — while the branch point's is regular, so the
     /// caller tries the branch point's system first and keeps it only where
-    /// it converges (μ = 0: a fold never satisfies it). Dense, as the
-    /// fold's system.
+    /// it converges (μ = 0: a fold never satisfies it). In F_x's shape,
+    /// as the fold's system.
     fn turns_at_branch_point(&self, best: &Located) -> bool {
         let (x, p) = (&best.1, best.2);
-        if x.len() > super::fold::FOLD_DENSE_UP_TO {
-            return false;
-        }
         let (Ok((_, fx)), Ok(fp)) = (
-            self.dense_jacobian(x, p),
+            self.linearization(x, p),
             self.family.parameter_derivative(x, p),
         ) else {
             return false;
         };
-        let Some((_, left)) = super::fold::null_vectors(&fx) else {
+        let Some((_, left)) = super::bordering::null_vectors(&fx) else {
             return false;
         };
         left.dot(&fp).abs() <= 1e-2 * fp.norm()

@@ -26,6 +26,7 @@
 //! saved diagram, `restart` a run started from given unknowns, `stage` the
 //! chained stages of one run joined into one diagram.
 
+mod bordering;
 mod branch_point;
 mod codim2;
 mod corrector;
@@ -56,7 +57,6 @@ pub use diagram::{
 };
 pub use driver::continuation;
 pub use family::{tip_angle, CarryError, DerivativeMethod, Family, FamilyError, PointError};
-pub(crate) use fold::FOLD_DENSE_UP_TO;
 pub use lens::{Lens, Parameter, RodLens};
 pub use measure::{Measure, Quantity};
 pub use options::ContinuationOptions;
