@@ -162,6 +162,57 @@ impl BorderedJacobian {
     }
 }
 
+/// What K = [F_x b; cᵀ 0] says of F_x's singularity: K[v; g] = e and
+/// Kᵀ[w; ·] = e (e the last unit vector) — g vanishes exactly where F_x is
+/// singular, with v, w its right and left null vectors there.
+pub(super) struct Singularity {
+    pub g: f64,
+    pub v: DVector<f64>,
+    pub w: DVector<f64>,
+}
+
+impl BorderedJacobian {
+    /// g, v and w (see [`Singularity`]); None where a solve fails.
+    pub fn singularity(&mut self) -> Option<Singularity> {
+        let n = self.column.len();
+        let mut e = DVector::zeros(n + 1);
+        e[n] = 1.0;
+        let vg = self.solve(&e)?;
+        let w = self.solve_transposed(&e)?.rows(0, n).into_owned();
+        Some(Singularity {
+            g: vg[n],
+            v: vg.rows(0, n).into_owned(),
+            w,
+        })
+    }
+}
+
+/// wᵀF_xx[d, ·] at x, as a column: the central difference of the
+/// transposed products F_x(x ± εd)ᵀw with ε = 10⁻⁶ max(1, ‖x‖∞)/‖d‖∞
+/// (F_xx is symmetric in its two arguments, so one difference along d
+/// gives the whole row; zero along a zero direction). `linearize` gives
+/// F_x at a point, the parameters held.
+pub(super) fn curvature_row<E>(
+    linearize: impl Fn(&[f64]) -> Result<Linearization, E>,
+    x: &[f64],
+    d: &DVector<f64>,
+    w: &DVector<f64>,
+) -> Result<DVector<f64>, E> {
+    if d.amax() == 0.0 {
+        return Ok(DVector::zeros(x.len()));
+    }
+    let eps = 1e-6 * x.iter().fold(1.0f64, |m, v| m.max(v.abs())) / d.amax();
+    let shifted = |sign: f64| -> Vec<f64> {
+        x.iter()
+            .zip(d.iter())
+            .map(|(a, e)| a + sign * eps * e)
+            .collect()
+    };
+    let up = linearize(&shifted(1.0))?.mul_transposed(w);
+    let down = linearize(&shifted(-1.0))?.mul_transposed(w);
+    Ok((up - down) / (2.0 * eps))
+}
+
 /// The solution of (K + U Vᵀ) z = r by the Sherman–Morrison–Woodbury
 /// formula (Golub & Van Loan, *Matrix Computations*, 4th ed., §2.1.4):
 /// z = y − Z C⁻¹ Vᵀ y with K y = r, K Z = U and the small capacitance
@@ -200,16 +251,6 @@ impl Run<'_> {
         let mut r = DVector::zeros(x.len());
         fx.evaluate(self.family, x, p, &mut r)?;
         Ok((r, fx))
-    }
-
-    /// wᵀ F_x at (x, p), as a column (F_xᵀ w).
-    pub(super) fn transposed_product(
-        &self,
-        x: &[f64],
-        p: f64,
-        w: &DVector<f64>,
-    ) -> Result<DVector<f64>, PointError> {
-        Ok(self.linearization(x, p)?.1.mul_transposed(w))
     }
 
     /// F_x at (x, p) times d.

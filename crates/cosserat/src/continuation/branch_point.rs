@@ -50,7 +50,9 @@
 
 use nalgebra::DVector;
 
-use super::bordering::{low_rank_solve, null_vectors, BorderedJacobian};
+use super::bordering::{
+    curvature_row, low_rank_solve, null_vectors, BorderedJacobian, Singularity,
+};
 use super::fold::unit;
 use super::Run;
 
@@ -135,38 +137,13 @@ impl Run<'_> {
         let fp = self.family.parameter_derivative(x, p).map_err(fail)?;
         let singular = "the bordered matrix [F_x b; cᵀ 0] is singular";
         let mut k = BorderedJacobian::new(fx, b.clone(), c.clone()).ok_or(singular)?;
-        let e = unit(n + 1, n);
-        let vg = k.solve(&e).ok_or(singular)?;
-        let (v, g) = (vg.rows(0, n).into_owned(), vg[n]);
-        let w = k
-            .solve_transposed(&e)
-            .ok_or(singular)?
-            .rows(0, n)
-            .into_owned();
+        let Singularity { g, v, w } = k.singularity().ok_or(singular)?;
         let minus_fp = DVector::from_iterator(n + 1, fp.iter().map(|v| -v).chain([0.0]));
         let v0 = k.solve(&minus_fp).ok_or(singular)?.rows(0, n).into_owned();
-        // wᵀ F_xx[d, ·] by a central difference of wᵀF_x along d (zero
-        // along a zero direction: v₀ = 0 where F_p = 0, e.g. a straight
-        // column in its load).
-        let along = |d: &DVector<f64>| -> Result<DVector<f64>, String> {
-            if d.amax() == 0.0 {
-                return Ok(DVector::zeros(n));
-            }
-            let eps = 1e-6 * x.iter().fold(1.0f64, |m, v| m.max(v.abs())) / d.amax();
-            let shifted = |sign: f64| -> Vec<f64> {
-                x.iter()
-                    .zip(d.iter())
-                    .map(|(a, e)| a + sign * eps * e)
-                    .collect()
-            };
-            let up = self
-                .transposed_product(&shifted(1.0), p, &w)
-                .map_err(fail)?;
-            let down = self
-                .transposed_product(&shifted(-1.0), p, &w)
-                .map_err(fail)?;
-            Ok((up - down) / (2.0 * eps))
-        };
+        // wᵀ F_xx[d, ·] along v and v₀ (zero along a zero direction: v₀ = 0
+        // where F_p = 0, e.g. a straight column in its load).
+        let linearize = |y: &[f64]| self.linearization(y, p).map(|l| l.1);
+        let along = |d: &DVector<f64>| curvature_row(linearize, x, d, &w).map_err(fail);
         let h = 1e-6 * p.abs().max(1.0);
         let (plus, minus) = (
             self.linearization(x, p + h).map_err(fail)?.1,

@@ -25,7 +25,7 @@ use std::sync::Arc;
 
 use nalgebra::DVector;
 
-use super::bordering::{low_rank_solve, BorderedJacobian};
+use super::bordering::{curvature_row, low_rank_solve, BorderedJacobian, Singularity};
 use super::corrector::Linearization;
 
 use super::{ContinuationError, Family, FamilyError, Lens, PointError};
@@ -230,14 +230,7 @@ impl Augmented<'_> {
         let (x, p1, p2) = (&z[..n], z[n], z[n + 1]);
         let (mut f, fx) = self.evaluate(z)?;
         let mut k = BorderedJacobian::new(fx, b.clone(), c.clone()).ok_or_else(singular)?;
-        let e = super::fold::unit(n + 1, n);
-        let vg = k.solve(&e).ok_or_else(singular)?;
-        let (v, g) = (vg.rows(0, n).into_owned(), vg[n]);
-        let w = k
-            .solve_transposed(&e)
-            .ok_or_else(singular)?
-            .rows(0, n)
-            .into_owned();
+        let Singularity { g, v, w } = k.singularity().ok_or_else(singular)?;
         let here = self.slice(p2);
         let fp1 = here.parameter_derivative(x, p1)?;
         let h2 = 1e-6 * p2.abs().max(1.0);
@@ -246,24 +239,20 @@ impl Augmented<'_> {
         up2.residual_only(x, p1, &mut up)?;
         down2.residual_only(x, p1, &mut down)?;
         let fp2 = (up - down) / (2.0 * h2);
-        // g_x by a central difference of wᵀF_x along v.
-        let eps = 1e-6 * x.iter().fold(1.0f64, |m, v| m.max(v.abs())) / v.amax();
-        let shifted =
-            |sign: f64| -> Vec<f64> { x.iter().zip(&v).map(|(a, d)| a + sign * eps * d).collect() };
-        let along = |family: &Family, x: &[f64], p: f64| -> Result<Linearization, PointError> {
-            let mut fx = Linearization::of(family);
-            let mut r = DVector::zeros(n);
-            fx.evaluate(family, x, p, &mut r)?;
-            Ok(fx)
-        };
-        let gx = -(along(&here, &shifted(1.0), p1)?.mul_transposed(&w)
-            - along(&here, &shifted(-1.0), p1)?.mul_transposed(&w))
-            / (2.0 * eps);
+        let linearized =
+            |family: &Family, x: &[f64], p: f64| -> Result<Linearization, PointError> {
+                let mut fx = Linearization::of(family);
+                let mut r = DVector::zeros(n);
+                fx.evaluate(family, x, p, &mut r)?;
+                Ok(fx)
+            };
+        let gx = -curvature_row(|y: &[f64]| linearized(&here, y, p1), x, &v, &w)?;
         let h1 = 1e-6 * p1.abs().max(1.0);
-        let gp1 = -w.dot(&(along(&here, x, p1 + h1)?.mul(&v) - along(&here, x, p1 - h1)?.mul(&v)))
-            / (2.0 * h1);
-        let gp2 =
-            -w.dot(&(along(&up2, x, p1)?.mul(&v) - along(&down2, x, p1)?.mul(&v))) / (2.0 * h2);
+        let gp1 = -w.dot(
+            &(linearized(&here, x, p1 + h1)?.mul(&v) - linearized(&here, x, p1 - h1)?.mul(&v)),
+        ) / (2.0 * h1);
+        let gp2 = -w.dot(&(linearized(&up2, x, p1)?.mul(&v) - linearized(&down2, x, p1)?.mul(&v)))
+            / (2.0 * h2);
         let mut residual = DVector::zeros(m - 1);
         let mut gradient = DVector::zeros(m);
         gradient.rows_mut(0, n).copy_from(&gx);

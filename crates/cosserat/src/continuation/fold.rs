@@ -31,7 +31,9 @@
 
 use nalgebra::DVector;
 
-use super::bordering::{low_rank_solve, null_vectors, BorderedJacobian};
+use super::bordering::{
+    curvature_row, low_rank_solve, null_vectors, BorderedJacobian, Singularity,
+};
 use super::Run;
 
 /// Newton iterations before the augmented system is given up.
@@ -110,26 +112,11 @@ impl Run<'_> {
         let (f, fx) = self.linearization(x, p).map_err(fail)?;
         let singular = "the bordered matrix [F_x b; cᵀ 0] is singular";
         let mut k = BorderedJacobian::new(fx, b.clone(), c.clone()).ok_or(singular)?;
-        let e = unit(n + 1, n);
-        let vg = k.solve(&e).ok_or(singular)?;
-        let (v, g) = (vg.rows(0, n).into_owned(), vg[n]);
-        let w = k
-            .solve_transposed(&e)
-            .ok_or(singular)?
-            .rows(0, n)
-            .into_owned();
+        let Singularity { g, v, w } = k.singularity().ok_or(singular)?;
         let fp = self.family.parameter_derivative(x, p).map_err(fail)?;
         // g_x = −wᵀ (∂/∂ε F_x(x + εv)), g_p = −wᵀ (∂/∂p F_x) v.
-        let eps = 1e-6 * x.iter().fold(1.0f64, |m, v| m.max(v.abs())) / v.amax();
-        let shifted =
-            |sign: f64| -> Vec<f64> { x.iter().zip(&v).map(|(a, d)| a + sign * eps * d).collect() };
-        let up = self
-            .transposed_product(&shifted(1.0), p, &w)
-            .map_err(fail)?;
-        let down = self
-            .transposed_product(&shifted(-1.0), p, &w)
-            .map_err(fail)?;
-        let gx = -(up - down) / (2.0 * eps);
+        let linearize = |y: &[f64]| self.linearization(y, p).map(|l| l.1);
+        let gx = -curvature_row(linearize, x, &v, &w).map_err(fail)?;
         let h = 1e-6 * p.abs().max(1.0);
         let up = self.product(x, p + h, &v).map_err(fail)?;
         let down = self.product(x, p - h, &v).map_err(fail)?;
@@ -140,6 +127,7 @@ impl Run<'_> {
         residual[n] = g;
         let column = DVector::from_iterator(n + 1, (&fp - b).iter().copied().chain([0.0]));
         let row = DVector::from_iterator(n + 1, (&gx - c).iter().copied().chain([gp]));
+        let e = unit(n + 1, n);
         let step = low_rank_solve(|r| k.solve(r), &[column, e.clone()], &[e, row], &residual)
             .ok_or("the augmented Jacobian is singular (not a simple fold)")?;
         let gradient = (gx.norm_squared() + gp * gp).sqrt();
