@@ -127,6 +127,10 @@ pub(super) struct Ascent {
     pub iterations: usize,
     /// Why it ended.
     pub end: AscentEnd,
+    /// The quasi-Newton model of −R̂'s Hessian where it ended (None where no
+    /// step was taken from a point with a gradient): the warm start of a
+    /// polish of the same design on another mesh.
+    pub hessian: Option<DMatrix<f64>>,
 }
 
 /// Maximizes `slope`'s value over the box `bounds` from `start` by projected
@@ -138,12 +142,15 @@ pub(super) struct Ascent {
 /// value ([`ASCENT_TOLERANCE`]). Deterministic (sequential). Written here
 /// because argmin's L-BFGS has no bounds and the box is part of the
 /// problem (the paper's (60)); 7 variables make the dense update cheap.
+/// `warm` is a Hessian model to start from (another mesh's, at a nearby
+/// point), else a diagonal guess rescaled after the first step.
 pub(super) fn ascend_in_box(
     start: &[f64],
     bounds: &[(f64, f64)],
     iterations: usize,
     slope: &dyn Fn(&[f64]) -> Option<Slope>,
     stop: &dyn Fn() -> bool,
+    warm: Option<&DMatrix<f64>>,
 ) -> Ascent {
     let project = |p: &[f64]| -> Vec<f64> {
         p.iter()
@@ -156,6 +163,7 @@ pub(super) fn ascend_in_box(
         evaluations: 0,
         iterations: 0,
         end: AscentEnd::Infeasible,
+        hessian: None,
     };
     let mut x = project(start);
     if stop() {
@@ -172,23 +180,29 @@ pub(super) fn ascend_in_box(
         return ascent;
     };
     let widths: Vec<f64> = bounds.iter().map(|(lo, hi)| hi - lo).collect();
-    let mut hessian = initial_hessian(&widths, &g);
+    // Whether `hessian` is the diagonal guess, to be rescaled by the first
+    // measured curvature before its first update.
+    let mut guessed = warm.is_none();
+    let mut hessian = warm.map_or_else(|| initial_hessian(&widths, &g), Clone::clone);
     loop {
-        if projected_gradient(&x, &g, bounds) <= ASCENT_TOLERANCE * f.abs() {
-            ascent.end = AscentEnd::Converged;
-            return ascent;
-        }
-        if ascent.iterations >= iterations {
-            ascent.end = AscentEnd::Capped;
+        let pg = projected_gradient(&x, &g, bounds);
+        if pg <= ASCENT_TOLERANCE * f.abs() || ascent.iterations >= iterations {
+            ascent.end = if pg <= ASCENT_TOLERANCE * f.abs() {
+                AscentEnd::Converged
+            } else {
+                AscentEnd::Capped
+            };
+            ascent.hessian = Some(hessian);
             return ascent;
         }
         ascent.iterations += 1;
-        let mut held = held_at_bounds(&x, &g, bounds);
+        let mut held = held_at_bounds(&x, &g, bounds, &widths, pg);
         let d = loop {
             let d = match ascent_direction(&hessian, &g, &held) {
                 Some(d) if d.iter().zip(&g).map(|(a, b)| a * b).sum::<f64>() > 0.0 => d,
                 _ => {
                     hessian = initial_hessian(&widths, &g);
+                    guessed = true;
                     ascent_direction(&hessian, &g, &held)
                         .expect("a positive diagonal is positive definite")
                 }
@@ -204,34 +218,24 @@ pub(super) fn ascend_in_box(
                 held[i] = true;
             }
         };
-        let mut t = 1.0;
-        let accepted = loop {
-            if stop() {
+        let path = ProjectedPath {
+            x: &x,
+            d: &d,
+            g: &g,
+            held: &held,
+            bounds,
+        };
+        let (next, fnext, gnext) = match path.search(f, slope, stop, &mut ascent.evaluations) {
+            Step::Accepted(point) => point,
+            Step::Flat => {
+                ascent.end = AscentEnd::Flat;
+                ascent.hessian = Some(hessian);
+                return ascent;
+            }
+            Step::Stopped => {
                 ascent.end = AscentEnd::Stopped;
                 return ascent;
             }
-            let trial = project(&x.iter().zip(&d).map(|(a, b)| a + t * b).collect::<Vec<_>>());
-            let rise: f64 = trial
-                .iter()
-                .zip(&x)
-                .zip(&g)
-                .map(|((a, b), c)| (a - b) * c)
-                .sum();
-            ascent.evaluations += 1;
-            if let Some((ft, gt)) = slope(&trial) {
-                // Armijo on the projected path: f(x_t) ≥ f + σ gᵀ(x_t − x).
-                if ft >= f + 1e-4 * rise && ft >= f {
-                    break Some((trial, ft, gt));
-                }
-            }
-            t *= 0.5;
-            if t < 1e-12 {
-                break None;
-            }
-        };
-        let Some((next, fnext, gnext)) = accepted else {
-            ascent.end = AscentEnd::Flat;
-            return ascent;
         };
         ascent.best = Some((next.clone(), fnext));
         let Some(gnext) = gnext else {
@@ -241,9 +245,199 @@ pub(super) fn ascend_in_box(
         // Minimizing −f: s = Δx, y = −Δg.
         let s: Vec<f64> = next.iter().zip(&x).map(|(a, b)| a - b).collect();
         let y: Vec<f64> = g.iter().zip(&gnext).map(|(a, b)| a - b).collect();
+        if guessed {
+            guessed = !rescale(&mut hessian, &widths, &s, &y);
+        }
         bfgs_update(&mut hessian, &s, &y);
         (x, f, g) = (next, fnext, gnext);
     }
+}
+
+/// How a line search ended.
+enum Step {
+    /// The accepted point, its value and gradient (if any).
+    Accepted((Vec<f64>, f64, Option<Vec<f64>>)),
+    /// No step of at least 1e-12 increased the value.
+    Flat,
+    /// `stop()` turned true.
+    Stopped,
+}
+
+/// The projected search path P(x + t d) of one iteration, with the held
+/// variables on their bounds for every t.
+struct ProjectedPath<'a> {
+    x: &'a [f64],
+    d: &'a [f64],
+    g: &'a [f64],
+    held: &'a [bool],
+    bounds: &'a [(f64, f64)],
+}
+
+impl ProjectedPath<'_> {
+    /// The point at step t, P(x + t d).
+    fn at(&self, t: f64) -> Vec<f64> {
+        (0..self.x.len())
+            .map(|i| {
+                let (lo, hi) = self.bounds[i];
+                (self.x[i] + t * self.d[i]).clamp(lo, hi)
+            })
+            .collect()
+    }
+
+    /// The first breakpoint: the least t > 0 at which a free variable
+    /// reaches a bound (∞ when none does).
+    fn breakpoint(&self) -> f64 {
+        (0..self.x.len())
+            .filter(|&i| !self.held[i] && self.d[i] != 0.0)
+            .map(|i| {
+                let (lo, hi) = self.bounds[i];
+                let room = if self.d[i] > 0.0 {
+                    hi - self.x[i]
+                } else {
+                    lo - self.x[i]
+                };
+                room / self.d[i]
+            })
+            .filter(|t| *t > 0.0)
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// Armijo backtracking along the path from t = 1: f(x_t) ≥ f +
+    /// σ gᵀ(x_t − x) and f(x_t) ≥ f. Where t = 1 fails and the first
+    /// breakpoint lies before it, the breakpoint is tried next (so that a
+    /// variable the step pushes through a bound lands on it, instead of
+    /// halvings that leave it just inside); then t halves, down to 1e-12.
+    fn search(
+        &self,
+        f: f64,
+        slope: &dyn Fn(&[f64]) -> Option<Slope>,
+        stop: &dyn Fn() -> bool,
+        evaluations: &mut usize,
+    ) -> Step {
+        let breakpoint = self.breakpoint();
+        let mut t: f64 = 1.0;
+        let mut kink = None;
+        while t >= 1e-12 {
+            if stop() {
+                return Step::Stopped;
+            }
+            let trial = self.at(t);
+            let rise: f64 = trial
+                .iter()
+                .zip(self.x)
+                .zip(self.g)
+                .map(|((a, b), c)| (a - b) * c)
+                .sum();
+            *evaluations += 1;
+            if let Some((ft, gt)) = slope(&trial) {
+                if ft >= f + 1e-4 * rise && ft >= f {
+                    if gt.is_none() && kink.is_none() && t > 1e-6 {
+                        // A step onto a kink (two critical loads met): a
+                        // shorter one may stay on the smooth side.
+                        kink = Some((trial, ft, gt));
+                        t *= 0.5;
+                        continue;
+                    }
+                    let accepted = (trial, ft, gt);
+                    return if t == 1.0 {
+                        self.extend(accepted, breakpoint, slope, stop, evaluations)
+                    } else {
+                        Step::Accepted(accepted)
+                    };
+                }
+                if let Some(kink) = kink.take() {
+                    return Step::Accepted(kink);
+                }
+            }
+            t = if t == 1.0 && breakpoint < 1.0 {
+                breakpoint
+            } else {
+                0.5 * t
+            };
+        }
+        kink.map_or(Step::Flat, Step::Accepted)
+    }
+}
+
+impl ProjectedPath<'_> {
+    /// The slope of f along d at a point with gradient `g` (over the free
+    /// variables, those the path moves).
+    fn slope_along(&self, g: &[f64]) -> f64 {
+        (0..self.d.len())
+            .filter(|&i| !self.held[i])
+            .map(|i| g[i] * self.d[i])
+            .sum()
+    }
+
+    /// Goes on past an accepted full step while f still rises steeply
+    /// along the path (its slope there above half the slope at x: the
+    /// quasi-Newton model's curvature is too large, as where R̂ is nearly
+    /// linear on the way to a bound): t grows to the secant estimate of
+    /// the slope's zero, at least ×2 and at most ×8, never past the first
+    /// breakpoint, while f increases. Without this a search creeps to a
+    /// bound by steps growing ×2–3 per iteration.
+    fn extend(
+        &self,
+        accepted: (Vec<f64>, f64, Option<Vec<f64>>),
+        breakpoint: f64,
+        slope: &dyn Fn(&[f64]) -> Option<Slope>,
+        stop: &dyn Fn() -> bool,
+        evaluations: &mut usize,
+    ) -> Step {
+        let s0 = self.slope_along(self.g);
+        let (mut t, mut best) = (1.0, accepted);
+        for _ in 0..EXTENSIONS {
+            let Some(g) = &best.2 else { break };
+            let s1 = self.slope_along(g);
+            if !(s1 > 0.5 * s0) || t >= breakpoint {
+                break;
+            }
+            let secant = if s1 < s0 {
+                t * s0 / (s0 - s1)
+            } else {
+                f64::INFINITY
+            };
+            let next = secant.clamp(2.0 * t, 8.0 * t).min(breakpoint);
+            if stop() {
+                return Step::Stopped;
+            }
+            let trial = self.at(next);
+            *evaluations += 1;
+            match slope(&trial) {
+                Some((ft, gt)) if ft > best.1 && gt.is_some() => {
+                    (t, best) = (next, (trial, ft, gt));
+                }
+                _ => break,
+            }
+        }
+        Step::Accepted(best)
+    }
+}
+
+/// The most extensions of one accepted full step ([`ProjectedPath::extend`]).
+const EXTENSIONS: usize = 8;
+
+/// Rescales the diagonal first guess B0 = diag(1/w_i²)/θ to the curvature
+/// the first step measured, B0 = κ diag(1/w_i²) with κ = ỹᵀỹ/s̃ᵀỹ in the
+/// width-scaled variables x̃ = x/w (Nocedal & Wright, eq. 6.20, before the
+/// first update): the guess limits the first step to 5 % of the box, and
+/// left unscaled it keeps later steps short where R̂ is nearly linear.
+/// Whether it was rescaled (not where no positive curvature was measured).
+fn rescale(b: &mut DMatrix<f64>, widths: &[f64], s: &[f64], y: &[f64]) -> bool {
+    let sy: f64 = s.iter().zip(y).map(|(a, b)| a * b).sum();
+    let yy: f64 = y.iter().zip(widths).map(|(a, w)| (a * w).powi(2)).sum();
+    if !(sy > 0.0 && yy > 0.0) {
+        return false;
+    }
+    let kappa = yy / sy;
+    *b = DMatrix::from_fn(widths.len(), widths.len(), |i, j| {
+        if i == j {
+            kappa / (widths[i] * widths[i])
+        } else {
+            0.0
+        }
+    });
+    true
 }
 
 /// max_i |x_i − P(x_i + g_i)|: zero exactly at a KKT point of the box.
@@ -255,14 +449,29 @@ fn projected_gradient(x: &[f64], g: &[f64], bounds: &[(f64, f64)]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// The variables at a bound that the gradient pushes outwards (held there).
-fn held_at_bounds(x: &[f64], g: &[f64], bounds: &[(f64, f64)]) -> Vec<bool> {
-    x.iter()
-        .zip(g)
-        .zip(bounds)
-        .map(|((xi, gi), (lo, hi))| (*xi <= *lo && *gi < 0.0) || (*xi >= *hi && *gi > 0.0))
+/// The ε-active variables (Bertsekas 1982): within ε_i of a bound that the
+/// gradient pushes them to, ε_i = min([`ACTIVE_FRACTION`] w_i, pg) with pg
+/// the projected-gradient norm (so that ε → 0 at a KKT point and a free
+/// variable near the optimum is never mistaken for a bound one). They are
+/// held on that bound for the iteration.
+fn held_at_bounds(
+    x: &[f64],
+    g: &[f64],
+    bounds: &[(f64, f64)],
+    widths: &[f64],
+    pg: f64,
+) -> Vec<bool> {
+    (0..x.len())
+        .map(|i| {
+            let (lo, hi) = bounds[i];
+            let eps = (ACTIVE_FRACTION * widths[i]).min(pg);
+            (x[i] <= lo + eps && g[i] < 0.0) || (x[i] >= hi - eps && g[i] > 0.0)
+        })
         .collect()
 }
+
+/// The largest ε of the ε-active set, as a fraction of a bound's width.
+const ACTIVE_FRACTION: f64 = 1e-3;
 
 /// The free variables on a bound that `d` moves outwards.
 fn stepping_out(x: &[f64], d: &[f64], bounds: &[(f64, f64)], held: &[bool]) -> Vec<usize> {
@@ -275,14 +484,19 @@ fn stepping_out(x: &[f64], d: &[f64], bounds: &[(f64, f64)], held: &[bool]) -> V
 }
 
 /// d solving B_ff d_f = g_f on the free variables (the quasi-Newton step
-/// of the reduced problem), 0 on the held; None where B_ff is not positive
+/// of the reduced problem), g_i/B_ii on the held; None where B_ff is not positive
 /// definite (by round-off).
 fn ascent_direction(hessian: &DMatrix<f64>, g: &[f64], held: &[bool]) -> Option<Vec<f64>> {
     let free: Vec<usize> = (0..g.len()).filter(|&i| !held[i]).collect();
     let reduced = DMatrix::from_fn(free.len(), free.len(), |i, j| hessian[(free[i], free[j])]);
     let rhs = DVector::from_iterator(free.len(), free.iter().map(|&i| g[i]));
     let step = reduced.cholesky()?.solve(&rhs);
-    let mut d = vec![0.0; g.len()];
+    // The held variables move along their gradient scaled by the model's
+    // diagonal (Bertsekas 1982), onto their bound as t grows: continuous
+    // in t, so that short steps change them little.
+    let mut d: Vec<f64> = (0..g.len())
+        .map(|i| if held[i] { g[i] / hessian[(i, i)] } else { 0.0 })
+        .collect();
     for (k, &i) in free.iter().enumerate() {
         d[i] = step[k];
     }
@@ -348,7 +562,7 @@ mod tests {
             Some((f, Some(vec![-qd[0], -qd[1]])))
         };
         let bounds = [(-1.0, 1.0), (-4.0, 4.0)];
-        let ascent = ascend_in_box(&[0.0, 0.0], &bounds, 200, &slope, &|| false);
+        let ascent = ascend_in_box(&[0.0, 0.0], &bounds, 200, &slope, &|| false, None);
         assert_eq!(ascent.end, AscentEnd::Converged, "{ascent:?}");
         let (x, _) = ascent.best.expect("a point");
         let x1 = t[1] - q[1][0] * (1.0 - t[0]) / q[1][1];
@@ -360,7 +574,7 @@ mod tests {
     #[test]
     fn ascent_stops_where_there_is_no_gradient() {
         let slope = |x: &[f64]| -> Option<Slope> { Some((-x[0].abs(), None)) };
-        let ascent = ascend_in_box(&[0.5], &[(-1.0, 1.0)], 10, &slope, &|| false);
+        let ascent = ascend_in_box(&[0.5], &[(-1.0, 1.0)], 10, &slope, &|| false, None);
         assert_eq!(ascent.end, AscentEnd::NoGradient);
         assert_eq!(ascent.iterations, 0);
     }

@@ -19,6 +19,7 @@
 //! whose box holds designs reaching 1.9458).
 
 use super::{ArmDesign, ArmOptimum, ArmProblem, ArmScene, SearchOptions, SearchProgress};
+use crate::stability::StabilityOptions;
 
 /// The relative discretization error of R̂ a reported optimum may have.
 /// The paper gives R* to two or three digits; this is four.
@@ -93,6 +94,36 @@ impl MeshStudy {
     }
 }
 
+/// The Lagrange order of the elements of a [`ReachLimit`] (at least; the
+/// search's own where higher): eigenvalues converge at O(h⁴) on quadratic
+/// elements against O(h²) on linear ones, so three modest meshes give the
+/// limit to ~1e-8 where linear elements on N, 2N, 4N leave ~1e-6.
+pub const LIMIT_ORDER: usize = 2;
+
+/// The fewest elements of a [`ReachLimit`]'s coarsest mesh.
+pub const LIMIT_MIN_ELEMENTS: usize = 8;
+
+/// The mesh-converged optimum R*(N → ∞): the reported optimum polished
+/// again on three meshes of [`LIMIT_ORDER`] elements (max(N/4, 8), twice
+/// and four times that, N the search's mesh), and Richardson's limit of
+/// those optima at their measured order with its bound
+/// ([`MeshStudy::converged`]: the finest mesh's estimated error).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReachLimit {
+    /// The Lagrange order of the study's elements.
+    pub order: usize,
+    /// The optimum on the three meshes (local optima).
+    pub study: MeshStudy,
+}
+
+impl ReachLimit {
+    /// (R*(N → ∞), its error bound); None where the order is not measured
+    /// (undecided, never a value).
+    pub fn converged(&self) -> Option<(f64, f64)> {
+        self.study.converged()
+    }
+}
+
 /// What became of the search's optimum on finer meshes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Verdict {
@@ -141,6 +172,14 @@ impl ArmProblem {
         p
     }
 
+    /// This problem on `elements` elements of Lagrange order `order`.
+    fn on_mesh_of_order(&self, elements: usize, order: usize) -> ArmProblem {
+        let mut p = self.clone();
+        p.stability = StabilityOptions::new(elements, order, p.stability.eigenvalues())
+            .expect("at least one element of order 1 to 3");
+        p
+    }
+
     /// R̂ of the design c2..cM on N (its value `reach`, already known), 2N
     /// and 4N elements, N = this problem's mesh; the evaluations used.
     ///
@@ -162,6 +201,24 @@ impl ArmProblem {
         design: &ArmDesign,
         iterations: u64,
     ) -> (MeshStudy, usize) {
+        let (study, _, evaluations) = self.mesh_checks(scene, design, iterations);
+        (study, evaluations)
+    }
+
+    /// [`Self::mesh_study`] and, where the values are re-polished optima,
+    /// the [`ReachLimit`] of the optimum from meshes of order-2 elements;
+    /// the evaluations used by both.
+    ///
+    /// The order-2 polish on the coarsest limit mesh goes first, from the
+    /// design; its final quasi-Newton Hessian (R̂'s curvature hardly depends
+    /// on the mesh) warm-starts the four others, which run in parallel:
+    /// the order-2 meshes from its optimum, 2N and 4N from the design.
+    fn mesh_checks(
+        &self,
+        scene: &ArmScene,
+        design: &ArmDesign,
+        iterations: u64,
+    ) -> (MeshStudy, Option<ReachLimit>, usize) {
         let n = self.stability.elements();
         let rest = &design.shape_coefficients[1..];
         // Without a gradient (an actuator limit) a re-polish is a whole
@@ -182,21 +239,55 @@ impl ArmProblem {
                 reach: [design.reach, r2.unwrap_or(f64::NAN), r4.unwrap_or(f64::NAN)],
                 local_optima: false,
             };
-            return (study, 2);
+            return (study, None, 2);
         }
         let mut evaluations = if own { 2 } else { 0 };
-        let mut polished = |m: usize| {
-            let (d, used) = self.on_mesh(m).polish(scene, rest, iterations, &|| false);
-            evaluations += used;
-            d.map_or(f64::NAN, |d| d.reach)
+        let order = self.stability.order().max(LIMIT_ORDER);
+        let base = (n / 4).max(LIMIT_MIN_ELEMENTS);
+        let coarse = self.on_mesh_of_order(base, order).polish_from(
+            scene,
+            rest,
+            iterations,
+            &|| false,
+            None,
+        );
+        evaluations += coarse.evaluations;
+        let hessian = coarse.hessian.as_ref();
+        let from_coarse = coarse
+            .design
+            .as_ref()
+            .map_or(rest, |d| &d.shape_coefficients[1..]);
+        let jobs = [
+            (self.on_mesh_of_order(2 * base, order), from_coarse),
+            (self.on_mesh_of_order(4 * base, order), from_coarse),
+            (self.on_mesh(2 * n), rest),
+            (self.on_mesh(4 * n), rest),
+        ];
+        let polished = super::search::in_parallel(jobs.len(), &|| false, |k, _| {
+            let (problem, start) = &jobs[k];
+            Some(problem.polish_from(scene, start, iterations, &|| false, hessian))
+        });
+        let mut value = |p: Option<super::search::Polished>| {
+            let p = p.expect("a job without a stop test runs");
+            evaluations += p.evaluations;
+            p.design.map_or(f64::NAN, |d| d.reach)
         };
-        let (r2, r4) = (polished(2 * n), polished(4 * n));
+        let values: Vec<f64> = polished.into_iter().map(&mut value).collect();
+        let [l2, l4, r2, r4] = <[f64; 4]>::try_from(values).expect("four jobs");
         let study = MeshStudy {
             elements: [n, 2 * n, 4 * n],
             reach: [design.reach, r2, r4],
             local_optima: true,
         };
-        (study, evaluations)
+        let limit = coarse.design.map(|d| ReachLimit {
+            order,
+            study: MeshStudy {
+                elements: [base, 2 * base, 4 * base],
+                reach: [d.reach, l2, l4],
+                local_optima: true,
+            },
+        });
+        (study, limit, evaluations)
     }
 
     /// A reported design that is not a reach optimum (the map's 'Q', the
@@ -240,8 +331,9 @@ impl ArmProblem {
         let mut optimum = optimum;
         let mut rejected = vec![];
         loop {
-            let (study, used) = problem.mesh_study(scene, &optimum.design, opts.iterations);
+            let (study, limit, used) = problem.mesh_checks(scene, &optimum.design, opts.iterations);
             optimum.evaluations += used;
+            optimum.limit = limit;
             let fine = 4 * problem.stability.elements();
             let verdict = if study.resolved(tolerance) {
                 Some(if rejected.is_empty() {
