@@ -518,13 +518,14 @@ fn report_mesh(opt: &ArmOptimum) {
         _ => "error undecided (the differences do not converge geometrically)".into(),
     };
     println!(
-        "mesh      R* = {:.6} / {:.6} / {:.6} on {} / {} / {} elements: {error}; {}",
+        "mesh      R* = {:.6} / {:.6} / {:.6} on {} / {} / {} elements of order {}: {error}; {}",
         s.reach[0],
         s.reach[1],
         s.reach[2],
         s.elements[0],
         s.elements[1],
         s.elements[2],
+        opt.mesh.order(),
         r.verdict.name()
     );
     if let Some(l) = &opt.limit {
@@ -545,10 +546,12 @@ fn report_mesh(opt: &ArmOptimum) {
     for (n, coarse, fine) in &r.rejected {
         eprintln!(
             "warning: R* = {coarse:.6} on {n} elements but {fine:.6} on {}: the mesh does not \
-             resolve the optimum (tolerance {:.0e}); searched again on {} elements",
+             resolve the optimum (tolerance {:.0e}); searched again, reported on {} elements \
+             of order {}",
             4 * n,
             cosserat::study::arm::REACH_TOLERANCE,
-            4 * n
+            opt.mesh.elements(),
+            opt.mesh.order()
         );
     }
     if r.verdict == cosserat::study::arm::Verdict::Unresolved {

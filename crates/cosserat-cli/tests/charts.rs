@@ -595,6 +595,7 @@ fn arm_design(reach: f64, c: [f64; 3], b: [f64; 2]) -> cosserat::study::arm::Arm
         scene: ArmScene::default(),
         resolution: None,
         limit: None,
+        mesh: cosserat::stability::StabilityOptions::default(),
     }
 }
 

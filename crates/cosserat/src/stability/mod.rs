@@ -13,7 +13,9 @@ mod fixed_shape_spatial;
 mod second_variation;
 
 pub use fixed_shape::{critical_load, CriticalLoad, FixedShape};
-pub use fixed_shape_gradient::{critical_load_gradient, LoadGradient, SIMPLE_GAP};
+pub use fixed_shape_gradient::{
+    critical_load_gradient, critical_load_gradients, BlockLoad, LoadGradient, SIMPLE_GAP,
+};
 pub use fixed_shape_spatial::{critical_load_spatial, SpatialShape};
 pub use second_variation::{Block, FiniteElements, FormCoefficients};
 

@@ -141,6 +141,9 @@ pub struct ArmOptimum {
     /// ([`ArmProblem::resolve`]); None where no check was made or the
     /// values have no gradient to polish with (an actuator limit).
     pub limit: Option<ReachLimit>,
+    /// The discretization the design was optimized on (the search's, or
+    /// the finer one [`ArmProblem::resolve`] searched again on).
+    pub mesh: StabilityOptions,
 }
 
 /// How far a search has come: what `cosserat optimize --resume` keeps of an

@@ -6,14 +6,17 @@
 //! γ_crit the mesh overestimates most: with a ±10 box at N = 100 linear
 //! elements the Sec. 4.4 arm reports R* inflated by 18 %.
 //!
-//! Every reported optimum is therefore evaluated again on 2N and 4N
+//! Every reported optimum is therefore polished again on 2N and 4N
 //! elements ([`MeshStudy`]): the measured convergence order p and
 //! Richardson's estimate of the error of R̂_N. When the estimated error
 //! (or the spread of the three values) exceeds [`REACH_TOLERANCE`], the
-//! search is redone on the finest mesh, and its optimum checked there the
-//! same way, until the reported design is an optimum of a discretization
-//! that resolves it ([`Verdict::Refined`]) or [`MAX_ELEMENTS`] is reached
-//! ([`Verdict::Unresolved`], said so). Re-polishing the rejected design
+//! search is redone on a finer discretization ([`ArmProblem::refined`]:
+//! order-2 elements first, then 4× the elements), and its optimum checked
+//! there the same way, until the reported design is an optimum of a
+//! discretization that resolves it ([`Verdict::Refined`]) or
+//! [`MAX_ELEMENTS`] is reached ([`Verdict::Unresolved`], said so). The
+//! optimum is also polished on three meshes of order-2 elements
+//! ([`ReachLimit`]): R*(N → ∞) with a bound ~1e-8. Re-polishing the rejected design
 //! alone is not enough: from the ±10 box's spurious optimum it ends on a
 //! poor local optimum of the finer mesh (R̂ = 1.77 for the circular arm,
 //! whose box holds designs reaching 1.9458).
@@ -25,7 +28,7 @@ use crate::stability::StabilityOptions;
 /// The paper gives R* to two or three digits; this is four.
 pub const REACH_TOLERANCE: f64 = 1e-4;
 
-/// The finest mesh a repeated search uses (elements); its check uses 4×.
+/// The most elements a repeated search uses; its check uses 4×.
 pub const MAX_ELEMENTS: usize = 1600;
 
 /// The reach of one design on N, 2N and 4N elements.
@@ -309,16 +312,32 @@ impl ArmProblem {
         optimum
     }
 
+    /// The mesh a search is redone on where this problem's does not resolve
+    /// its optimum: the same elements of order [`LIMIT_ORDER`] where they
+    /// are of a lower order (p-refinement: the eigenvalue error drops from
+    /// O(h²) to O(h⁴), as 4× the linear elements would only quarter it, at
+    /// twice the cost of an evaluation instead of four times), else 4× the
+    /// elements; None past [`MAX_ELEMENTS`].
+    pub fn refined(&self) -> Option<ArmProblem> {
+        let (n, order) = (self.stability.elements(), self.stability.order());
+        if order < LIMIT_ORDER {
+            Some(self.on_mesh_of_order(n, LIMIT_ORDER))
+        } else {
+            (4 * n <= MAX_ELEMENTS).then(|| self.on_mesh(4 * n))
+        }
+    }
+
     /// The optimum `optimum` (found on this problem's mesh by a search with
     /// `opts`), checked on finer meshes and, where they disagree beyond
-    /// `tolerance`, searched for again on 4× the mesh — the whole search
-    /// (the coarse mesh's ranking of the samples is what misled it), plus a
-    /// polish from the rejected design, the better of the two kept — and
-    /// checked there, until resolved or past [`MAX_ELEMENTS`]. Returns the
-    /// reported optimum (its shapes from the mesh it was optimized on) with
-    /// its [`Resolution`]; the evaluations used are added to its count.
-    /// `stop()` ends a finer search: the optimum so far is then returned,
-    /// unresolved.
+    /// `tolerance`, searched for again on the [`Self::refined`] mesh — the
+    /// whole search (the coarse mesh's ranking of the samples is what
+    /// misled it), plus a polish from the rejected design, the better of
+    /// the two kept — and checked there, until resolved or past
+    /// [`MAX_ELEMENTS`]. Returns the reported optimum (its shapes from the
+    /// mesh it was optimized on, [`ArmOptimum::mesh`]) with its
+    /// [`Resolution`] and [`ReachLimit`]; the evaluations used are added to
+    /// its count. `stop()` ends a finer search: the optimum so far is then
+    /// returned, unresolved.
     pub fn resolve(
         &self,
         scene: &ArmScene,
@@ -334,28 +353,28 @@ impl ArmProblem {
             let (study, limit, used) = problem.mesh_checks(scene, &optimum.design, opts.iterations);
             optimum.evaluations += used;
             optimum.limit = limit;
-            let fine = 4 * problem.stability.elements();
+            optimum.mesh = problem.stability;
+            let finer = problem.refined();
             let verdict = if study.resolved(tolerance) {
                 Some(if rejected.is_empty() {
                     Verdict::Resolved
                 } else {
                     Verdict::Refined
                 })
-            } else if fine > MAX_ELEMENTS || stop() {
+            } else if finer.is_none() || stop() {
                 Some(Verdict::Unresolved)
             } else {
                 None
             };
-            if let Some(verdict) = verdict {
+            let (None, Some(finer)) = (verdict, finer) else {
                 optimum.resolution = Some(Resolution {
                     study,
-                    verdict,
+                    verdict: verdict.unwrap_or(Verdict::Unresolved),
                     rejected,
                 });
                 return optimum;
-            }
+            };
             rejected.push((study.elements[0], study.reach[0], study.reach[2]));
-            let finer = problem.on_mesh(fine);
             let (searched, progress, interrupted) =
                 finer.search_on_mesh(scene, opts, SearchProgress::default(), stop, &mut |_| {});
             let start = &optimum.design.shape_coefficients[1..];

@@ -230,10 +230,7 @@ impl ArmProblem {
             start,
             &self.bounds,
             usize::try_from(iterations).unwrap_or(usize::MAX),
-            &|x| {
-                self.reach_slope(scene, x)
-                    .map(|r| (r.design.reach, r.gradient))
-            },
+            &|x| self.reach_slope(scene, x).map(|r| r.branches),
             stop,
             warm,
         );
@@ -332,6 +329,7 @@ impl ArmProblem {
             scene: *scene,
             resolution: None,
             limit: None,
+            mesh: self.stability,
         })
     }
 }
