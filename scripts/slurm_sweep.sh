@@ -50,6 +50,10 @@ if ! [[ $count =~ ^[1-9][0-9]*$ ]] || ((task >= count)); then
 fi
 out="${prefix}.shard-${task}-of-${count}.h5"
 
-# The threads are the task's CPUs.
-"$cosserat" sweep "$problem" -o "$out" --shard "${task}/${count}" \
+# The threads are the task's CPUs. `exec`: cosserat replaces this shell as
+# the batch step's main process. Slurm's SIGTERM (scancel, time limit,
+# preemption) reaches every process of the step, and a shell killed by it
+# ends the step, whose remaining processes Slurm then kills at once; the
+# sweep would lose that race to write its finished points.
+exec "$cosserat" sweep "$problem" -o "$out" --shard "${task}/${count}" \
     --threads "${SLURM_CPUS_PER_TASK:-1}" --resume "$@"

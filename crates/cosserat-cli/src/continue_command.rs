@@ -400,7 +400,7 @@ pub(crate) fn report(d: &Diagram) {
     for (i, s) in d.special_points.iter().enumerate() {
         println!(
             "special {i}  {} on branch {} at parameter {:.12}, {} block{}, Morse index {}, \
-             multiplicity {}, located {}",
+             multiplicity {}, located {}{}",
             s.kind.name(),
             s.branch,
             s.point.parameter,
@@ -412,7 +412,10 @@ pub(crate) fn report(d: &Diagram) {
             },
             s.point.morse_index,
             s.multiplicity,
-            s.location.name()
+            s.location.name(),
+            s.parameter_error.map_or(String::new(), |e| format!(
+                " (error of the parameter ±{e:.1e})"
+            ))
         );
     }
 }

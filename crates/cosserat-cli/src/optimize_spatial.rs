@@ -149,7 +149,7 @@ fn compare(
             .map_or(String::new(), |s| mesh_error(&s.resolution)),
         100.0 * (spatial.0 / planar.0 - 1.0),
         100.0 * (extrapolated(spatial) / extrapolated(planar) - 1.0),
-        verdict.name()
+        describe(&verdict)
     );
     Some(DirectionComparison {
         alpha: arm.planar.alpha,

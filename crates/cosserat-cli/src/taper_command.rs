@@ -69,7 +69,7 @@ pub fn run_tapered(
     };
     report(&opt, t.elapsed().as_secs_f64());
     let t = Instant::now();
-    let path = tapered.loading_path(&opt, 2001, &signals::requested);
+    let path = tapered.loading_path(&opt, &signals::requested);
     if signals::requested() {
         return interrupted();
     }
@@ -136,16 +136,32 @@ fn report(o: &TaperedOptimum, time: f64) {
         "prismatic R* = {:.6}, γ_crit = {:.6} (the start of the tapered search)",
         o.prismatic.reach, o.prismatic.gamma
     );
+    let m = &o.mesh;
     println!(
-        "tapered   R* = {:.6} ± {:.1e} (R̂ on {} elements − on {}), γ_crit = {:.6} (designed rod: {:.6}), {} block; gain {:.4}",
+        "tapered   R* = {:.6}, γ_crit = {:.6} (designed rod: {:.6}), {} block; gain {:.4}",
         o.design.reach,
-        o.reach_error().abs(),
-        2 * o.elements,
-        o.elements,
         o.design.gamma,
         o.critical_load,
         o.block.name(),
         o.design.reach / o.prismatic.reach
+    );
+    println!(
+        "          joint ascent {} after {} iterations, projected gradient {:.1e} (tolerance {:.0e} R*)",
+        o.ascent.end.name(),
+        o.ascent.iterations,
+        o.ascent.projected_gradient,
+        cosserat::study::arm::taper::ASCENT_TOLERANCE
+    );
+    println!(
+        "          re-polished on {}/{}/{} elements: R* = {:.8}, {:.8}, {:.8}; order {}, error {:.1e}",
+        m.elements[0],
+        m.elements[1],
+        m.elements[2],
+        m.reach[0],
+        m.reach[1],
+        m.reach[2],
+        m.order().map_or("undecided".into(), |p| format!("{p:.2}")),
+        o.reach_error()
     );
     println!(
         "          shape c = [{}]",
@@ -157,13 +173,7 @@ fn report(o: &TaperedOptimum, time: f64) {
         .iter()
         .fold(0.0f64, |a, k| a.max(k.abs()));
     println!(
-        "          max |κ̄⁰| = {peak:.4} (per L); {} rounds, {} evaluations, {time:.2} s{}",
-        o.rounds,
-        o.evaluations,
-        if o.section_converged {
-            ""
-        } else {
-            " (a section step ran out of steps)"
-        }
+        "          max |κ̄⁰| = {peak:.4} (per L); {} evaluations, {time:.2} s",
+        o.evaluations
     );
 }

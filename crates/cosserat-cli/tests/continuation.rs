@@ -133,7 +133,7 @@ fn fine_eigenvalue(f: &Family, x: &[f64], p: f64, block: Block) -> f64 {
     let mut samples = f.samples(x, p, &points).unwrap();
     let tip = samples.pop().unwrap();
     let c = coefficients(&rod, &samples);
-    let constraints = support_constraints(&rod, &fe, block, &samples, &tip);
+    let constraints = support_constraints(&rod, &fe, block, &samples, &tip).unwrap();
     let (k, g) = (fe.stiffness(&c, block), fe.mass(block));
     let pairs = lowest_eigenpairs_constrained(&k, &g, &constraints, 4, None)
         .unwrap_or_else(|e| panic!("p = {p}, {block:?}: {e}"));

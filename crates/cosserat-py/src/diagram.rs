@@ -352,10 +352,17 @@ impl SpecialPoint {
         self.point.block.name()
     }
 
-    /// How it was located: "augmented" or "bracketed".
+    /// How it was located: "augmented", "bracketed" or "extrapolated".
     #[getter]
     fn location(&self) -> &'static str {
         self.point.location.name()
+    }
+
+    /// The estimated error of the parameter where it is not the BVP's own
+    /// (an "extrapolated" location), else None.
+    #[getter]
+    fn parameter_error(&self) -> Option<f64> {
+        self.point.parameter_error
     }
 
     /// How many eigenvalues cross zero there.

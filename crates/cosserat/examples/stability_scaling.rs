@@ -103,7 +103,7 @@ fn equilibrium_run(problem: &Problem, n: usize) -> (f64, f64, f64, f64) {
     let lowest = blocks
         .into_iter()
         .map(|b| {
-            let c = support_constraints(&problem.rod, &fe, b, &samples, &tip);
+            let c = support_constraints(&problem.rod, &fe, b, &samples, &tip).expect("constraints");
             block_spectrum(&fe, &coeffs, b, opts.eigenvalues(), &c)
                 .expect("spectrum")
                 .eigenvalues[0]

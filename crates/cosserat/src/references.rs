@@ -333,6 +333,61 @@ pub fn greenhill_clamped(tau: f64) -> f64 {
     0.5 * (lo + hi)
 }
 
+/// The critical thrust of a shearable, extensible column (Haringx 1948;
+/// Bažant & Cedolin, *Stability of Structures*, §1.7, in the form of the
+/// linear Cosserat rod's second variation, docs/methods.md): the least
+/// positive P with P (1 − P/S3) + P²/S = P_E, where P_E = B k² is the
+/// Euler load of the same mode (k its wavenumber: π/2L clamped–free,
+/// 2π/L clamped–clamped), S the shear stiffness across the bending plane
+/// and S3 the extensional one. Written 2P_E / (1 + √(1 + 4aP_E)),
+/// a = 1/S − 1/S3, with no cancellation as a → 0 (P → P_E).
+pub fn haringx_load(euler: f64, shear: f64, extension: f64) -> f64 {
+    let a = 1.0 / shear - 1.0 / extension;
+    2.0 * euler / (1.0 + (1.0 + 4.0 * a * euler).sqrt())
+}
+
+/// The second critical thrust of a shearable, extensible column clamped
+/// at both ends a fixed distance apart (the mode whose deflection is odd
+/// about the middle, B = L = 1 scaled out by the caller): with
+/// μ = P(1 − P/S3) + P²/S the Haringx load of the mode, the rotation
+/// ω = C cos kξ + c/μ (ξ from the middle, k² = μ/B) vanishes at both ends,
+/// and the lateral tip displacement (1 − P/S3 + P/S)∫ω ds, which the
+/// clamped end does not allow, is taken up by shear across the rod: a
+/// spring of stiffness K = S(1 − P/S3 + P/S)²/L on ∫ω (the held
+/// position on a Cosserat rod, docs/methods.md). Its condition is
+/// tan x = x (1 − μ/(K L)), x = kL/2; as S, S3 → ∞ it is tan x = x,
+/// P = 4x₁²B/L² (x₁ = 4.4934). The least root above the first mode's
+/// [`haringx_load`] (2π/L), by a scan and bisection on
+/// sin x − x(1 − μ/(KL)) cos x.
+pub fn haringx_clamped_second(bending: f64, shear: f64, extension: f64, length: f64) -> f64 {
+    let condition = |p: f64| {
+        let mu = p * (1.0 - p / extension) + p * p / shear;
+        let k = shear * (1.0 - p / extension + p / shear).powi(2) / length;
+        let x = 0.5 * length * (mu / bending).sqrt();
+        x.sin() - x * (1.0 - mu / (k * length)) * x.cos()
+    };
+    let first = haringx_load(
+        bending * (2.0 * std::f64::consts::PI / length).powi(2),
+        shear,
+        extension,
+    );
+    let step = 1e-3 * first;
+    let mut lo = first * (1.0 + 1e-9);
+    while condition(lo) * condition(lo + step) > 0.0 {
+        lo += step;
+    }
+    let (mut a, mut b) = (lo, lo + step);
+    for _ in 0..200 {
+        let m = 0.5 * (a + b);
+        if condition(a) * condition(m) <= 0.0 {
+            b = m;
+        } else {
+            a = m;
+        }
+    }
+    0.5 * (a + b)
+}
+
 /// The critical end moment of a twisted rod clamped at both ends, the
 /// distance between them held and no axial force (B = L = 1): the
 /// deflection w = a + b s + c s² + d e^{iMs} of B w'''' − i M w''' = 0 with

@@ -276,7 +276,15 @@ fn the_central_difference_misses_the_reference() {
 /// and a central difference, said so, elsewhere (the support's axis).
 #[test]
 fn file_keys_are_exact_where_the_tangent_covers_them() {
+    // A held tip whose frame defaults to the clamp's: the reread problem
+    // keeps it at its start value (it used to turn with the clamp, so the
+    // exact F_p disagreed with the residual's own difference).
+    let twisted_at_clamp = include_str!("../../../problems/twisted_rod.toml").replace(
+        "d3 = [0.0, 0.0, 1.0]\n",
+        "d3 = [0.0, 0.0, 1.0]\nturn = { axis = [0.0, 0.0, 1.0], angle = 0.0 }\n",
+    );
     let cases = [
+        (twisted_at_clamp.as_str(), "clamp.turn.angle"),
         (
             include_str!("../../../problems/clamped_elastica_displacement.toml"),
             "support.position[2]",

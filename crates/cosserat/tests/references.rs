@@ -3,7 +3,7 @@
 mod support;
 use cosserat::references::{
     bessel_first_zero, clamped_elastica_load, ellip_e, ellip_f, greenhill_clamped,
-    twisted_clamped_moment, CantileverTip,
+    haringx_clamped_second, haringx_load, twisted_clamped_moment, CantileverTip,
 };
 
 #[test]
@@ -68,6 +68,30 @@ fn column_references_match_their_classical_limits() {
 fn twisted_rod_reference_is_twice_the_root_of_tan_x_equals_x() {
     let m = twisted_clamped_moment();
     assert!((m - 2.0 * 4.493_409_457_909_064).abs() < 1e-13, "{m}");
+}
+
+/// Haringx's loads: Euler's as the shear and extension stiffnesses grow
+/// (at order 1 in 1/S), Haringx's own shear-only form
+/// (S/2)(√(1 + 4P_E/S) − 1) without extension (Bažant & Cedolin §1.7),
+/// and the clamped column's second mode tends to 4x₁² (x₁ = 4.4934…, tan
+/// x = x: the inextensible clamped–clamped column's antisymmetric mode,
+/// Timoshenko & Gere §2.5).
+#[test]
+fn haringx_references_match_their_classical_limits() {
+    let euler = 4.0 * std::f64::consts::PI.powi(2);
+    let shear_only = 0.5 * 400.0 * ((1.0 + 4.0 * euler / 400.0).sqrt() - 1.0);
+    assert!((haringx_load(euler, 400.0, f64::INFINITY) - shear_only).abs() < 1e-12 * euler);
+    assert_eq!(haringx_load(euler, 500.0, 500.0), euler);
+    let second = 4.0 * 4.493_409_457_909_064_f64.powi(2);
+    let errors: Vec<f64> = [1e4, 1e5, 1e6]
+        .iter()
+        .map(|&s| (haringx_clamped_second(1.0, s, 2.0 * s, 1.0) - second).abs())
+        .collect();
+    for w in errors.windows(2) {
+        let order = (w[0] / w[1]).log10();
+        assert!((order - 1.0).abs() < 0.05, "{errors:?}");
+    }
+    assert!(errors[2] < 1e-3 * second, "{errors:?}");
 }
 
 /// The clamped–clamped elastica: at small shortening the load tends to

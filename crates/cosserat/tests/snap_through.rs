@@ -200,40 +200,49 @@ fn buckled_strip_snaps_at_the_elastica_fold_angle() {
     );
 }
 
-/// Multiple shooting: on 160 segments (958 unknowns) the folds are located
-/// on the augmented system (measured 1e-13 from the elastica); on 260
-/// segments (1557 unknowns, beyond the dense augmented system's 1000) the
-/// regula-falsi root is kept, recorded as `bracketed`, with a warning
-/// naming why — and it is measurably worse: the snap 1.9e-9 off.
+/// Large systems: multiple shooting on 260 segments (1557 unknowns) and
+/// collocation on 400 intervals (2397 unknowns) locate both folds on the
+/// augmented system, solved in F_x's band shape (`continuation/
+/// bordering.rs`; it used to be dense up to 1000 unknowns, the bracketed
+/// root kept beyond, 1.9e-9 off), to 1e-10 of the elastica.
 #[test]
-fn beyond_the_dense_limit_the_bracketed_root_is_kept_and_said() {
+#[cfg_attr(
+    debug_assertions,
+    ignore = "two large diagrams, ≈ 5 s in release: run with --release"
+)]
+fn large_systems_locate_their_folds_on_the_augmented_system() {
     let reference = arch_elastica_folds(THETA).unwrap().loads;
-    let run = |segments: usize| {
-        let sets = [
-            "solver.method=multiple-shooting".to_string(),
-            format!("solver.segments={segments}"),
-            "continuation.max_points=3000".into(),
-            "continuation.max_step=2.0".into(),
-            "continuation.bounds=[-1.0, 2.5]".into(),
-        ];
+    let run = |method: &[String]| {
+        let mut sets = method.to_vec();
+        sets.extend(
+            [
+                "continuation.max_points=3000",
+                "continuation.max_step=2.0",
+                "continuation.bounds=[-1.0, 2.5]",
+            ]
+            .map(String::from),
+        );
         diagram(&Problem::from_str_with(ARCH, &sets).unwrap())
     };
-    let augmented = run(160);
-    assert!(augmented.warnings.is_empty(), "{:?}", augmented.warnings);
-    for ((p, location), exact) in folds(&augmented).iter().zip(&reference) {
-        assert_eq!(*location, Location::Augmented);
-        assert!((p - exact).abs() <= 1e-10 * exact, "{p} vs {exact}");
-    }
-    let bracketed = run(260);
-    let found = folds(&bracketed);
-    assert_eq!(found.len(), 2, "{found:?}");
-    assert_eq!(bracketed.warnings.len(), 2, "{:?}", bracketed.warnings);
-    for (w, ((p, location), exact)) in bracketed.warnings.iter().zip(found.iter().zip(&reference)) {
-        assert_eq!(*location, Location::Bracketed);
-        assert!(
-            w.contains("bracketed root of τ_p") && w.contains("dense up to 1000"),
-            "{w}"
-        );
-        assert!((p - exact).abs() <= 1e-8 * exact, "{p} vs {exact}");
+    let shooting = [
+        "solver.method=multiple-shooting".to_string(),
+        "solver.segments=260".to_string(),
+    ];
+    let collocation = [
+        "solver.method=collocation".to_string(),
+        "continuation.intervals=400".to_string(),
+    ];
+    for method in [&shooting[..], &collocation[..]] {
+        let d = run(method);
+        let size = d.branches[0].points[0].unknowns.len();
+        assert!(size > 1500, "{method:?}: {size} unknowns");
+        assert!(d.warnings.is_empty(), "{method:?}: {:?}", d.warnings);
+        let found = folds(&d);
+        assert_eq!(found.len(), 2, "{found:?}");
+        for ((p, location), exact) in found.iter().zip(&reference) {
+            eprintln!("{method:?}, {size} unknowns: fold {p} against {exact}");
+            assert_eq!(*location, Location::Augmented);
+            assert!((p - exact).abs() <= 1e-10 * exact, "{p} vs {exact}");
+        }
     }
 }

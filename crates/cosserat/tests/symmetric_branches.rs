@@ -66,3 +66,51 @@ fn the_twisted_rod_switches_onto_its_buckled_copies() {
     );
     congruent(&d);
 }
+
+/// Michell's twisted ring (problems/twisted_ring.toml): the closed
+/// isotropic ring, itself one of a continuum of copies (turned about the
+/// clamp's tangent), carries the twisting moment −C θ / L at every twist
+/// (the circle with uniform twist κ3 = −θ/L: the material frame turns back
+/// from the turned clamp to the held tip), and loses stability where
+/// θ = 2π√3 · B/C (Michell 1889), a pair of writhing modes crossing
+/// together (the Morse index 0 → 2). The slice corrector cannot converge
+/// within about 1e-3 of that point, so the crossing is bracketed there
+/// and reported with its bracket as the parameter's error: Michell's value
+/// must lie within it, for C = B and C = 2B.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "two continuations: seconds in release")]
+fn twisted_ring_loses_stability_at_michells_twist() {
+    let text = include_str!("../../../problems/twisted_ring.toml");
+    for c in [1.0, 2.0] {
+        let stiffness = format!("energy.stiffness=[1.0, 1.0, {c}]");
+        let d = run(text, &[&stiffness, "continuation.bounds=[0.0, 11.5]"]);
+        assert!(
+            d.warnings.iter().all(|w| w.contains("only to ±")),
+            "{:?}",
+            d.warnings
+        );
+        for point in &d.branches[0].points {
+            let moment = point.measures[0];
+            assert!(
+                (moment + c * point.parameter).abs() <= 1e-9 * (1.0 + moment.abs()),
+                "θ = {}: M = {moment}",
+                point.parameter
+            );
+        }
+        let michell = 2.0 * std::f64::consts::PI * 3f64.sqrt() / c;
+        let bp = d
+            .special_points
+            .iter()
+            .find(|s| s.kind == SpecialKind::BranchPoint)
+            .expect("Michell's point");
+        assert_eq!(bp.multiplicity, 2);
+        let error = bp.parameter_error.unwrap_or(1e-9 * michell);
+        let p = bp.point.parameter;
+        eprintln!("C = {c}: θ = {p} ± {error:.1e} vs Michell {michell}");
+        assert!((p - michell).abs() <= error, "{p} ± {error} vs {michell}");
+        assert!(error <= 1e-3 * michell, "{error}");
+        let before = &d.branches[0].points[bp.index];
+        assert_eq!(before.morse_index, 0);
+        assert_eq!(d.branches[0].points[bp.index + 1].morse_index, 2);
+    }
+}

@@ -25,6 +25,9 @@ use std::sync::Arc;
 
 use nalgebra::{DMatrix, DVector};
 
+use super::bordering::BorderedJacobian;
+use super::corrector::Linearization;
+
 use super::{ContinuationError, Family, FamilyError, Lens, PointError};
 use crate::model::Rod;
 
@@ -164,7 +167,10 @@ impl Augmented<'_> {
         b: &DVector<f64>,
         c: &DVector<f64>,
     ) -> Option<(f64, DVector<f64>)> {
-        super::fold::bordered(fx, b, c)
+        let n = fx.nrows();
+        let mut k = BorderedJacobian::new(Linearization::Dense(fx.clone()), b.clone(), c.clone())?;
+        let vg = k.solve(&super::fold::unit(n + 1, n))?;
+        Some((vg[n], vg.rows(0, n).into_owned()))
     }
 
     /// Unknowns: x, p₁, p₂ and, at a branch point, ψ.

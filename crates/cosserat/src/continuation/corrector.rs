@@ -65,7 +65,7 @@ pub enum Linearization {
 impl Linearization {
     /// The zero F_x of the family's shape: a staircase above
     /// [`DENSE_UP_TO`] unknowns, dense below.
-    fn of(family: &Family) -> Self {
+    pub(super) fn of(family: &Family) -> Self {
         if let Some(a) = family.staircase().filter(|a| a.size() > DENSE_UP_TO) {
             Linearization::Staircase(a)
         } else {
@@ -75,7 +75,7 @@ impl Linearization {
     }
 
     /// F(x, p) into `r` and F_x into self.
-    fn evaluate(
+    pub(super) fn evaluate(
         &mut self,
         family: &Family,
         x: &[f64],
@@ -85,6 +85,30 @@ impl Linearization {
         match self {
             Linearization::Dense(fx) => family.residual(x, p, r, fx),
             Linearization::Staircase(a) => family.residual_staircase(x, p, r, a),
+        }
+    }
+
+    /// F_x d.
+    pub(super) fn mul(&self, d: &DVector<f64>) -> DVector<f64> {
+        match self {
+            Linearization::Dense(fx) => fx * d,
+            Linearization::Staircase(a) => {
+                let mut y = DVector::zeros(d.len());
+                a.mul(d.as_slice(), y.as_mut_slice());
+                y
+            }
+        }
+    }
+
+    /// F_xᵀ w.
+    pub(super) fn mul_transposed(&self, w: &DVector<f64>) -> DVector<f64> {
+        match self {
+            Linearization::Dense(fx) => fx.tr_mul(w),
+            Linearization::Staircase(a) => {
+                let mut y = DVector::zeros(w.len());
+                a.mul_transposed(w.as_slice(), y.as_mut_slice());
+                y
+            }
         }
     }
 }

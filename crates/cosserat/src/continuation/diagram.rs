@@ -64,9 +64,16 @@ pub enum Location {
     /// tolerance.
     Augmented,
     /// The root of the test function bracketed in the arclength (Illinois
-    /// regula falsi): every branch point, and a fold whose augmented
+    /// regula falsi): a multiple branch point (on an entry of Govaerts'
+    /// bordered G), and a fold or simple branch point whose augmented
     /// Newton failed — the diagram's warnings say why.
     Bracketed,
+    /// A mode the model's BVP does not see (out of the plane of a planar
+    /// model): the crossing of the finite-element eigenvalue located on
+    /// the tracked mesh and on two and four times its elements, and
+    /// extrapolated at the elements' order (Richardson); its estimated
+    /// error is [`SpecialPoint::parameter_error`].
+    Extrapolated,
 }
 
 impl Location {
@@ -75,6 +82,7 @@ impl Location {
         match self {
             Location::Augmented => "augmented",
             Location::Bracketed => "bracketed",
+            Location::Extrapolated => "extrapolated",
         }
     }
 }
@@ -110,6 +118,12 @@ pub struct SpecialPoint {
     pub multiplicity: usize,
     /// How it was located.
     pub location: Location,
+    /// The estimated discretization error of `point.parameter` where it
+    /// is not the BVP's own ([`Location::Extrapolated`]: the difference of
+    /// the extrapolations from two pairs of meshes); None where the point
+    /// solves the BVP's equations (its error is then the discretization's
+    /// of every point of the branch).
+    pub parameter_error: Option<f64>,
 }
 
 /// A followed branch.

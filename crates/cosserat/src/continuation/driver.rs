@@ -213,7 +213,7 @@ impl<'a> Run<'a> {
             .map_err(|e| start_err(e.to_string()))?;
         let mut forward = vec![0.0; x.len()];
         forward.push(1.0);
-        let tangent = self.tangent(&x, p, &forward)?;
+        let tangent = self.start_tangent(&x, p, &forward)?;
         self.tracker.reset();
         self.point(x, p, tangent)
     }
@@ -472,6 +472,12 @@ impl<'a> Run<'a> {
             diagram.warnings.extend(missed);
             diagram.branches[branch].points.push(next);
             self.total_points += 1;
+            if closes(&diagram.branches[branch].points)
+                || passes_again(&diagram.special_points, &specials)
+            {
+                let points = diagram.branches[branch].points.len();
+                return end(specials, BranchEnd::Closed(points), false);
+            }
             ds = self.control().after_success(ds, iterations);
             diagram.branches[branch].next_step = ds;
             let progress = Progress {
@@ -484,4 +490,79 @@ impl<'a> Run<'a> {
             }
         }
     }
+}
+
+/// Whether the last step of a branch passed its first point again in the
+/// same direction: the chord from the last point but one to the last
+/// passes the first point within a tenth of its length, between its ends,
+/// and the tangents there and at the first point agree (cosine ≥ 0.99), so
+/// that a branch crossing its start at an angle is not taken for a loop.
+/// A closed branch (the full shallow arch's asymmetric branch joining its
+/// two branch points) would otherwise be followed round and round until
+/// `max_points`. In the scaled unknowns and the parameter, as the
+/// arclength.
+fn closes(points: &[Point]) -> bool {
+    let n = points.len();
+    if n < 4 {
+        return false;
+    }
+    let z = |p: &Point| -> Vec<f64> { p.unknowns.iter().copied().chain([p.parameter]).collect() };
+    let (first, last, next) = (z(&points[0]), z(&points[n - 2]), z(&points[n - 1]));
+    let chord: Vec<f64> = next.iter().zip(&last).map(|(a, b)| a - b).collect();
+    let length = chord.iter().map(|c| c * c).sum::<f64>().sqrt();
+    if length == 0.0 {
+        return false;
+    }
+    let to_first: Vec<f64> = first.iter().zip(&last).map(|(a, b)| a - b).collect();
+    let along = to_first.iter().zip(&chord).map(|(a, c)| a * c).sum::<f64>() / length;
+    if !(0.0..=length).contains(&along) {
+        return false;
+    }
+    let across = to_first
+        .iter()
+        .zip(&chord)
+        .map(|(a, c)| (a - along * c / length).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    let cosine: f64 = points[0]
+        .tangent
+        .iter()
+        .zip(&points[n - 1].tangent)
+        .map(|(a, b)| a * b)
+        .sum();
+    across <= 0.1 * length && cosine >= 0.99
+}
+
+/// Whether the branch's last special point repeats an earlier one of the
+/// same branch (`found`, indices into `all`): the same kind and block at
+/// the same point (p to 1e-9, x to 1e-6, relative), met on another step
+/// (an isotropic column's in-plane and out-of-plane crossings are one
+/// point met once), passed the same way (the
+/// branch's directions before them agree, cosine ≥ 0.9) — the branch is a
+/// loop that has come round once. Special points are located on their own
+/// systems, so this holds where the chord test of [`closes`] misses the
+/// start for the curvature near it (a branch leaving a pitchfork).
+fn passes_again(all: &[super::SpecialPoint], found: &[usize]) -> bool {
+    let Some((&last, earlier)) = found.split_last() else {
+        return false;
+    };
+    let s = &all[last];
+    earlier.iter().map(|&i| &all[i]).any(|e| {
+        let (x, y) = (&e.point, &s.point);
+        let dx = x
+            .unknowns
+            .iter()
+            .zip(&y.unknowns)
+            .map(|(a, b)| (a - b).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let size = 1.0 + x.unknowns.iter().map(|a| a * a).sum::<f64>().sqrt();
+        let cosine: f64 = x.tangent.iter().zip(&y.tangent).map(|(a, b)| a * b).sum();
+        e.kind == s.kind
+            && e.block == s.block
+            && e.index != s.index
+            && (x.parameter - y.parameter).abs() <= 1e-9 * (1.0 + x.parameter.abs())
+            && dx <= 1e-6 * size
+            && cosine >= 0.9
+    })
 }

@@ -1,8 +1,9 @@
 //! Folds and branch points between two points of a branch: detection,
 //! location by regula falsi (Illinois) in the arclength on a test function
-//! with a simple root — for a fold then refined by Newton on Govaerts'
-//! minimally augmented system (`fold.rs`) —, classification, and branch
-//! switching.
+//! with a simple root — for a fold or a simple branch point then refined by
+//! Newton on a minimally augmented system (`fold.rs`, `branch_point.rs`);
+//! for a mode the model does not see, extrapolated from three
+//! finite-element meshes —, classification, and branch switching.
 //!
 //! A fold is decided by the tangent's parameter component τ_p changing
 //! sign, always, whatever the eigenvalues do; a branch point by a change
@@ -21,14 +22,17 @@
 //! when dim ker F_x = m. An entry of G that changes sign has a simple
 //! root, where det F_x has a root of order m (a double root for the pair
 //! of an isotropic rod, which bisection on the determinant cannot see).
-//! A simple branch point (m = 1) is located on det F_x itself, whose root
-//! is then simple; modes the model's Jacobian does not see (out of the
-//! plane of a planar model) on the block's eigenvalue nearest zero.
+//! A simple branch point (m = 1) is bracketed on det F_x itself, whose
+//! root is then simple; modes the model's Jacobian does not see (out of the
+//! plane of a planar model) on the block's eigenvalue nearest zero, on
+//! three meshes ([`Run::extrapolated_crossing`]).
 
 use nalgebra::{DMatrix, DVector};
 
 use super::corrector::DENSE_UP_TO;
+use super::engine;
 use super::kernel::BandedJacobian;
+use super::Tracker;
 use super::{Location, Point, Run, SpecialKind, SpecialPoint};
 use crate::model::ModelLevel;
 use crate::numerics::scalar::{End, Illinois};
@@ -37,6 +41,17 @@ use crate::stability::Block;
 
 /// A test function along the step from a point: f(σ) and the point there.
 type Located = (f64, Vec<f64>, f64, Vec<f64>);
+
+/// A converged point of a location and its arclength σ from the start.
+type Anchor = (f64, Located);
+
+/// A root of a test function along a step: its arclength σ, the point
+/// there, and the width of the parameter bracket it ended with.
+struct Root {
+    sigma: f64,
+    located: Located,
+    spread: f64,
+}
 
 /// The function whose sign change locates an event.
 enum Test {
@@ -54,6 +69,9 @@ enum Test {
     /// The block's eigenvalue nearest zero (modes the model's Jacobian
     /// does not see; accurate to the finite-element mesh).
     Eigenvalue(Block),
+    /// The same on a finer mesh than the run's (the Richardson meshes of
+    /// [`Run::extrapolated_crossing`]).
+    EigenvalueOn(Block, Box<Tracker>),
 }
 
 /// An event to locate: its kind, block and multiplicity.
@@ -80,7 +98,10 @@ impl Run<'_> {
                 missed.extend(note);
                 located
             } else {
-                self.locate(a, b, sign, (branch, index), (kind, block, multiplicity))
+                let (located, notes) =
+                    self.locate(a, b, sign, (branch, index), (kind, block, multiplicity));
+                missed.extend(notes);
+                located
             };
             match located.len() {
                 0 => missed.push(format!(
@@ -170,9 +191,18 @@ impl Run<'_> {
         )
     }
 
-    /// The test function at arclength σ from `a`, and the point there.
-    fn test_at(&self, a: &Point, sign: f64, sigma: f64, test: &Test) -> Option<Located> {
-        let (x, p, tangent, _) = self.step(a, sign, sigma).ok()??;
+    /// The test function at arclength σ from `a`, and the point there,
+    /// corrected from the converged point `near` of the same location
+    /// when there is one (see [`Self::point_at`]).
+    fn test_at(
+        &self,
+        a: &Point,
+        sign: f64,
+        sigma: f64,
+        near: Option<&Anchor>,
+        test: &Test,
+    ) -> Option<Located> {
+        let (x, p, tangent) = self.point_at(a, sign, sigma, near)?;
         let n = x.len();
         let value = match test {
             Test::Fold => tangent[n],
@@ -184,8 +214,63 @@ impl Run<'_> {
                     .ok()?
                     .0
             }
+            Test::EigenvalueOn(block, tracker) => {
+                tracker.nearest_zero(self.family, &x, p, *block).ok()?.0
+            }
         };
         Some((value, x, p, tangent))
+    }
+
+    /// The point where the plane τ_aᵀ(z − z_a) = σ cuts the branch. From
+    /// `a` the predictor is z_a + σ τ_a; from a converged point `near` of
+    /// the same plane family (at σ_n, tangent τ_n) it is
+    /// z_n + (σ − σ_n)/(τ_aᵀτ_n) τ_n, which lies on the same plane. Near a
+    /// branch point the bordered matrix [F_x F_p; τ_aᵀ] is nearly singular
+    /// and Newton's basin shrinks with the distance to it: a predictor a
+    /// whole step long leaves it (the full bistable strip's and the full
+    /// arch's asymmetric branch points were bracketed but never located),
+    /// one from the nearer bracket end does not. None where the corrector
+    /// does not converge.
+    fn point_at(
+        &self,
+        a: &Point,
+        sign: f64,
+        sigma: f64,
+        near: Option<&Anchor>,
+    ) -> Option<(Vec<f64>, f64, Vec<f64>)> {
+        let travel = |t: &[f64]| -> Vec<f64> { t.iter().map(|v| v * sign).collect() };
+        let t_a = travel(&a.tangent);
+        let anchored = near.and_then(|(sigma_n, (_, x, p, t))| {
+            let t_n = travel(t);
+            let cosine: f64 = t_a.iter().zip(&t_n).map(|(u, v)| u * v).sum();
+            (cosine > 0.5).then(|| {
+                let along = (sigma - sigma_n) / cosine;
+                x.iter()
+                    .chain([p])
+                    .zip(&t_n)
+                    .map(|(z, t)| z + along * t)
+                    .collect::<Vec<f64>>()
+            })
+        });
+        let Some(pred) = anchored else {
+            let (x, p, tangent, _) = self.step(a, sign, sigma).ok()??;
+            return Some((x, p, tangent));
+        };
+        if self.sliced {
+            // The slice through `a` (its copies' null vectors), as the
+            // step from `a` itself would use.
+            let kernel = self.symmetric_kernel(&a.unknowns, a.parameter)?;
+            let (z, _) = self
+                .correct_sliced(&a.unknowns, &pred, &t_a, &kernel)
+                .ok()??;
+            let n = z.len() - 1;
+            let t = self.sliced_tangent(&z[..n], z[n], &kernel, &t_a).ok()?;
+            return Some((z[..n].to_vec(), z[n], travel(&t)));
+        }
+        let (z, _, fu) = self.correct(&pred, &t_a).ok()??;
+        let n = z.len() - 1;
+        let t = engine::tangent_from(self.family, &fu, &z[..n], z[n], &t_a).ok()?;
+        Some((z[..n].to_vec(), z[n], travel(&t)))
     }
 
     fn jacobian(&self, x: &[f64], p: f64) -> Option<DMatrix<f64>> {
@@ -313,6 +398,11 @@ impl Run<'_> {
     /// back on the eigenvalue).
     fn bordered_test(&self, a: &Point, b: &Point, m: usize) -> Option<Test> {
         let n = a.unknowns.len();
+        // On a branch of symmetric copies F_x keeps the copies' null
+        // vector everywhere: the borders must complement it too, or the
+        // bordered matrix is singular at the branch point (a twisted ring's
+        // Michell point: the copies' direction and the pair that crosses).
+        let m = m + usize::from(self.sliced);
         if m == 0 || m >= n {
             return None;
         }
@@ -357,7 +447,7 @@ impl Run<'_> {
         sign: f64,
         (branch, index): (usize, usize),
         (kind, block, multiplicity): Wanted,
-    ) -> Vec<SpecialPoint> {
+    ) -> (Vec<SpecialPoint>, Vec<String>) {
         let span = span_of(a, b, sign);
         let test = match kind {
             SpecialKind::Fold => Test::Fold,
@@ -367,24 +457,129 @@ impl Run<'_> {
                 .bordered_test(a, b, multiplicity)
                 .unwrap_or(Test::Eigenvalue(block)),
         };
-        let Some((sigma, best)) = self.root(a, (sign, b.parameter), (0.0, span), &test) else {
-            return vec![];
+        let Some(root) = self.root(a, (sign, b.parameter), (0.0, span), &test) else {
+            if matches!(test, Test::Determinant) {
+                return self.unbracketed_branch_point(
+                    a,
+                    b,
+                    sign,
+                    (branch, index),
+                    (kind, block, 1),
+                );
+            }
+            return (vec![], vec![]);
         };
+        // A bracket that could not be closed cannot tell one multiple
+        // crossing from several simple ones: it is reported with its spread.
+        let resolved = self.unresolved(&root, "", (branch, index)).is_none();
         if let Test::Bordered { right, left, .. } = &test {
-            if !self.degenerate(a, b, &best, right, left) {
-                return self.separate(a, b, sign, (sigma, best), (branch, index), block);
+            if resolved && !self.degenerate(a, b, &root.located, right, left) {
+                return self.separate(
+                    a,
+                    b,
+                    sign,
+                    (root.sigma, root.located),
+                    (branch, index),
+                    block,
+                );
             }
         }
-        self.special_point(
-            a,
-            b,
-            sign,
-            best,
-            (branch, index),
-            ((kind, block, multiplicity), Location::Bracketed),
-        )
-        .into_iter()
-        .collect()
+        let wanted = (kind, block, multiplicity);
+        if let Test::Eigenvalue(block) = test {
+            let (point, note) = self.extrapolated_crossing(
+                a,
+                b,
+                sign,
+                (root.sigma, root.located),
+                (branch, index),
+                (wanted, block),
+            );
+            return (point.into_iter().collect(), note.into_iter().collect());
+        }
+        if matches!(test, Test::Determinant) {
+            let (point, note) =
+                self.refined_branch_point(a, b, sign, root, (branch, index), wanted);
+            return (point.into_iter().collect(), note.into_iter().collect());
+        }
+        let note = self.unresolved(&root, kind.name(), (branch, index));
+        let point = self
+            .special_point(
+                a,
+                b,
+                sign,
+                root.located,
+                (branch, index),
+                (wanted, Location::Bracketed),
+            )
+            .map(|mut sp| {
+                sp.parameter_error = note.is_some().then_some(root.spread);
+                sp
+            });
+        (point.into_iter().collect(), note.into_iter().collect())
+    }
+
+    /// The simple branch point bracketed at `best` on det F_x, refined by
+    /// Newton on the minimally augmented system (`branch_point.rs`). Where
+    /// Newton fails the bracketed root is kept, recorded as
+    /// [`Location::Bracketed`], with a note saying why; on a branch of
+    /// symmetric copies (`slice.rs`, F_x keeps the copies' null vector) it
+    /// is not tried.
+    fn refined_branch_point(
+        &self,
+        a: &Point,
+        b: &Point,
+        sign: f64,
+        root: Root,
+        (branch, index): (usize, usize),
+        wanted: Wanted,
+    ) -> (Option<SpecialPoint>, Option<String>) {
+        let bracketed = |root: Root, note: Option<String>| {
+            let unresolved = self.unresolved(&root, "branch point", (branch, index));
+            let spread = root.spread;
+            let point = self
+                .special_point(
+                    a,
+                    b,
+                    sign,
+                    root.located,
+                    (branch, index),
+                    (wanted, Location::Bracketed),
+                )
+                .map(|mut sp| {
+                    sp.parameter_error = unresolved.is_some().then_some(spread);
+                    sp
+                });
+            (point, note.or(unresolved))
+        };
+        if self.sliced {
+            return bracketed(root, None);
+        }
+        let best = root.located.clone();
+        let radius = span_of(a, b, sign).abs().max(distance(a, b));
+        match self.refine_branch_point(&best.1, best.2, radius) {
+            Ok((x, p, _)) => {
+                let located = (0.0, x, p, best.3);
+                let point = self.special_point(
+                    a,
+                    b,
+                    sign,
+                    located,
+                    (branch, index),
+                    (wanted, Location::Augmented),
+                );
+                (point, None)
+            }
+            Err(why) => {
+                let note = format!(
+                    "branch {branch}: the branch point between points {index} and {} is located \
+                     only as the bracketed root of det F_x, at parameter {:.12}: the minimally \
+                     augmented Newton failed: {why}",
+                    index + 1,
+                    best.2
+                );
+                bracketed(root, Some(note))
+            }
+        }
     }
 
     /// Locates the fold between `a` and `b`: the root of τ_p bracketed by
@@ -401,9 +596,27 @@ impl Run<'_> {
         wanted: Wanted,
     ) -> (Vec<SpecialPoint>, Option<String>) {
         let span = span_of(a, b, sign);
-        let Some((_, best)) = self.root(a, (sign, b.parameter), (0.0, span), &Test::Fold) else {
+        let Some(root) = self.root(a, (sign, b.parameter), (0.0, span), &Test::Fold) else {
             return (vec![], None);
         };
+        let radius = span.abs().max(distance(a, b));
+        if !self.sliced && self.turns_at_branch_point(&root.located) {
+            let best = &root.located;
+            if let Ok((x, p, _)) = self.refine_branch_point(&best.1, best.2, radius) {
+                let located = (0.0, x, p, best.3.clone());
+                let bp = (SpecialKind::BranchPoint, wanted.1, 1);
+                let point = self.special_point(
+                    a,
+                    b,
+                    sign,
+                    located,
+                    (branch, index),
+                    (bp, Location::Augmented),
+                );
+                return (point.into_iter().collect(), None);
+            }
+        }
+        let best = root.located;
         // On a branch of symmetric copies F_x keeps the copies' null vector,
         // so its kernel at a fold is two-dimensional and the one-bordered
         // system singular: the fold is the bracketed root, and its record
@@ -419,7 +632,6 @@ impl Run<'_> {
             );
             return (point.into_iter().collect(), None);
         }
-        let radius = span.abs().max(distance(a, b));
         let refined = self
             .refine_fold(&best.1, best.2, radius)
             .and_then(|(x, p, _)| {
@@ -441,6 +653,200 @@ impl Run<'_> {
         };
         let point = self.special_point(a, b, sign, located, (branch, index), (wanted, location));
         (point.into_iter().collect(), note)
+    }
+
+    /// The direction of the branch through a simple branch point (x, p):
+    /// `reference` (the tangent at the branch's last regular point)
+    /// projected on the null plane of [F_x F_p] there, spanned by (φ, 0)
+    /// and (v₀, 1), [F_x b; cᵀ 0][v₀; s] = [−F_p; 0] (φ = c, b the near
+    /// null vectors), in F_x's shape (`bordering.rs`). None on a branch of
+    /// symmetric copies or where a solve fails.
+    fn branch_direction(&self, x: &[f64], p: f64, reference: &[f64]) -> Option<Vec<f64>> {
+        let n = x.len();
+        if self.sliced {
+            return None;
+        }
+        let (_, fx) = self.linearization(x, p).ok()?;
+        let fp = self.family.parameter_derivative(x, p).ok()?;
+        let (c, b) = super::bordering::null_vectors(&fx)?;
+        let mut k = super::bordering::BorderedJacobian::new(fx, b, c.clone())?;
+        let v0 = super::branch_point::bordered_solve(&mut k, &(-&fp))?;
+        let e1 = DVector::from_iterator(n + 1, c.iter().copied().chain([0.0])).normalize();
+        let mut e2 = DVector::from_iterator(n + 1, v0.iter().copied().chain([1.0]));
+        e2 -= &e1 * e1.dot(&e2);
+        let e2 = e2.normalize();
+        let r = DVector::from_column_slice(reference);
+        let t = &e1 * e1.dot(&r) + &e2 * e2.dot(&r);
+        let norm = t.norm();
+        (norm.is_finite() && norm > 0.0).then(|| (t / norm).as_slice().to_vec())
+    }
+
+    /// Whether the branch may turn back (τ_p changes sign) at a branch
+    /// point rather than at a fold: F_p nearly in the range of the singular
+    /// F_x (|ψᵀF_p| ≤ 1e-2 |F_p|, ψ its left null vector; at a fold it is of
+    /// the order of |F_p|, at a branch point of the distance to it). A
+    /// branch that bifurcated at a pitchfork meets the branch it left there
+    /// again and turns with p'(σ) = 0 (the parabola p − p* ∝ a²): the full
+    /// shallow arch's asymmetric branch at both of its ends. There the
+    /// fold's augmented system is singular — it did not converge, or
+    /// converged 7e-8 off — while the branch point's is regular, so the
+    /// caller tries the branch point's system first and keeps it only where
+    /// it converges (μ = 0: a fold never satisfies it). In F_x's shape,
+    /// as the fold's system.
+    fn turns_at_branch_point(&self, best: &Located) -> bool {
+        let (x, p) = (&best.1, best.2);
+        let (Ok((_, fx)), Ok(fp)) = (
+            self.linearization(x, p),
+            self.family.parameter_derivative(x, p),
+        ) else {
+            return false;
+        };
+        let Some((_, left)) = super::bordering::null_vectors(&fx) else {
+            return false;
+        };
+        left.dot(&fp).abs() <= 1e-2 * fp.norm()
+    }
+
+    /// A simple branch point between `a` and `b` whose bracket could not
+    /// be narrowed (the corrector fails near it: a branch crossing
+    /// another close to the crossing, where Newton's basin on the
+    /// pseudo-arclength system shrinks): Newton on the minimally augmented
+    /// system, which is regular there, from each end (the nearer-singular
+    /// first), kept where it lands between them.
+    fn unbracketed_branch_point(
+        &self,
+        a: &Point,
+        b: &Point,
+        sign: f64,
+        (branch, index): (usize, usize),
+        wanted: Wanted,
+    ) -> (Vec<SpecialPoint>, Vec<String>) {
+        if self.sliced {
+            return (vec![], vec![]);
+        }
+        let radius = span_of(a, b, sign).abs().max(distance(a, b));
+        let singularity = |e: &Point| {
+            self.det(&e.unknowns, e.parameter)
+                .map_or(f64::INFINITY, f64::abs)
+        };
+        let mut ends = [a, b];
+        ends.sort_by(|x, y| singularity(x).total_cmp(&singularity(y)));
+        let (lo, hi) = (a.parameter.min(b.parameter), a.parameter.max(b.parameter));
+        for end in ends {
+            let Ok((x, p, _)) = self.refine_branch_point(&end.unknowns, end.parameter, radius)
+            else {
+                continue;
+            };
+            if !(lo..=hi).contains(&p) {
+                continue;
+            }
+            let located = (0.0, x, p, end.tangent.iter().map(|t| t * sign).collect());
+            let point = self.special_point(
+                a,
+                b,
+                sign,
+                located,
+                (branch, index),
+                (wanted, Location::Augmented),
+            );
+            return (point.into_iter().collect(), vec![]);
+        }
+        (vec![], vec![])
+    }
+
+    /// A crossing the model's BVP does not see, located on the block's
+    /// finite-element eigenvalue — whose crossing carries the elements'
+    /// error O(h^{2k}), k their order — on the run's mesh (σ₁, at
+    /// `first`) and on two and four times its elements (σ₂, σ₄), then
+    /// extrapolated: σ* = σ₄ + (σ₄ − σ₂)/(2^{2k} − 1), the point there by
+    /// the corrector. The parameter's error estimate is the difference of
+    /// the extrapolations from (σ₂, σ₄) and from (σ₁, σ₂) in p, a bound
+    /// of the first's error by the second's; where the measured order of
+    /// the three crossings is not 2k ± 1 (a crossing converged to the
+    /// event tolerance already, or not yet in the asymptotic range) the
+    /// finest crossing is kept with |p₄ − p₂| as its error; either error
+    /// adds the event tolerance each crossing is located to. With a note
+    /// where the finer meshes could not be used: the run's crossing is
+    /// then reported as located on its own mesh, error unknown.
+    fn extrapolated_crossing(
+        &self,
+        a: &Point,
+        b: &Point,
+        sign: f64,
+        first: (f64, Located),
+        (branch, index): (usize, usize),
+        (wanted, block): (Wanted, Block),
+    ) -> (Option<SpecialPoint>, Option<String>) {
+        let span = span_of(a, b, sign);
+        let finer: Option<Vec<(f64, Located)>> = [2, 4]
+            .into_iter()
+            .map(|factor| {
+                let tracker = Box::new(self.tracker.refined(factor)?);
+                let test = Test::EigenvalueOn(block, tracker);
+                self.root(a, (sign, b.parameter), (0.0, span), &test)
+                    .map(|r| (r.sigma, r.located))
+            })
+            .collect();
+        let at = (branch, index);
+        let Some(finer) = finer else {
+            let note = format!(
+                "branch {branch}: the {} branch point between points {index} and {} is located \
+                 on the {}-element mesh only (the finer meshes of its extrapolation failed): \
+                 parameter {:.10}, error not estimated",
+                block.name(),
+                index + 1,
+                self.opts.stability.elements(),
+                first.1 .2
+            );
+            let point = self.special_point(a, b, sign, first.1, at, (wanted, Location::Bracketed));
+            return (point, Some(note));
+        };
+        let p1 = first.1 .2;
+        let (s2, p2) = (finer[0].0, finer[0].1 .2);
+        let (s4, p4) = (finer[1].0, finer[1].1 .2);
+        let q = 2.0 * self.tracker.order() as f64;
+        let r = 2f64.powf(q) - 1.0;
+        let measured = ((p1 - p2) / (p2 - p4)).abs().log2();
+        // Each crossing is itself located to the event tolerance.
+        let resolution = self.opts.event_tolerance * p4.abs().max(1.0);
+        let (sigma, error) = if (measured - q).abs() <= 1.0 {
+            let fine = p4 + (p4 - p2) / r;
+            let coarse = p2 + (p2 - p1) / r;
+            (s4 + (s4 - s2) / r, (fine - coarse).abs() + resolution)
+        } else {
+            (s4, (p4 - p2).abs() + resolution)
+        };
+        let near = &finer[1];
+        let Some((x, p, tangent)) = self.point_at(a, sign, sigma, Some(near)) else {
+            let point = self
+                .special_point(
+                    a,
+                    b,
+                    sign,
+                    finer[1].1.clone(),
+                    at,
+                    (wanted, Location::Extrapolated),
+                )
+                .map(|mut sp| {
+                    sp.parameter_error = Some((p4 - p2).abs() + resolution);
+                    sp
+                });
+            return (point, None);
+        };
+        let point = self
+            .special_point(
+                a,
+                b,
+                sign,
+                (0.0, x, p, tangent),
+                at,
+                (wanted, Location::Extrapolated),
+            )
+            .map(|mut sp| {
+                sp.parameter_error = Some(error);
+                sp
+            });
+        (point, None)
     }
 
     /// Whether the whole of G vanishes at the located point (relative to
@@ -476,7 +882,7 @@ impl Run<'_> {
         (sigma, best): (f64, Located),
         at: (usize, usize),
         block: Block,
-    ) -> Vec<SpecialPoint> {
+    ) -> (Vec<SpecialPoint>, Vec<String>) {
         let bi = self.tracker.blocks().iter().position(|&x| x == block);
         let morse = |x: &[f64], p: f64| -> Option<usize> {
             let s = self.tracker.evaluate(self.family, x, p).ok()?;
@@ -487,56 +893,140 @@ impl Run<'_> {
             morse(&best.1, best.2),
             morse(&b.unknowns, b.parameter),
         ) else {
-            return vec![];
+            return (vec![], vec![]);
         };
         let span = (sigma, span_of(a, b, sign));
-        let mut found = vec![];
+        let (mut found, mut notes) = (vec![], vec![]);
         for (range, jump) in [((0.0, span.0), lo.abs_diff(mid)), (span, mid.abs_diff(hi))] {
             if jump != 1 {
                 continue;
             }
-            let Some((_, root)) = self.root(a, (sign, b.parameter), range, &Test::Determinant)
-            else {
+            let Some(root) = self.root(a, (sign, b.parameter), range, &Test::Determinant) else {
                 continue;
             };
             let wanted = (SpecialKind::BranchPoint, block, 1);
-            found.extend(self.special_point(a, b, sign, root, at, (wanted, Location::Bracketed)));
+            let (point, note) = self.refined_branch_point(a, b, sign, root, at, wanted);
+            found.extend(point);
+            notes.extend(note);
         }
-        found
+        (found, notes)
     }
 
     /// The root σ of the test function on σ ∈ (lo, hi) by Illinois, to
-    /// the event tolerance on the parameter, and the point there.
+    /// the event tolerance on the parameter, and the point there. Each
+    /// iterate is corrected from the converged bracket end nearer to it
+    /// ([`Self::point_at`]), so the predictor stays short as the bracket
+    /// closes on the root; where that corrector fails, from `a`, and then
+    /// at points halfway towards the nearer end ([`Self::test_near`]):
+    /// close to a branch point the corrector's basin shrinks, and the
+    /// false position lands right on it. Where no point closer to the root
+    /// can be corrected the bracket stops there: the root is the best
+    /// point so far, its `spread` (the parameter bracket) wider than the
+    /// event tolerance, which the caller reports.
     fn root(
         &self,
         a: &Point,
         (sign, p_b): (f64, f64),
         (lo, hi): (f64, f64),
         test: &Test,
-    ) -> Option<(f64, Located)> {
+    ) -> Option<Root> {
         let span = hi - lo;
-        let f_lo = self.test_at(a, sign, lo + 1e-12 * span, test)?.0;
-        let f_hi = self.test_at(a, sign, hi, test)?.0;
-        let mut bracket = Illinois::new(lo, hi, f_lo, f_hi)?;
-        let mut sigma = 0.5 * (lo + hi);
-        let mut best = self.test_at(a, sign, sigma, test)?;
+        let start = lo + 1e-12 * span;
+        let lower = self.test_at(a, sign, start, None, test)?;
+        let upper = self.test_at(a, sign, hi, None, test)?;
+        let mut bracket = Illinois::new(lo, hi, lower.0, upper.0)?;
         let (mut p_lo, mut p_hi) = (a.parameter, p_b);
+        let mut ends: [Anchor; 2] = [(start, lower), (hi, upper)];
+        let mut best: Option<Anchor> = None;
         for _ in 0..80 {
-            sigma = bracket.next_point();
-            best = self.test_at(a, sign, sigma, test)?;
-            match bracket.update(sigma, best.0) {
-                End::Lower => p_lo = best.2,
-                End::Upper => p_hi = best.2,
-            }
-            let tol = self.opts.event_tolerance * best.2.abs().max(1.0);
-            if (p_hi - p_lo).abs() <= tol && bracket.width() <= 1e3 * tol
-                || best.0 == 0.0
-                || bracket.width() <= 1e-15 * span
-            {
+            let Some((sigma, here)) = self.test_near(a, sign, bracket.next_point(), &ends, test)
+            else {
+                break;
+            };
+            let end = match bracket.update(sigma, here.0) {
+                End::Lower => {
+                    p_lo = here.2;
+                    0
+                }
+                End::Upper => {
+                    p_hi = here.2;
+                    1
+                }
+            };
+            ends[end] = (sigma, here.clone());
+            let tol = self.opts.event_tolerance * here.2.abs().max(1.0);
+            let done = (p_hi - p_lo).abs() <= tol && bracket.width() <= 1e3 * tol
+                || here.0 == 0.0
+                || bracket.width() <= 1e-15 * span;
+            best = Some((sigma, here));
+            if done {
                 break;
             }
         }
-        Some((sigma, best))
+        // Without an interior point, the end with the smaller test value.
+        let (sigma, located) = best.unwrap_or_else(|| {
+            let [l, u] = ends;
+            if l.1 .0.abs() <= u.1 .0.abs() {
+                l
+            } else {
+                u
+            }
+        });
+        Some(Root {
+            sigma,
+            located,
+            spread: (p_hi - p_lo).abs(),
+        })
+    }
+
+    /// The test function at σ, or — where the corrector fails there — at
+    /// up to three points each halfway from the last try towards the
+    /// nearer bracket end; the σ used and the value. None where all fail.
+    fn test_near(
+        &self,
+        a: &Point,
+        sign: f64,
+        sigma: f64,
+        ends: &[Anchor; 2],
+        test: &Test,
+    ) -> Option<(f64, Located)> {
+        let nearer = |s: f64| {
+            ends.iter()
+                .min_by(|x, y| (x.0 - s).abs().total_cmp(&(y.0 - s).abs()))
+                .expect("two ends")
+        };
+        let mut s = sigma;
+        for _ in 0..4 {
+            let near = nearer(s);
+            if let Some(here) = self
+                .test_at(a, sign, s, Some(near), test)
+                .or_else(|| self.test_at(a, sign, s, None, test))
+            {
+                return Some((s, here));
+            }
+            s = 0.5 * (s + near.0);
+        }
+        None
+    }
+
+    /// Whether a root's parameter bracket closed to the event tolerance;
+    /// else a note naming the bracket it reached.
+    fn unresolved(
+        &self,
+        root: &Root,
+        what: &str,
+        (branch, index): (usize, usize),
+    ) -> Option<String> {
+        let tol = self.opts.event_tolerance * root.located.2.abs().max(1.0);
+        (root.spread > tol).then(|| {
+            format!(
+                "branch {branch}: the {what} between points {index} and {} is located at \
+                 parameter {:.12} only to ±{:.1e} (the corrector fails closer to it)",
+                index + 1,
+                root.located.2,
+                root.spread
+            )
+        })
     }
 
     /// The special point at the located `best`: its spectrum, null mode
@@ -550,7 +1040,19 @@ impl Run<'_> {
         (branch, index): (usize, usize),
         ((kind, block, multiplicity), location): (Wanted, Location),
     ) -> Option<SpecialPoint> {
-        let stored: Vec<f64> = tangent.iter().map(|v| v * sign).collect();
+        // At a branch point the null space of [F_x F_p] is a plane, and the
+        // tangent computed at a point that close to it may lie anywhere in
+        // it — along the crossing branch, so that switching, which removes
+        // the stored tangent from that plane, followed the branch it was on
+        // (the pinned arch's asymmetric point). A simple one stores the
+        // branch's own direction: its last regular point's, projected on
+        // that plane ([`Self::branch_direction`]).
+        let stored: Vec<f64> = match kind {
+            SpecialKind::BranchPoint if multiplicity == 1 => self
+                .branch_direction(&x, p, &a.tangent)
+                .unwrap_or_else(|| tangent.iter().map(|v| v * sign).collect()),
+            _ => tangent.iter().map(|v| v * sign).collect(),
+        };
         let (eigenvalue, null_mode) = self.tracker.nearest_zero(self.family, &x, p, block).ok()?;
         // |det F_x| relative to its size at the two neighbours; NaN (not a
         // default) where a determinant cannot be evaluated.
@@ -576,6 +1078,7 @@ impl Run<'_> {
             singularity: ((det_here / det_scale).abs(), eigenvalue),
             multiplicity,
             location,
+            parameter_error: None,
         })
     }
 

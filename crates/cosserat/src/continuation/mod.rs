@@ -9,10 +9,12 @@
 //! a **fold** where the parameter component of the tangent changes sign; a
 //! **branch point** where the Morse index of a block changes without a
 //! fold. Folds are bracketed where τ_p changes sign and located on
-//! Govaerts' minimally augmented system (`fold`); branch points where det F_x = 0
-//! when the model can represent the bifurcating mode (exact to the
-//! integration tolerance), else where the tracked eigenvalue vanishes
-//! (accurate to the finite-element mesh). Branch switching follows the
+//! Govaerts' minimally augmented system (`fold`); simple branch points
+//! bracketed where det F_x = 0 when the model can represent the
+//! bifurcating mode and located on a minimally augmented system
+//! (`branch_point`; exact to the integration tolerance), else where the
+//! tracked eigenvalue vanishes on three meshes, extrapolated (with the
+//! estimated error). Branch switching follows the
 //! null vector of [F_x F_p] orthogonal to the branch tangent, both ways.
 //!
 //! The modules: `options` holds the settings ([`ContinuationOptions`]),
@@ -24,6 +26,8 @@
 //! saved diagram, `restart` a run started from given unknowns, `stage` the
 //! chained stages of one run joined into one diagram.
 
+mod bordering;
+mod branch_point;
 mod codim2;
 mod corrector;
 mod diagram;
@@ -53,7 +57,6 @@ pub use diagram::{
 };
 pub use driver::continuation;
 pub use family::{tip_angle, CarryError, DerivativeMethod, Family, FamilyError, PointError};
-pub(crate) use fold::FOLD_DENSE_UP_TO;
 pub use lens::{Lens, Parameter, RodLens};
 pub use measure::{Measure, Quantity};
 pub use options::ContinuationOptions;

@@ -87,7 +87,7 @@ impl Run<'_> {
                 f
             }
         };
-        let tangent = self.tangent(&x, p, &forward)?;
+        let tangent = self.start_tangent(&x, p, &forward)?;
         self.tracker.reset();
         self.point(x, p, tangent)
     }

@@ -56,6 +56,8 @@ pub struct SavedSpecial {
     pub multiplicity: usize,
     /// How it was located ([`SpecialPoint::location`]).
     pub location: super::Location,
+    /// Its parameter's estimated error ([`SpecialPoint::parameter_error`]).
+    pub parameter_error: Option<f64>,
     /// Parameter.
     pub parameter: f64,
     /// Unknowns.
@@ -271,5 +273,6 @@ pub(super) fn rebuild_special(
         singularity: s.singularity,
         multiplicity: s.multiplicity,
         location: s.location,
+        parameter_error: s.parameter_error,
     })
 }

@@ -167,6 +167,24 @@ impl Run<'_> {
         Some((z[..n].to_vec(), z[n], t))
     }
 
+    /// The tangent at the first point of a branch: within the slice where
+    /// F_x has a persistent null vector there (the start is one of a
+    /// continuum of symmetric copies, e.g. a closed isotropic ring turned
+    /// about its clamp's tangent), else the plain tangent. The plain one
+    /// would be the copies' direction itself, along which no parameter
+    /// moves and which the slice then forbids, so the first step failed.
+    pub(super) fn start_tangent(
+        &self,
+        x: &[f64],
+        p: f64,
+        forward: &[f64],
+    ) -> Result<Vec<f64>, PointError> {
+        match self.symmetric_kernel(x, p) {
+            Some(kernel) => self.sliced_tangent(x, p, &kernel, forward),
+            None => self.tangent(x, p, forward),
+        }
+    }
+
     /// The unit tangent within the slice at (x, p): the null vector of
     /// [F_x F_p w; vᵀ 0 0] without its μ part, oriented along `previous`.
     pub(super) fn sliced_tangent(

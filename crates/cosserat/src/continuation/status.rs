@@ -94,6 +94,9 @@ pub enum BranchEnd {
         /// Why the loads have no potential there.
         reason: String,
     },
+    /// The branch came back to its first point, travelling the same way:
+    /// a closed branch (a loop), followed once.
+    Closed(usize),
     /// A point could not be evaluated.
     Failed(String),
     /// The branch's first point could not be evaluated.
@@ -138,6 +141,10 @@ impl fmt::Display for BranchEnd {
                 f,
                 "loads not conservative at parameter {parameter}, where stability has no \
                  meaning: {reason}"
+            ),
+            BranchEnd::Closed(points) => write!(
+                f,
+                "closed: back at its first point after {points} points (a loop, followed once)"
             ),
             BranchEnd::Failed(e) => write!(f, "stopped: {e}"),
             BranchEnd::StartFailed(e) => write!(f, "start point failed: {e}"),

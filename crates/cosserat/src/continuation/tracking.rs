@@ -106,6 +106,30 @@ impl Tracker {
         }
     }
 
+    /// The same tracker on `factor` times the elements (same order and
+    /// eigenvalue count; no remembered vectors, a fresh mass cache): the
+    /// finer meshes of a crossing located by Richardson extrapolation.
+    /// None where the finer mesh is refused.
+    pub fn refined(&self, factor: usize) -> Option<Tracker> {
+        let opts = self
+            .opts
+            .with_elements(self.opts.elements() * factor)
+            .ok()?;
+        Some(Tracker {
+            opts,
+            previous: None,
+            previous_values: None,
+            masses: RefCell::new(None),
+            ..self.clone()
+        })
+    }
+
+    /// The Lagrange order of the elements: the eigenvalues converge at
+    /// order 2·order in the element size.
+    pub fn order(&self) -> usize {
+        self.opts.order()
+    }
+
     /// The blocks, in the order of the eigenvalue columns.
     pub fn blocks(&self) -> &[Block] {
         &self.blocks
@@ -194,10 +218,11 @@ impl Tracker {
             .iter()
             .zip(masses)
             .map(|(&b, g)| {
-                let constraints = support_constraints(&rod, &fe, b, &samples, tip);
-                (fe.stiffness(&c, b), g, constraints)
+                let constraints = support_constraints(&rod, &fe, b, &samples, tip)
+                    .map_err(|e| PointError::Eigen(e.to_string()))?;
+                Ok((fe.stiffness(&c, b), g, constraints))
             })
-            .collect();
+            .collect::<Result<_, PointError>>()?;
         Ok((fe, mats, norm, shape))
     }
 
@@ -357,7 +382,7 @@ impl Tracker {
             .previous
             .as_ref()
             .and_then(|prev| prev.get(bi))
-            .filter(|_| constraints.count() == 0)
+            .filter(|_| constraints.is_empty())
             .and_then(|start| lowest_eigenpairs_from(k, g, count, start));
         match warm {
             Some(pairs) => Ok(pairs),

@@ -44,8 +44,8 @@ pub trait RodEquations: Send + Sync {
     fn unknowns(&self) -> usize;
     /// The rod length L (the interval is [0, L]).
     fn length(&self) -> f64;
-    /// The interior points where the right-hand side jumps (point forces:
-    /// [`crate::model::DeadLoads::jumps`]), sorted. Every solver stops its
+    /// The interior points where the right-hand side jumps or is kinked
+    /// (point forces, kinked profiles: [`crate::model::Rod::breaks`]), sorted. Every solver stops its
     /// integration there, puts a mesh node there, and never evaluates the
     /// right-hand side of one side at the other's s (the right-hand side
     /// at s = s_k is the right limit).

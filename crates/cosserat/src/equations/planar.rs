@@ -280,7 +280,7 @@ impl RodEquations for PlanarEquations {
     }
 
     fn jumps(&self) -> Vec<f64> {
-        self.rod.loads().jumps()
+        self.rod.breaks()
     }
 
     fn initial_state(&self, u: &[f64], y0: &mut [f64]) {

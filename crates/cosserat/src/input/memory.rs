@@ -16,7 +16,7 @@
 //! | multiple shooting | `solver.segments` | 4 × 8 N², N = u + n (segments − 1) (dense Jacobian, its LU, Newton's copies) |
 //! | collocation | `solver.max_intervals` | 2 × 8 K (m²n² + 2mn² + 2mn + (m+1)n), K = max_intervals, m = stages (per interval: the condensed LU, its right-hand sides, the stage Jacobians; the old and the new mesh during adaptation) |
 //! | stability verdict | `stability.elements` | the finite elements below at the verdict's finest mesh, max(2E, min(32E, [`crate::stability::MAX_VERDICT_ELEMENTS`])) for E = elements (its first comparison, then [`crate::stability::REFINEMENTS`] doublings up to the cap), eigenvalues + 1 |
-//! | continuation system | `continuation.intervals` (collocation) or `solver.segments` | N the family's unknowns: 6 × 8 (N+1)² (dense F_x, the bordered matrix, its LU, the SVD at branch points) for single shooting and N ≤ 200; above, 6 × 8 min(N+1, 1001)² (a fold's dense augmented system) + 8 × 40 n (N+1) (band F_x, its copy and transpose, the bordered embedding, their LUs) |
+//! | continuation system | `continuation.intervals` (collocation) or `solver.segments` | N the family's unknowns: 6 × 8 (N+1)² (dense F_x, the bordered matrix, its LU, the SVD at branch points) for single shooting and N ≤ 200; above, 8 × 40 n (N+1) (band F_x, its copy and transpose, the bordered embedding, their LUs; the augmented systems of folds and branch points reuse them) |
 //! | continuation points | `continuation.max_points` | points × branches × (8 (2N + 1 + 3k + 3 shape_points + measures) + S + 256), branches = (1 + both_directions)(1 + 6 k switch_depth) |
 //! | tracked spectrum | `continuation.elements` | the finite elements below at `continuation.elements`, plus the previous point's 3k eigenvectors |
 //! | arm's second variation | `arm.elements` | the finite elements below at 4 × arm.elements, 1 eigenvalue (a reported optimum is re-evaluated on finer meshes) |
@@ -170,9 +170,8 @@ fn add_continuation(e: &mut MemoryEstimate, problem: &Problem) {
         };
         let n = equations(&problem.rod, problem.model.level).dim() as f64;
         e.add(field, continuation_system(family, size, n), format!(
-            "continuation systems of {size} unknowns (dense up to {}, a fold's augmented system up to {}, band beyond)",
-            crate::continuation::DENSE_UP_TO,
-            crate::continuation::FOLD_DENSE_UP_TO
+            "continuation systems of {size} unknowns (dense up to {}, band beyond, the augmented systems of folds and branch points too)",
+            crate::continuation::DENSE_UP_TO
         ));
         let k = opts.stability.eigenvalues() as f64;
         let branches = (1.0 + f64::from(u8::from(opts.both_directions)))
@@ -203,16 +202,14 @@ fn add_continuation(e: &mut MemoryEstimate, problem: &Problem) {
 /// matrix, its LU, the SVD at branch points) up to
 /// [`crate::continuation::DENSE_UP_TO`] unknowns or for single shooting;
 /// above, band storage linear in N (F_x, its band copy and transpose, the
-/// bordered embedding, their LUs: 8 × 40 n (N+1)) plus a fold's dense
-/// augmented system up to [`crate::continuation::FOLD_DENSE_UP_TO`]
-/// unknowns (beyond, a fold keeps its bracketed root).
+/// bordered embedding, their LUs: 8 × 40 n (N+1)); the augmented systems
+/// of folds and branch points reuse the same band storage.
 fn continuation_system(family: &crate::continuation::Family, size: f64, n: f64) -> f64 {
     let dense = |m: f64| 6.0 * 8.0 * m * m;
     if family.staircase().is_none() || size <= (crate::continuation::DENSE_UP_TO + 1) as f64 {
         return dense(size);
     }
-    let fold = size.min((crate::continuation::FOLD_DENSE_UP_TO + 1) as f64);
-    dense(fold) + 8.0 * 40.0 * n * size
+    8.0 * 40.0 * n * size
 }
 
 /// The arm optimization's finite elements, map samples and sweep grid.

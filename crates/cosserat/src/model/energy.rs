@@ -70,6 +70,13 @@ pub trait StoredEnergy: std::fmt::Debug + Send + Sync {
     fn is_uniform(&self) -> bool {
         false
     }
+    /// The interior points s in (0, L) where W's explicit s-dependence is
+    /// not smooth (a piecewise profile's breakpoints, [`Profile::breaks`]),
+    /// sorted: the solvers stop there as at a point force
+    /// ([`super::Rod::breaks`]). None by default.
+    fn breaks(&self, _length: f64) -> Vec<f64> {
+        Vec::new()
+    }
     /// The stiffnesses S = (S1, S2, S3) of a quadratic shear and extension
     /// energy ½ (ν − e3)ᵀ diag(S) (ν − e3) at s (see [`super::Shearable`]);
     /// None for an unshearable, inextensible (Kirchhoff) rod.
@@ -256,6 +263,19 @@ impl StoredEnergy for LinearElastic {
 
     fn is_uniform(&self) -> bool {
         LinearElastic::is_uniform(self)
+    }
+
+    /// Every breakpoint of the six profiles.
+    fn breaks(&self, length: f64) -> Vec<f64> {
+        let mut s: Vec<f64> = self
+            .stiffness
+            .iter()
+            .chain(&self.intrinsic_curvature)
+            .flat_map(|p| p.breaks(length))
+            .collect();
+        s.sort_by(f64::total_cmp);
+        s.dedup();
+        s
     }
 
     fn profile_edits(&self) -> Option<&dyn ProfileEdits> {
@@ -451,6 +471,10 @@ impl StoredEnergy for QuarticStiffening {
 
     fn is_uniform(&self) -> bool {
         self.linear.is_uniform()
+    }
+
+    fn breaks(&self, length: f64) -> Vec<f64> {
+        self.linear.breaks(length)
     }
 }
 

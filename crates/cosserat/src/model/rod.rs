@@ -304,6 +304,19 @@ impl Rod {
             .fold(Vector3::zeros(), |a, m| a.sup(&m))
     }
 
+    /// The interior points where the equations' right-hand side is not
+    /// smooth, sorted and without repeats: the point forces' points
+    /// ([`DeadLoads::jumps`], where n jumps) and the energy's breakpoints
+    /// ([`StoredEnergy::breaks`], where a profile is kinked). Every solver
+    /// stops there ([`crate::equations::RodEquations::jumps`]).
+    pub fn breaks(&self) -> Vec<f64> {
+        let mut s = self.loads.jumps();
+        s.extend(self.energy.breaks(self.length));
+        s.sort_by(f64::total_cmp);
+        s.dedup();
+        s
+    }
+
     /// The same rod under loads scaled by `factor`; refused when the
     /// scaled loads are not finite (a non-finite factor, or an overflow).
     pub fn with_load_factor(&self, factor: f64) -> Result<Rod, ModelError> {
@@ -419,5 +432,56 @@ mod tests {
             rod.with_length(-2.0),
             Err(ModelError::Length(l)) if l == -2.0
         ));
+    }
+
+    /// A stiffness kinked at s = 0.4 (B = 2 − 2.5s, then 1 + 2(s − 0.4)) is
+    /// a break of the equations, where every solver stops; under a tip
+    /// couple C about d2 the moment is C everywhere, so the rod turns by
+    /// C ∫ 1/B = C (0.4 ln 2 + 0.5 ln 2.2) — met by shooting, multiple
+    /// shooting (the break inside a segment) and collocation.
+    #[test]
+    fn a_kinked_stiffness_is_a_break_of_every_solver() {
+        use crate::bvp::{equations, solve, Method, SolverOptions};
+        use crate::model::{ModelChoice, ModelLevel, Profile};
+        let bend =
+            Profile::piecewise(vec![0.0, 0.4, 1.0], vec![vec![1.5, -0.5], vec![1.6, 0.6]]).unwrap();
+        let energy = LinearElastic::new(
+            [bend.scaled(2.0), bend.clone(), bend.scaled(1.5)],
+            [0.0; 3].map(Profile::Constant),
+        )
+        .unwrap();
+        let c = 0.5;
+        let rod = Rod::new(
+            1.0,
+            Arc::new(energy),
+            Clamp::paper(),
+            DeadLoads {
+                tip_couple: Vector3::new(0.0, c, 0.0),
+                ..Default::default()
+            },
+            None,
+        )
+        .unwrap();
+        assert_eq!(rod.breaks(), vec![0.4]);
+        assert_eq!(equations(&rod, ModelLevel::Planar).jumps(), vec![0.4]);
+        let turn = c * (0.4 * 2f64.ln() + 0.5 * 2.2f64.ln());
+        let model = ModelChoice {
+            level: ModelLevel::Planar,
+            reason: String::new(),
+        };
+        for method in [
+            Method::Shooting,
+            Method::MultipleShooting { segments: 3 },
+            Method::Collocation { stages: 3 },
+        ] {
+            let opts = SolverOptions {
+                method,
+                ..Default::default()
+            };
+            let eq = solve(&rod, &model, &opts).unwrap();
+            let d3 = eq.tip().directors[2];
+            let angle = d3.dot(&Clamp::paper().director(2)).clamp(-1.0, 1.0).acos();
+            assert!((angle - turn).abs() < 1e-9, "{method:?}: {angle} vs {turn}");
+        }
     }
 }

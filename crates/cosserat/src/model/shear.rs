@@ -103,6 +103,10 @@ impl StoredEnergy for Shearable {
         self.bending.is_uniform()
     }
 
+    fn breaks(&self, length: f64) -> Vec<f64> {
+        self.bending.breaks(length)
+    }
+
     fn shear_stiffness(&self, _s: f64) -> Option<Vector3<f64>> {
         Some(self.shear)
     }

@@ -200,6 +200,36 @@ impl BandLu {
             }
         }
     }
+
+    /// b ← A⁻ᵀ b with the same factors (LAPACK's `dgbtrs` with 'T'):
+    /// Aᵀ = Uᵀ Lᵀ P, so Uᵀ y = b forward, then Lᵀ with the row interchanges
+    /// undone backward. The left null vector and the transposed bordered
+    /// solves of the minimally augmented systems need it.
+    pub fn solve_transposed(&self, b: &mut [f64]) {
+        assert!(self.factored, "solve before a successful factor");
+        let (n, kl, kv) = (self.n, self.kl, self.kl + self.ku);
+        let ld = self.lead();
+        for j in 0..n {
+            let top = j.saturating_sub(kv);
+            let dot: f64 = b[top..j]
+                .iter()
+                .enumerate()
+                .map(|(i, bi)| self.data[self.at(top + i, j)] * bi)
+                .sum();
+            b[j] = (b[j] - dot) / self.data[self.at(j, j)];
+        }
+        for j in (0..n.saturating_sub(1)).rev() {
+            let col = j * ld + kv;
+            let dot: f64 = (1..=kl.min(n - 1 - j))
+                .map(|i| self.data[col + i] * b[j + i])
+                .sum();
+            b[j] -= dot;
+            let p = self.pivots[j];
+            if p != j {
+                b.swap(p, j);
+            }
+        }
+    }
 }
 
 #[cfg(test)]
@@ -252,6 +282,15 @@ mod tests {
             let residual = (&a * &x - &b).amax();
             let bound = 1e-13 * a.amax() * x.amax() * n as f64;
             assert!(residual <= bound, "{n} {kl} {ku}: {residual:e} > {bound:e}");
+            let mut y = b.as_slice().to_vec();
+            lu.solve_transposed(&mut y);
+            let y = DVector::from_vec(y);
+            let residual = (a.transpose() * &y - &b).amax();
+            let bound = 1e-13 * a.amax() * y.amax() * n as f64;
+            assert!(
+                residual <= bound,
+                "ᵀ {n} {kl} {ku}: {residual:e} > {bound:e}"
+            );
             if kl > 0 && ku > 0 {
                 let dense = a.clone().lu().solve(&b).unwrap();
                 let err = (&x - &dense).amax();

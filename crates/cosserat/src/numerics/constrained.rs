@@ -1,7 +1,11 @@
 //! The pencil (K, G) restricted to the null space of a few linear
 //! constraints C v = 0: the second variation of a rod whose tip is held
 //! (a position held in some directions is ∫ R(ω × e3) ds = 0 along them, a
-//! held frame is ω(L) = 0 in some directions).
+//! held frame is ω(L) = 0 in some directions) — and raised by a few
+//! *springs*, K + U Uᵀ with U = (u_1 … u_k): a position held on a
+//! shearable, extensible rod is not a constraint on ω but costs the strain
+//! energy of the shear and extension that keep the tip in place
+//! (`stability::second_variation`, "A held position on a Cosserat rod").
 //!
 //! With m ≪ n constraints nothing dense of size n is formed. For a shift σ
 //! and A = K − σG (banded LDLᵀ), Z = A⁻¹Cᵀ and S = C Z (m × m):
@@ -15,6 +19,15 @@
 //!   1/(λ − σ), so the Lanczos of [`super::eigen`] applies unchanged.
 //!
 //! Each solve costs m + 1 banded solves: still O(n) per eigenvalue.
+//!
+//! Springs border the same way with −I in the corner: with
+//! C = [C_h; Uᵀ] (hard rows, then the springs) and D̃ = diag(0, I),
+//! In([A Cᵀ; C −D̃]) = In((A + UUᵀ)|null C_h) + (m_h, m_h, 0) + (0, k, 0)
+//! (eliminate the springs' multipliers first), and by Haynsworth on A the
+//! count below σ is neg(A) + pos(S + D̃) − m, m = m_h + k, S = C A⁻¹Cᵀ;
+//! the bordered solve is (A⁻¹ − Z (S + D̃)⁻¹ Zᵀ) b, which is
+//! ((A + UUᵀ)|null C_h)⁻¹ b (Sherman–Morrison–Woodbury on the springs).
+//! Only the hard rows are projected out.
 
 use nalgebra::{DMatrix, DVector};
 
@@ -25,10 +38,12 @@ use super::eigen::{
 };
 use crate::numerics::banded::{BandedLdlt, SymmetricBanded};
 
-/// Linear constraints C v = 0 with orthonormal rows (m × n).
+/// Linear constraints C v = 0 with orthonormal rows (m × n), and springs
+/// that add vᵀUUᵀv to the form (U n × k).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Constraints {
     rows: DMatrix<f64>,
+    springs: DMatrix<f64>,
 }
 
 impl Constraints {
@@ -36,7 +51,40 @@ impl Constraints {
     pub fn none(n: usize) -> Self {
         Constraints {
             rows: DMatrix::zeros(0, n),
+            springs: DMatrix::zeros(n, 0),
         }
+    }
+
+    /// The same constraints with the springs u_j added: the form becomes
+    /// vᵀKv + Σ_j (u_j·v)².
+    #[must_use]
+    pub fn with_springs(self, springs: &[DVector<f64>]) -> Self {
+        let n = self.rows.ncols();
+        Constraints {
+            springs: DMatrix::from_fn(n, springs.len(), |i, j| springs[j][i]),
+            ..self
+        }
+    }
+
+    /// Neither constraints nor springs.
+    pub fn is_empty(&self) -> bool {
+        self.rows.nrows() == 0 && self.springs.ncols() == 0
+    }
+
+    /// Σ_j (u_j·v)²: what the springs add to vᵀKv.
+    pub fn spring_form(&self, v: &[f64]) -> f64 {
+        (self.springs.transpose() * DVector::from_column_slice(v)).norm_squared()
+    }
+
+    /// The bordering rows [C_h; Uᵀ] and the corner's diagonal: 0 for a
+    /// constraint, 1 for a spring (D̃ in the module documentation).
+    fn bordering(&self) -> (DMatrix<f64>, Vec<f64>) {
+        let (h, k, n) = (self.rows.nrows(), self.springs.ncols(), self.rows.ncols());
+        let mut c = DMatrix::zeros(h + k, n);
+        c.rows_mut(0, h).copy_from(&self.rows);
+        c.rows_mut(h, k).copy_from(&self.springs.transpose());
+        let corner = (0..h + k).map(|i| if i < h { 0.0 } else { 1.0 }).collect();
+        (c, corner)
     }
 
     /// From rows that may be dependent or zero: Gram–Schmidt keeps an
@@ -61,10 +109,14 @@ impl Constraints {
         for (i, b) in basis.iter().enumerate() {
             m.set_row(i, &b.transpose());
         }
-        Constraints { rows: m }
+        Constraints {
+            rows: m,
+            springs: DMatrix::zeros(n, 0),
+        }
     }
 
-    /// The number of independent constraints.
+    /// The number of independent constraints (springs not counted: they
+    /// do not reduce the space).
     pub fn count(&self) -> usize {
         self.rows.nrows()
     }
@@ -88,7 +140,8 @@ impl Constraints {
     }
 }
 
-/// A = K − σG factored, with Z = A⁻¹Cᵀ and S = C Z.
+/// A = K − σG factored, with Z = A⁻¹Cᵀ and S = C Z + D̃ (C the bordering
+/// rows, D̃ the springs' identity in the corner).
 struct Bordered {
     a: BandedLdlt,
     z: DMatrix<f64>,
@@ -98,16 +151,17 @@ struct Bordered {
 impl Bordered {
     fn new(k: &SymmetricBanded, g: &SymmetricBanded, c: &Constraints, sigma: f64) -> Option<Self> {
         let a = k.combine(1.0, g, -sigma).ldlt().ok()?;
-        let (m, n) = (c.count(), k.size());
+        let (rows, corner) = c.bordering();
+        let (m, n) = (rows.nrows(), k.size());
         let mut z = DMatrix::zeros(n, m);
         for j in 0..m {
-            let mut col: Vec<f64> = c.rows.row(j).iter().copied().collect();
+            let mut col: Vec<f64> = rows.row(j).iter().copied().collect();
             a.solve_in_place(&mut col);
             z.set_column(j, &DVector::from_vec(col));
         }
-        let s = &c.rows * &z;
+        let s = &rows * &z;
         Some(Bordered {
-            s: (&s + s.transpose()) * 0.5,
+            s: (&s + s.transpose()) * 0.5 + DMatrix::from_diagonal(&DVector::from_vec(corner)),
             a,
             z,
         })
@@ -147,7 +201,7 @@ pub fn count_below_constrained(
     c: &Constraints,
     sigma: f64,
 ) -> Inertia {
-    if c.count() == 0 {
+    if c.is_empty() {
         return count_below(k, g, sigma);
     }
     try_count_below_constrained(k, g, c, sigma)
@@ -180,7 +234,7 @@ pub fn lowest_eigenpairs_constrained(
     count: usize,
     previous: Option<(f64, f64)>,
 ) -> Result<Eigenpairs, EigenError> {
-    if c.count() == 0 {
+    if c.is_empty() {
         return lowest_eigenpairs_near(k, g, count, previous);
     }
     let count = count.min(k.size().saturating_sub(c.count()));
@@ -224,9 +278,9 @@ fn shift_below_constrained(
     })
 }
 
-/// Backward error of K v − λ G v projected off the constraint normals, and
-/// C v = 0, both to 1e-8, after each vector is put back on null C
-/// ([`Constraints::project`]).
+/// Backward error of (K + UUᵀ) v − λ G v projected off the constraint
+/// normals, and C v = 0, both to 1e-8, after each vector is put back on
+/// null C ([`Constraints::project`]).
 ///
 /// A Ritz vector leaves null C by the round-off of the bordered solves
 /// (Z S⁻¹ Zᵀ, S = C A⁻¹Cᵀ as ill-conditioned as the pencil's scaling
@@ -249,7 +303,10 @@ fn verify(
         k,
         g,
         pairs,
-        |r| &r - c.rows.transpose() * (&c.rows * &r),
+        |r, v| {
+            let r = r + &c.springs * (c.springs.transpose() * DVector::from_column_slice(v));
+            &r - c.rows.transpose() * (&c.rows * &r)
+        },
         |v| c.apply(v).norm() <= 1e-8 * DVector::from_column_slice(v).norm(),
     )
 }
@@ -285,7 +342,8 @@ fn dense_constrained(
             found += 1;
         }
     }
-    let kr = basis.transpose() * k.to_dense() * &basis;
+    let raised = k.to_dense() + &c.springs * c.springs.transpose();
+    let kr = basis.transpose() * raised * &basis;
     let gr = basis.transpose() * g.to_dense() * &basis;
     let pairs = dense_pencil(&kr, &gr, count)?;
     Ok(Eigenpairs {
@@ -342,5 +400,63 @@ mod tests {
         // The constraints raise the spectrum (interlacing).
         let free = lowest_eigenpairs_near(&k, &g, 1, None).unwrap();
         assert!(sparse.values[0] > free.values[0]);
+    }
+
+    /// Springs: K + uuᵀ (G = I here) against the eigenvalues of the dense
+    /// matrix, with and without a hard row beside them, and the counts
+    /// against those eigenvalues; a stiffening spring tends to the
+    /// constraint u·v = 0 (interlacing from below).
+    #[test]
+    fn springs_raise_the_form_by_their_squares() {
+        let n = 120;
+        let (k, g, hard) = pencil(n);
+        let u = DVector::from_fn(n, |i, _| (1.0 + i as f64 / n as f64).ln() * 40.0);
+        let springs = Constraints::none(n).with_springs(std::slice::from_ref(&u));
+        let dense = (k.to_dense() + &u * u.transpose()).symmetric_eigen();
+        let mut exact: Vec<f64> = dense.eigenvalues.iter().copied().collect();
+        exact.sort_by(f64::total_cmp);
+        let pairs = lowest_eigenpairs_constrained(&k, &g, &springs, 4, None).unwrap();
+        for (a, b) in pairs.values.iter().zip(&exact) {
+            assert!((a - b).abs() < 1e-8 * b.abs(), "{a} vs {b}");
+        }
+        for v in &pairs.vectors {
+            let lambda = (DVector::from_column_slice(v).transpose()
+                * (k.to_dense() + &u * u.transpose())
+                * DVector::from_column_slice(v))[0]
+                / DVector::from_column_slice(v).norm_squared();
+            assert!(pairs
+                .values
+                .iter()
+                .any(|l| (l - lambda).abs() < 1e-8 * l.abs()));
+        }
+        let sigma = 0.5 * (exact[1] + exact[2]);
+        assert_eq!(
+            count_below_constrained(&k, &g, &springs, sigma),
+            Inertia::Below(2)
+        );
+        // Beside hard rows: against the projected dense pencil of K + uuᵀ.
+        let both = hard.clone().with_springs(std::slice::from_ref(&u));
+        let sparse = lowest_eigenpairs_constrained(&k, &g, &both, 3, None).unwrap();
+        let reference = dense_constrained(&k, &g, &both, 3).unwrap();
+        for (a, b) in sparse.values.iter().zip(&reference.values) {
+            assert!((a - b).abs() < 1e-8 * b.abs(), "{a} vs {b}");
+        }
+        let sigma = 0.5 * (reference.values[1] + reference.values[2]);
+        assert_eq!(
+            count_below_constrained(&k, &g, &both, sigma),
+            Inertia::Below(2)
+        );
+        // A spring 10⁴ times stiffer approaches the constraint u·v = 0.
+        let stiff = Constraints::none(n).with_springs(&[&u * 1e4]);
+        let held = Constraints::from_rows(std::slice::from_ref(&u), n);
+        let (a, b) = (
+            lowest_eigenpairs_constrained(&k, &g, &stiff, 1, None)
+                .unwrap()
+                .values[0],
+            lowest_eigenpairs_constrained(&k, &g, &held, 1, None)
+                .unwrap()
+                .values[0],
+        );
+        assert!(a < b && (b - a) < 1e-4 * b, "{a} vs {b}");
     }
 }

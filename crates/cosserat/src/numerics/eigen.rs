@@ -426,16 +426,17 @@ fn verify(
     g: &SymmetricBanded,
     pairs: Eigenpairs,
 ) -> Result<Eigenpairs, EigenError> {
-    verify_with(k, g, pairs, |r| r, |_| true)
+    verify_with(k, g, pairs, |r, _| r, |_| true)
 }
 
-/// [`verify`] with the residual first passed through `project` (off the
-/// normals of constraints) and each vector required to be `admissible`.
+/// [`verify`] with the residual first passed through `project` (given the
+/// vector too: springs add UUᵀv, and the result is taken off the normals of
+/// constraints) and each vector required to be `admissible`.
 pub(super) fn verify_with(
     k: &SymmetricBanded,
     g: &SymmetricBanded,
     pairs: Eigenpairs,
-    project: impl Fn(DVector<f64>) -> DVector<f64>,
+    project: impl Fn(DVector<f64>, &[f64]) -> DVector<f64>,
     admissible: impl Fn(&[f64]) -> bool,
 ) -> Result<Eigenpairs, EigenError> {
     let n = k.size();
@@ -444,10 +445,10 @@ pub(super) fn verify_with(
     for (lambda, v) in pairs.values.iter().zip(&pairs.vectors) {
         k.matvec(v, &mut kv);
         g.matvec(v, &mut gv);
-        let r = project(DVector::from_iterator(
-            n,
-            kv.iter().zip(&gv).map(|(a, b)| a - lambda * b),
-        ));
+        let r = project(
+            DVector::from_iterator(n, kv.iter().zip(&gv).map(|(a, b)| a - lambda * b)),
+            v,
+        );
         let v_norm = v.iter().map(|a| a * a).sum::<f64>().sqrt();
         let backward =
             r.norm() / ((norm_k + lambda.abs() * norm_g) * v_norm).max(f64::MIN_POSITIVE);

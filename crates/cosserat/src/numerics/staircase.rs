@@ -129,6 +129,24 @@ impl Staircase {
         }
     }
 
+    /// y = Aᵀ x.
+    pub fn mul_transposed(&self, x: &[f64], y: &mut [f64]) {
+        y.fill(0.0);
+        for (j, block) in self.blocks.iter().enumerate() {
+            let c0 = self.column_of(j);
+            for i in 0..block.nrows() {
+                let row = self.dim * j + i;
+                let xi = x[row];
+                for c in 0..block.ncols() {
+                    y[c0 + c] += block[(i, c)] * xi;
+                }
+                if j + 1 < self.segments() {
+                    y[self.first + self.dim * j + i] += self.coupling[row] * xi;
+                }
+            }
+        }
+    }
+
     /// The dense matrix (for the few dense users: determinants at special
     /// points, small systems, tests).
     pub fn to_dense(&self) -> DMatrix<f64> {
@@ -338,6 +356,64 @@ impl StaircaseLu {
             }
             None => false,
         }
+    }
+
+    /// w = M⁻ᵀ (f, g) for M = [A b; cᵀ d], with the bordered factors of
+    /// the same A and border, refined once on Mᵀ, into `w` (length N + 1).
+    /// The embedding E gives M⁻¹ = G E⁻¹ S (S scatters (f, g) onto E's
+    /// rows, G gathers (x, π) from its unknowns), so M⁻ᵀ = Sᵀ E⁻ᵀ Gᵀ: the
+    /// same factors solved transposed, with the two maps exchanged. False
+    /// without bordered factors or where the solution is not finite (no
+    /// least-squares fallback: the callers border with approximate null
+    /// vectors, which keep M regular).
+    pub fn solve_bordered_transposed(
+        &mut self,
+        a: &Staircase,
+        border: &Border,
+        rhs: &[f64],
+        w: &mut [f64],
+    ) -> bool {
+        if !(self.factored && self.bordered) {
+            return false;
+        }
+        self.embedded_solve_transposed(a, rhs, w);
+        let n = a.size();
+        let mut r = std::mem::take(&mut self.residual);
+        let mut dw = std::mem::take(&mut self.correction);
+        r.clear();
+        r.resize(n + 1, 0.0);
+        dw.resize(n + 1, 0.0);
+        // r = (f, g) − Mᵀ w, Mᵀ = [Aᵀ c; bᵀ d].
+        a.mul_transposed(&w[..n], &mut r[..n]);
+        for i in 0..n {
+            r[i] = rhs[i] - r[i] - border.row[i] * w[n];
+        }
+        let dot: f64 = border.column.iter().zip(&w[..n]).map(|(b, x)| b * x).sum();
+        r[n] = rhs[n] - dot - border.corner * w[n];
+        self.embedded_solve_transposed(a, &r, &mut dw);
+        w.iter_mut().zip(&dw).for_each(|(a, b)| *a += b);
+        (self.residual, self.correction) = (r, dw);
+        w.iter().all(|v| v.is_finite())
+    }
+
+    /// M⁻ᵀ (f, g) = Sᵀ E⁻ᵀ Gᵀ (f, g) into `w`, without refinement.
+    fn embedded_solve_transposed(&mut self, a: &Staircase, rhs: &[f64], w: &mut [f64]) {
+        self.work.clear();
+        self.work.resize(self.lu.size(), 0.0);
+        let layout = &self.layout;
+        for (j, block) in a.blocks.iter().enumerate() {
+            let (u, c0, cols) = (layout.unknown[j], a.column_of(j), block.ncols());
+            self.work[u..u + cols].copy_from_slice(&rhs[c0..c0 + cols]);
+        }
+        let k = a.segments() - 1;
+        self.work[layout.unknown[k] + a.blocks[k].ncols()] = rhs[a.size()];
+        self.lu.solve_transposed(&mut self.work);
+        for (j, block) in a.blocks.iter().enumerate() {
+            let e = layout.equation[j];
+            let rows = block.nrows();
+            w[a.dim * j..a.dim * j + rows].copy_from_slice(&self.work[e + 1..e + 1 + rows]);
+        }
+        w[a.size()] = self.work[self.work.len() - 1];
     }
 
     /// M⁻¹ (f, g) through the embedding into `z`, without refinement.

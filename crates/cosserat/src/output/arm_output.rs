@@ -302,17 +302,20 @@ pub struct TaperedStudy<'a> {
 /// Writes a tapered-arm study atomically: `/optimum/` as for the prismatic
 /// arm (`reach`, `load_factor`, `gamma_crit` — the designed rod's by the
 /// library's fixed-shape pencil —, `shape_coefficients`, `loaded_shape`,
-/// `unloaded_shape`, `intrinsic_curvature`, `reach_fine` on 2N elements,
-/// `reach_error` = `reach_fine` − `reach`) with the section:
-/// `section` (A at the knots, unit volume), `section_knots` (s̄ of the
-/// knots), `section_profile` (A at the shape points); attributes
-/// `elements`, `min_section`, `critical_block`, `rounds`, `evaluations`,
-/// `section_search` (`converged` or `budget`), `loading_path` (the
-/// verdict: `reaches_design`, `loses_stability`, `other_equilibrium`,
-/// `undecided`, or `not_computed`) and `loading_path_value` (the load
-/// factor where stability is lost, the tip's miss per L, or where the path
-/// ended); `/prismatic/` the prismatic optimum the search started from
-/// (`reach`, `load_factor`, `shape_coefficients`).
+/// `unloaded_shape`, `intrinsic_curvature`, and the mesh study of the
+/// optimum re-polished on N, 2N, 4N elements: `mesh_elements`,
+/// `reach_meshes`, `reach_fine` on 4N, `reach_error` and `reach_order` by
+/// Richardson) with the section: `section` (A at the knots, unit volume),
+/// `section_knots` (s̄ of the knots), `section_profile` (A at the shape
+/// points); the joint ascent's `projected_gradient`; attributes
+/// `elements`, `min_section`, `critical_block`, `evaluations`, `ascent`
+/// (how the joint ascent ended: `converged`, `flat`, `no_gradient`,
+/// `capped`), `ascent_iterations`, `loading_path` (the verdict:
+/// `reaches_design`, `loses_stability`, `other_equilibrium`, `undecided`,
+/// or `not_computed`) and `loading_path_value` (the load factor where
+/// stability is lost, the tip's miss per L, or where the path ended);
+/// `/prismatic/` the prismatic optimum the search started from (`reach`,
+/// `load_factor`, `shape_coefficients`).
 pub fn write_tapered_arm(
     path: &Path,
     problem: &str,
@@ -326,8 +329,14 @@ pub fn write_tapered_arm(
             .set_text("stop_reason", RunState::Completed.name());
         let g = root.create_group("optimum");
         g.float("reach", o.design.reach)?;
-        g.float("reach_fine", o.reach_fine)?;
+        let m = &o.mesh;
+        let elements: Vec<u64> = m.elements.iter().map(|n| *n as u64).collect();
+        g.counts("mesh_elements", &elements)?;
+        g.floats("reach_meshes", &[3], &m.reach)?;
+        g.float("reach_fine", m.reach[2])?;
         g.float("reach_error", o.reach_error())?;
+        g.float("reach_order", m.order().unwrap_or(f64::NAN))?;
+        g.float("projected_gradient", o.ascent.projected_gradient)?;
         g.float("load_factor", o.design.gamma)?;
         g.float("gamma_crit", o.critical_load)?;
         let c = &o.design.shape_coefficients;
@@ -346,12 +355,9 @@ pub fn write_tapered_arm(
         g.attrs.set_count("elements", o.elements as u64);
         g.attrs.set_text("critical_block", o.block.name());
         g.attrs.set_count("evaluations", o.evaluations as u64);
-        let search = if o.section_converged {
-            "converged"
-        } else {
-            "budget"
-        };
-        g.attrs.set_text("section_search", search);
+        g.attrs.set_text("ascent", o.ascent.end.name());
+        g.attrs
+            .set_count("ascent_iterations", o.ascent.iterations as u64);
         let (verdict, value) = match study.loading {
             None => ("not_computed", f64::NAN),
             Some(v) => (v.name(), v.value()),

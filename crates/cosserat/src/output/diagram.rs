@@ -16,9 +16,12 @@
 //! (s strings: `breaking`, `preserving`; u64 1/0 in files of schema 1),
 //! `null_vectors` (s×nodes×3), `singularity` (s×2), `multiplicity` (s:
 //! eigenvalues crossing zero; absent in older files, read as 1), `location` (s strings:
-//! `augmented` — a fold on the minimally augmented system —, `bracketed` —
-//! the root of a test function by regula falsi; absent in older files, read
-//! as `bracketed`); `/warnings` (events
+//! `augmented` — a fold or simple branch point on a minimally augmented
+//! system —, `bracketed` — the root of a test function by regula falsi —,
+//! `extrapolated` — a finite-element crossing on three meshes, Richardson;
+//! absent in older files, read as `bracketed`), `parameter_error` (s: the
+//! estimated error of an extrapolated parameter, NaN elsewhere; absent in
+//! older files); `/warnings` (events
 //! detected but not located, as text); the problem text as the
 //! root attribute `problem`, the run's `stop_reason` and the parameter name
 //! as root attributes (the first stage's parameter for a chained run, whose
@@ -269,6 +272,13 @@ fn write_special_points(root: &mut Group, d: &Diagram) -> StoreResult<()> {
         "location",
         &sp.iter().map(|s| s.location.name()).collect::<Vec<_>>(),
     )?;
+    g.floats(
+        "parameter_error",
+        &[sp.len()],
+        &sp.iter()
+            .map(|s| s.parameter_error.unwrap_or(f64::NAN))
+            .collect::<Vec<_>>(),
+    )?;
     let nodes = d.nodes.len();
     let null: Vec<f64> = sp
         .iter()
@@ -306,9 +316,25 @@ fn locations(g: &Group, count: usize) -> StoreResult<Vec<Location>> {
         .map(|v| match v.as_str() {
             "augmented" => Ok(Location::Augmented),
             "bracketed" => Ok(Location::Bracketed),
+            "extrapolated" => Ok(Location::Extrapolated),
             other => Err(format!("unknown location `{other}`").into()),
         })
         .collect()
+}
+
+/// The estimated parameter error of each of `count` special points (NaN
+/// stored where there is none); files written before the estimate was
+/// recorded hold points located on the BVP only, or on one mesh's
+/// eigenvalue with no estimate.
+fn parameter_errors(g: &Group, count: usize) -> StoreResult<Vec<Option<f64>>> {
+    let Ok(ds) = g.dataset("parameter_error") else {
+        return Ok(vec![None; count]);
+    };
+    Ok(ds
+        .floats()?
+        .iter()
+        .map(|e| (!e.is_nan()).then_some(*e))
+        .collect())
 }
 
 /// The problem text and what a diagram file keeps of its run (for
@@ -352,6 +378,7 @@ pub fn read_saved(path: &Path) -> StoreResult<(String, SavedDiagram)> {
         Err(_) => vec![1; kinds.len()],
     };
     let location = locations(g, kinds.len())?;
+    let parameter_error = parameter_errors(g, kinds.len())?;
     let (x, t) = (rows(g, "unknowns")?, rows(g, "tangent")?);
     let count = kinds.len();
     let lengths = [
@@ -363,6 +390,7 @@ pub fn read_saved(path: &Path) -> StoreResult<(String, SavedDiagram)> {
         sing.len(),
         multiplicity.len(),
         location.len(),
+        parameter_error.len(),
         x.len(),
         t.len(),
     ];
@@ -392,6 +420,7 @@ pub fn read_saved(path: &Path) -> StoreResult<(String, SavedDiagram)> {
             singularity: (sing[i][0], sing[i][1]),
             multiplicity: multiplicity[i] as usize,
             location: location[i],
+            parameter_error: parameter_error[i],
             parameter: parameter[i],
             unknowns: x[i].clone(),
             tangent: t[i].clone(),

@@ -60,7 +60,8 @@ fn entry(parent: &str, name: &str) -> (&'static str, &'static str) {
         ("special_points", "symmetry_breaking") => ("", "`breaking` where the mode breaks the branch's symmetry, else `preserving`"),
         ("special_points", "singularity") => ("1", "size of the singularity (test function, its bound)"),
         ("special_points", "multiplicity") => ("", "eigenvalues crossing zero together"),
-        ("special_points", "location") => ("", "augmented (minimally augmented system) or bracketed (regula falsi)"),
+        ("special_points", "location") => ("", "augmented (minimally augmented system), bracketed (regula falsi) or extrapolated (finite-element crossings on three meshes, Richardson)"),
+        ("special_points", "parameter_error") => ("as the continued key", "estimated error of the parameter where it is not the BVP's own (extrapolated); NaN where the point solves the BVP"),
         (_, "warnings") => ("", "events detected but not located, and other warnings"),
         // Curves of singular points.
         ("curve", "parameters") => ("as the two keys", "the two parameters along the curve"),
@@ -103,6 +104,7 @@ fn entry(parent: &str, name: &str) -> (&'static str, &'static str) {
         (_, "section_knots") => ("1", "arc length of the section's knots per rod length"),
         (_, "min_section") => ("1", "lower bound A_min of the section, in units of the prismatic section"),
         (_, "loading_path_value") => ("1", "the loading path's number: load factor of the loss of stability, tip miss per L, or where it ended"),
+        (_, "projected_gradient") => ("1", "max_i |x_i − P(x + ∇R̂)_i| of the joint ascent at the optimum (its stationarity)"),
         (_, "section_profile") => ("1", "section area A at the shape points, in units of the prismatic section"),
         // Sweeps.
         ("grid", "keys") => ("", "the --set key of each axis"),

@@ -17,6 +17,7 @@
 //! (ε N²)² + ε N — below 1e-10 at 10⁵ elements.
 
 use super::second_variation::{Block, FiniteElements, FormCoefficients};
+use crate::numerics::constrained::Constraints;
 use crate::numerics::eigen::Eigenpairs;
 
 /// vᵀKv from the factors: Σ_q w_q q(ω_q, ω'_q) for the block unknowns `v`
@@ -48,6 +49,15 @@ pub fn rayleigh_quotient(
     stiffness / metric
 }
 
+/// vᵀGv from the factors: Σ_q w_q |ω_q|².
+fn metric(fe: &FiniteElements, block: Block, v: &[f64]) -> f64 {
+    fe.interpolate(block, v)
+        .iter()
+        .zip(fe.quadrature_weights())
+        .map(|((w, _), weight)| weight * w.norm_squared())
+        .sum()
+}
+
 /// The load factor λ = −vᵀK0v / vᵀK1v of the pencil K0 + λK1 at its null
 /// vector `v`, both forms from the factors (`coeffs` = (K0's, K1's)): the
 /// critical load to second order in the error of `v`. None when the load
@@ -65,18 +75,26 @@ pub fn load_factor(
 }
 
 /// The pairs with each eigenvalue replaced by its Rayleigh quotient from
-/// the factors, in increasing order again (a cluster may swap by
-/// round-off).
+/// the factors (plus the support's springs, Σ (u_j·v)² over vᵀGv), in
+/// increasing order again (a cluster may swap by round-off).
 pub fn refined(
     fe: &FiniteElements,
     coeffs: &[FormCoefficients],
     block: Block,
+    support: &Constraints,
     pairs: Eigenpairs,
 ) -> Eigenpairs {
     let mut all: Vec<(f64, Vec<f64>)> = pairs
         .vectors
         .into_iter()
-        .map(|v| (rayleigh_quotient(fe, coeffs, block, &v), v))
+        .map(|v| {
+            let springs = if support.is_empty() {
+                0.0
+            } else {
+                support.spring_form(&v) / metric(fe, block, &v)
+            };
+            (rayleigh_quotient(fe, coeffs, block, &v) + springs, v)
+        })
         .collect();
     all.sort_by(|a, b| a.0.total_cmp(&b.0));
     Eigenpairs {

@@ -17,7 +17,7 @@ pub use fixed_shape_gradient::{
     critical_load_gradient, critical_load_gradients, BlockLoad, LoadGradient, SIMPLE_GAP,
 };
 pub use fixed_shape_spatial::{critical_load_spatial, SpatialShape};
-pub use second_variation::{Block, FiniteElements, FormCoefficients};
+pub use second_variation::{Block, FiniteElements, FormCoefficients, TipMotion};
 
 use nalgebra::{Matrix3, Vector3};
 
@@ -228,6 +228,7 @@ pub fn block_spectrum(
         fe,
         coeffs,
         block,
+        constraints,
         lowest_eigenpairs_constrained(&k, &g, constraints, count, None)?,
     );
     Ok(BlockSpectrum {
@@ -264,30 +265,57 @@ pub fn check_conservative(rod: &Rod) -> Result<(), StabilityError> {
                 .into(),
         ));
     }
-    let shear = rod.energy().strain_energy().is_some();
-    if shear && rod.support().as_ref().is_some_and(|s| s.holds_position()) {
-        return Err(StabilityError::Unsupported(
-            "the stability of a shearable rod with a held tip position is not implemented \
-             (the shear strain can no longer be minimized out pointwise)"
-                .into(),
-        ));
-    }
     Ok(())
 }
 
 /// The constraints of `rod`'s tip support on a block (none for a free
-/// tip); `samples` at the quadrature points, `tip` at s = L.
+/// tip); `samples` at the quadrature points, `tip` at s = L. On a
+/// shearable, extensible rod a held position is a spring, not a constraint
+/// ([`FiniteElements::support_springs`]); refused with the reason where
+/// its strain or compliance cannot be formed.
 pub fn support_constraints(
     rod: &Rod,
     fe: &FiniteElements,
     block: Block,
     samples: &[RodSample],
     tip: &RodSample,
-) -> Constraints {
-    match &rod.support() {
-        Some(support) => fe.support_constraints(block, support, samples, tip),
-        None => Constraints::none(fe.size(block)),
+) -> Result<Constraints, StabilityError> {
+    let Some(support) = rod.support() else {
+        return Ok(Constraints::none(fe.size(block)));
+    };
+    if rod.energy().strain_energy().is_none() || !support.holds_position() {
+        return Ok(fe.support_constraints(block, support, samples, tip));
     }
+    let motions = samples
+        .iter()
+        .map(|p| tip_motion(rod, p))
+        .collect::<Result<Vec<_>, _>>()?;
+    fe.support_springs(block, support, samples, tip, &motions)
+        .ok_or_else(|| {
+            StabilityError::Unsupported(
+                "the held position's compliance ∫ R H_νν⁻¹ Rᵀ ds is not positive definite".into(),
+            )
+        })
+}
+
+/// How a rotation field moves the tip at one sample of a shearable rod
+/// ([`TipMotion`]): the quadratic shear part's explicit strain, or ν from
+/// W_ν = N and the 6 × 6 Hessian of a general W(s, κ, ν).
+fn tip_motion(rod: &Rod, p: &RodSample) -> Result<TipMotion, StabilityError> {
+    let frame = Matrix3::from_columns(&p.directors);
+    let body_force = frame.transpose() * p.force;
+    let energy = rod.energy();
+    if let Some(stiffness) = energy.shear_stiffness(p.s) {
+        return Ok(TipMotion::sheared(&stiffness.map(|v| 1.0 / v), &body_force));
+    }
+    let refused = |e: String| StabilityError::Unsupported(format!("shear-extension strain: {e}"));
+    let strain = energy
+        .strain_energy()
+        .ok_or_else(|| refused("no strain energy".into()))?;
+    let (nu, jet) = shear_strain(strain, p.s, &p.curvature, &body_force, &Vector3::z())
+        .map_err(|e| refused(e.to_string()))?;
+    TipMotion::strained(&jet.hessian, &p.curvature, &nu, &body_force)
+        .ok_or_else(|| refused(format!("W_νν is not positive definite at s = {}", p.s)))
 }
 
 /// The stability of an equilibrium of `rod` (from [`crate::bvp::solve`]).
@@ -299,7 +327,7 @@ pub fn analyze(
 ) -> Result<Stability, StabilityError> {
     check_conservative(rod)?;
     let fe = FiniteElements::new(rod.length(), opts.elements, opts.order)
-        .with_breaks(&rod.loads().jumps())
+        .with_breaks(&rod.breaks())
         .with_hinged_base(rod.clamp().hinge);
     let mut points = fe.quadrature_points();
     points.push(rod.length());
@@ -313,7 +341,7 @@ pub fn analyze(
     let blocks = blocks
         .into_iter()
         .map(|b| {
-            let c = support_constraints(rod, &fe, b, &samples, &tip);
+            let c = support_constraints(rod, &fe, b, &samples, &tip)?;
             block_spectrum(&fe, &coeffs, b, opts.eigenvalues, &c)
         })
         .collect::<Result<Vec<_>, _>>()?;

@@ -68,6 +68,25 @@
 //! where the shooting Jacobian is. The in-plane part (ζ) and the
 //! out-of-plane part (ψ, χ) decouple: the paper's (50) and (51).
 //!
+//! # A held position on a Cosserat rod
+//!
+//! A held tip position δr(L) = ∫ δ(Rν) ds = ∫ R(ω×ν + η) ds = 0 couples η
+//! across the rod, so η is no longer minimized out pointwise alone. With a
+//! multiplier μ (the variation of the support's force), minimizing over η
+//! gives η = η₀(ω) − H_νν⁻¹Rᵀμ, η₀ = H_νν⁻¹(p − H_νκ a) the free minimizer
+//! above; the constraint then fixes μ = D⁻¹ c(ω) with
+//!
+//!   c(ω) = ∫ R(ω×ν + η₀(ω)) ds,   D = ∫ R H_νν⁻¹ Rᵀ ds,
+//!
+//! and the form on ω is the free one plus c(ω)ᵀD⁻¹c(ω): the shear and
+//! extension that bring the tip back cost strain energy, a rank-3 *spring*
+//! (per held direction), not a constraint on ω (`numerics::constrained`
+//! with springs: U = Cᵀ L⁻ᵀ, D = LLᵀ restricted to the held directions).
+//! As H_νν⁻¹ → 0 (the Kirchhoff rod) D vanishes, ν = e3, and the spring
+//! stiffens into the constraint ∫ R(ω×e3) ds = 0 below. In body
+//! components, with T₀ = −[ν]× + H_νν⁻¹([N]× − H_νκ[κ]×) and
+//! T₁ = −H_νν⁻¹H_νκ, the integrand of c is R(T₀ω + T₁ω') ([`TipMotion`]).
+//!
 //! # Discretization
 //!
 //! Lagrange finite elements of order p (1 to 3) on a uniform mesh, Gauss
@@ -174,6 +193,55 @@ impl FormCoefficients {
     /// The quadratic form at (ω, ω').
     pub fn evaluate(&self, w: &Vector3<f64>, dw: &Vector3<f64>) -> f64 {
         dw.dot(&(self.a * dw)) + 2.0 * dw.dot(&(self.b * w)) + w.dot(&(self.c * w))
+    }
+}
+
+/// How a rotation field moves the tip at one point of a shearable,
+/// extensible rod whose shear and extension are minimized out: δr'(s) =
+/// R(T₀ω + T₁ω') + R H_νν⁻¹Rᵀ(−μ) (module doc, "A held position on a
+/// Cosserat rod"), body components.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TipMotion {
+    /// T₀ = −[ν]× + H_νν⁻¹([N]× − H_νκ[κ]×).
+    pub t0: Matrix3<f64>,
+    /// T₁ = −H_νν⁻¹H_νκ.
+    pub t1: Matrix3<f64>,
+    /// H_νν⁻¹, the shear–extension compliance.
+    pub compliance: Matrix3<f64>,
+}
+
+impl TipMotion {
+    /// From the 6 × 6 Hessian of W(κ, ν) at the equilibrium strains, the
+    /// curvature, the strain and the body force N; None where H_νν is not
+    /// positive definite.
+    pub fn strained(
+        h: &nalgebra::Matrix6<f64>,
+        kappa: &Vector3<f64>,
+        nu: &Vector3<f64>,
+        force: &Vector3<f64>,
+    ) -> Option<Self> {
+        let nn = h.fixed_view::<3, 3>(3, 3).into_owned();
+        let nk = h.fixed_view::<3, 3>(3, 0).into_owned();
+        let compliance = nn.cholesky()?.inverse();
+        let coupling = compliance * nk;
+        Some(TipMotion {
+            t0: -nu.cross_matrix() + compliance * force.cross_matrix()
+                - coupling * kappa.cross_matrix(),
+            t1: -coupling,
+            compliance,
+        })
+    }
+
+    /// The quadratic shear–extension energy ½(ν − e3)ᵀS(ν − e3) with
+    /// compliance c = S⁻¹ (no coupling to κ): ν = e3 + c∘N.
+    pub fn sheared(compliance: &Vector3<f64>, force: &Vector3<f64>) -> Self {
+        let c = Matrix3::from_diagonal(compliance);
+        let nu = Vector3::z() + compliance.component_mul(force);
+        TipMotion {
+            t0: -nu.cross_matrix() + c * force.cross_matrix(),
+            t1: Matrix3::zeros(),
+            compliance: c,
+        }
     }
 }
 
@@ -529,6 +597,90 @@ impl FiniteElements {
             rows.push(row);
         }
         Constraints::from_rows(&rows, n)
+    }
+
+    /// The tip support of a shearable, extensible rod: a frame held as in
+    /// [`Self::support_constraints`], a position held along a_1 … a_k as
+    /// springs (module doc, "A held position on a Cosserat rod"): rows
+    /// c_i = a_i·∫ R(T₀ω + T₁ω') ds, D_ij = a_i·(∫ R H_νν⁻¹ Rᵀ ds) a_j =
+    /// LLᵀ, springs the rows of L⁻¹C. `motions` at the quadrature points.
+    /// None where D is not positive definite.
+    pub fn support_springs(
+        &self,
+        block: Block,
+        support: &TipSupport,
+        samples: &[RodSample],
+        tip: &RodSample,
+        motions: &[TipMotion],
+    ) -> Option<Constraints> {
+        let held = TipSupport {
+            translation: Freedom::Free,
+            ..support.clone()
+        };
+        let turns = self.support_constraints(block, &held, samples, tip);
+        let directions: Vec<Vector3<f64>> = match support.translation {
+            Freedom::Free => return Some(turns),
+            Freedom::Fixed => (0..3).map(|j| Vector3::ith(j, 1.0)).collect(),
+            Freedom::Axial(a) => across(&a).to_vec(),
+        };
+        let rows: Vec<DVector<f64>> = directions
+            .iter()
+            .map(|a| self.motion_row(block, a, samples, motions))
+            .collect();
+        let weights = self.quadrature_weights();
+        let compliance = samples.iter().zip(motions).zip(&weights).fold(
+            Matrix3::zeros(),
+            |sum, ((sample, m), w)| {
+                let r = Matrix3::from_columns(&sample.directors);
+                sum + r * m.compliance * r.transpose() * *w
+            },
+        );
+        let k = directions.len();
+        let d = nalgebra::DMatrix::from_fn(k, k, |i, j| {
+            directions[i].dot(&(compliance * directions[j]))
+        });
+        let l = d.cholesky()?.l();
+        let c = nalgebra::DMatrix::from_fn(k, self.size(block), |i, j| rows[i][j]);
+        let springs = l.solve_lower_triangular(&c)?;
+        let springs: Vec<DVector<f64>> = springs.row_iter().map(|r| r.transpose()).collect();
+        Some(turns.with_springs(&springs))
+    }
+
+    /// Σ_q w_q a·R(T₀ φ_node e_c + T₁ φ'_node e_c)(s_q) for every unknown:
+    /// a·δr(L) of the rotation field with the strain minimized out.
+    fn motion_row(
+        &self,
+        block: Block,
+        a: &Vector3<f64>,
+        samples: &[RodSample],
+        motions: &[TipMotion],
+    ) -> DVector<f64> {
+        let comps = block.components();
+        let p = self.order;
+        let (xs, ws) = gauss(p + 1);
+        let mut row = DVector::zeros(self.size(block));
+        for e in 0..self.elements() {
+            let (_, h) = self.element(e);
+            for (g, (&x, w)) in xs.iter().zip(&ws).enumerate() {
+                let q = e * (p + 1) + g;
+                let body = Matrix3::from_columns(&samples[q].directors).transpose() * a;
+                let (along, rate) = (
+                    motions[q].t0.transpose() * body,
+                    motions[q].t1.transpose() * body,
+                );
+                let (val, der) = self.shape(x);
+                for (local, (phi, dphi)) in val.iter().zip(&der).enumerate() {
+                    let Some(node) = (e * p + local).checked_sub(self.first_node(block)) else {
+                        continue;
+                    };
+                    for (i, &c) in comps.iter().enumerate() {
+                        row[node * comps.len() + i] +=
+                            w * h * (phi * along[c] + dphi / h * rate[c]);
+                    }
+                }
+            }
+        }
+        row
     }
 
     /// Σ_q w_q φ_node(s_q) a·(d_c × d3)(s_q) for every unknown.

@@ -81,6 +81,8 @@ impl KeyLens {
                 ))
             }
         }
+        let mut doc = doc;
+        pin_support_defaults(&mut doc, catalog);
         Ok(KeyLens {
             key: key.trim().to_string(),
             doc,
@@ -144,6 +146,42 @@ impl KeyLens {
             .map_err(|m| invalid(&self.key, m))?;
         let file: ProblemFile = strict::from_table(doc)?;
         build_rod(&file, &self.catalog)
+    }
+}
+
+/// The held tip's defaults written into the document at their start
+/// values: `support.d1`, `support.d3` (default: the clamp's directors,
+/// after its `angle` and `turn`) and `support.position` (default
+/// r(0) + L d3(0)). Rereading the problem with a clamp key or the length
+/// set would otherwise move the held tip with the clamp — a rigid motion,
+/// not the turn or shift the key asks for (a ring clamped at both ends
+/// and twisted by `clamp.turn.angle` turned both ends together and did
+/// not twist) — while the key's tangent (`RodTangent`) and the keys
+/// edited in the rod directly (`clamp.angle`, `rod.length`) hold the
+/// support where the start put it. Left alone where the document does not
+/// build (its error surfaces where it is read).
+fn pin_support_defaults(doc: &mut toml::Table, catalog: &EnergyCatalog) {
+    let Ok(file) = strict::from_table::<ProblemFile>(doc.clone()) else {
+        return;
+    };
+    let Ok(rod) = build_rod(&file, catalog) else {
+        return;
+    };
+    let Some(support) = rod.support() else {
+        return;
+    };
+    let Some(toml::Value::Table(table)) = doc.get_mut("support") else {
+        return;
+    };
+    let vector =
+        |v: Vector3<f64>| toml::Value::Array(v.iter().map(|x| toml::Value::Float(*x)).collect());
+    for (name, i) in [("d1", 0), ("d3", 2)] {
+        if !table.contains_key(name) {
+            table.insert(name.into(), vector(rod.clamp().director(i)));
+        }
+    }
+    if support.holds_position() && !table.contains_key("position") {
+        table.insert("position".into(), vector(support.position));
     }
 }
 

@@ -2,7 +2,9 @@
 //! profiles of non-prismatic or pre-curved rods.
 //!
 //! A profile is a constant, a polynomial in s (coefficients in increasing
-//! powers, s in the same length unit as the rod), or a piecewise-linear table.
+//! powers, s in the same length unit as the rod), a piecewise-linear table, a
+//! natural cubic spline, or a piecewise polynomial with breakpoints where the
+//! solvers stop (`piecewise.rs`).
 //! Energies need the value and its s-derivative: the body moment
 //! M = ∇W(s, κ) depends on s explicitly, so M' = H κ' + ∂s∇W and the
 //! equations solve κ' = H⁻¹(M' − ∂s∇W) with H = ∂²W/∂κ² (Antman,
@@ -23,6 +25,11 @@ pub enum Profile {
     /// The natural cubic spline through (s_k, v_k) (C², so that equations
     /// using the derivative stay continuous); build with [`Profile::spline`].
     Spline(SplineKnots),
+    /// A polynomial on each interval between breakpoints, possibly kinked
+    /// at them (a tapered section's stiffness); the solvers stop at its
+    /// breakpoints ([`Profile::breaks`]). Build with
+    /// [`Profile::piecewise`] or [`Profile::piecewise_interpolant`].
+    Piecewise(Pieces),
 }
 
 /// The points (s_k, v_k) of a table or spline: at least two, as many
@@ -97,7 +104,9 @@ impl SplineKnots {
     }
 }
 
+mod piecewise;
 mod polynomial;
+pub use piecewise::{Pieces, Sampler};
 use polynomial::polynomial_extremes;
 pub use polynomial::Extremes;
 
@@ -148,6 +157,46 @@ impl Profile {
         Ok(Profile::Spline(SplineKnots { knots, curvature }))
     }
 
+    /// The piecewise polynomial with the Chebyshev coefficients
+    /// `coefficients[k]` on [s_k, s_{k+1}] in t = (2s − s_k − s_{k+1})/(s_{k+1}
+    /// − s_k); refused as in [`Pieces::new`].
+    pub fn piecewise(breaks: Vec<f64>, coefficients: Vec<Vec<f64>>) -> Result<Profile, ModelError> {
+        Ok(Profile::Piecewise(Pieces::new(breaks, coefficients)?))
+    }
+
+    /// The piecewise interpolant of a function smooth between `breaks`, to
+    /// `tolerance` × max(`scale`, each piece's largest |value|); `f` gives
+    /// its values at sorted points of one piece. Refused where the
+    /// function is not smooth on a piece (degree 128 does not meet the
+    /// tolerance) or `f` fails (see the module `piecewise`).
+    pub fn piecewise_interpolant(
+        breaks: Vec<f64>,
+        f: &mut Sampler<'_>,
+        (tolerance, scale): (f64, f64),
+    ) -> Result<Profile, ModelError> {
+        Ok(Profile::Piecewise(piecewise::interpolate(
+            breaks,
+            f,
+            (tolerance, scale),
+        )?))
+    }
+
+    /// The interior points where the profile is not smooth and the
+    /// solvers stop: a piecewise profile's breakpoints strictly inside
+    /// (0, length). A table's knots are not listed (its kinks are left to
+    /// the integrator's step control, as they always were).
+    pub fn breaks(&self, length: f64) -> Vec<f64> {
+        match self {
+            Profile::Piecewise(p) => p
+                .interior_breaks()
+                .iter()
+                .copied()
+                .filter(|s| *s > 0.0 && *s < length)
+                .collect(),
+            _ => Vec::new(),
+        }
+    }
+
     /// The profile times a constant factor (a control raising an
     /// intrinsic curvature in proportion, paper Sec. 5).
     #[must_use]
@@ -161,6 +210,7 @@ impl Profile {
                 knots: sp.knots.with_values(times(&sp.knots.values)),
                 curvature: times(&sp.curvature),
             }),
+            Profile::Piecewise(p) => Profile::Piecewise(p.map(|v| v * factor)),
         }
     }
 
@@ -197,6 +247,7 @@ impl Profile {
                     curvature: mix(&a.curvature, &b.curvature),
                 })
             }
+            (Profile::Piecewise(a), Profile::Piecewise(b)) => Profile::Piecewise(a.blend(b, p)?),
             _ => return None,
         })
     }
@@ -223,6 +274,7 @@ impl Profile {
                     + h * h / 6.0
                         * ((a * a * a - a) * curvature[k] + (b * b * b - b) * curvature[k + 1])
             }
+            Profile::Piecewise(p) => p.value(s),
         }
     }
 
@@ -256,6 +308,7 @@ impl Profile {
                         * (-(3.0 * a * a - 1.0) * curvature[k]
                             + (3.0 * b * b - 1.0) * curvature[k + 1])
             }
+            Profile::Piecewise(p) => p.derivative(s),
         }
     }
 
@@ -269,6 +322,7 @@ impl Profile {
                 knots: Knots { values, .. },
                 ..
             }) => values.iter().all(|&x| x == 0.0),
+            Profile::Piecewise(p) => p.is_zero(),
         }
     }
 
@@ -334,6 +388,7 @@ impl Profile {
                 }
                 e
             }
+            Profile::Piecewise(p) => p.extremes_on(length),
         }
     }
     /// Every number in the profile is finite.
@@ -350,6 +405,7 @@ impl Profile {
                 .chain(values)
                 .chain(curvature)
                 .all(|x| x.is_finite()),
+            Profile::Piecewise(p) => p.is_finite(),
         }
     }
 }

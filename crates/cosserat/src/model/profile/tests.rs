@@ -139,3 +139,35 @@ fn knots_are_checked() {
         assert!(matches!(Profile::spline(s, v), Err(ModelError::Profile(_))));
     }
 }
+
+/// A piecewise profile lists its interior breakpoints inside (0, L) (other
+/// kinds none), and scales and blends as the function does.
+#[test]
+fn piecewise_breaks_scale_and_blend() {
+    let a = Profile::piecewise(
+        vec![0.0, 0.4, 1.0, 2.0],
+        vec![vec![1.0, 0.5], vec![2.0], vec![1.0, 0.0, 0.25]],
+    )
+    .unwrap();
+    let b = Profile::piecewise(
+        vec![0.0, 0.4, 1.0, 2.0],
+        vec![vec![3.0], vec![0.0, 1.0], vec![-1.0]],
+    )
+    .unwrap();
+    assert_eq!(a.breaks(1.5), vec![0.4, 1.0]);
+    assert_eq!(a.breaks(1.0), vec![0.4]);
+    assert!(Profile::Constant(1.0).breaks(1.0).is_empty());
+    let mix = a.blend(&b, 0.25).unwrap();
+    let twice = a.scaled(2.0);
+    for s in [0.0, 0.1, 0.4, 0.7, 1.0, 1.3, 2.0] {
+        let expect = 0.75 * a.value(s) + 0.25 * b.value(s);
+        assert!((mix.value(s) - expect).abs() < 1e-15, "{s}");
+        let slope = 0.75 * a.derivative(s) + 0.25 * b.derivative(s);
+        assert!((mix.derivative(s) - slope).abs() < 1e-14, "{s}");
+        assert!((twice.value(s) - 2.0 * a.value(s)).abs() < 1e-15);
+    }
+    let other = Profile::piecewise(vec![0.0, 0.5, 2.0], vec![vec![1.0], vec![1.0]]).unwrap();
+    assert!(a.blend(&other, 0.5).is_none(), "other breakpoints");
+    assert!(Profile::piecewise(vec![0.0, 1.0], vec![]).is_err());
+    assert!(Profile::piecewise(vec![1.0, 0.0], vec![vec![1.0]]).is_err());
+}

@@ -102,12 +102,28 @@ fn the_bordered_solve_equals_dense_lu() {
         lu.factor(&a, Some(&border)).unwrap();
         let mut z = vec![0.0; n + 1];
         assert!(lu.solve_bordered(&a, &border, &rhs, &mut z));
-        let dense = bordered_dense(&a, &border)
+        let m = bordered_dense(&a, &border);
+        let dense = m
+            .clone()
             .lu()
-            .solve(&DVector::from_vec(rhs))
+            .solve(&DVector::from_vec(rhs.clone()))
             .unwrap();
         assert_close(&z, &dense, 1e-10);
+        let mut w = vec![0.0; n + 1];
+        assert!(lu.solve_bordered_transposed(&a, &border, &rhs, &mut w));
+        let dense = m.transpose().lu().solve(&DVector::from_vec(rhs)).unwrap();
+        assert_close(&w, &dense, 1e-10);
     }
+}
+
+#[test]
+fn the_transposed_product_is_the_dense_one() {
+    let a = sample(3, 12, 5, 17);
+    let x = vector(a.size(), 18);
+    let mut y = vec![0.0; a.size()];
+    a.mul_transposed(&x, &mut y);
+    let dense = a.to_dense().transpose() * DVector::from_column_slice(&x);
+    assert_close(&y, &dense, 1e-14);
 }
 
 /// A fold: A with a zero column (x₁[0] enters no equation) and a zero row
@@ -136,8 +152,16 @@ fn the_bordered_solve_is_exact_at_a_fold() {
     let mut z = vec![0.0; n + 1];
     assert!(lu.solve_bordered(&a, &border, &rhs, &mut z));
     let m = bordered_dense(&a, &border);
-    let dense = m.clone().lu().solve(&DVector::from_vec(rhs)).unwrap();
+    let dense = m
+        .clone()
+        .lu()
+        .solve(&DVector::from_vec(rhs.clone()))
+        .unwrap();
     assert_close(&z, &dense, 1e-10);
+    let mut w = vec![0.0; n + 1];
+    assert!(lu.solve_bordered_transposed(&a, &border, &rhs, &mut w));
+    let dense = m.transpose().lu().solve(&DVector::from_vec(rhs)).unwrap();
+    assert_close(&w, &dense, 1e-10);
 }
 
 /// An exact branch point: M itself singular (a zero row of A that the

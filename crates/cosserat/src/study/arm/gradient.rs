@@ -99,7 +99,7 @@ impl ArmProblem {
 
 /// (∂ρ/∂c_j, ∂c1/∂c_j) for j = 2..M at the full coefficients `c` (module
 /// doc; both invariant under the rigid turn c1).
-fn chord_rates(c: &[f64]) -> (Vec<f64>, Vec<f64>) {
+pub(super) fn chord_rates(c: &[f64]) -> (Vec<f64>, Vec<f64>) {
     let free = c.len() - 1;
     let (mut x, mut z) = (0.0, 0.0);
     let (mut dx, mut dz) = (vec![0.0; free], vec![0.0; free]);

@@ -43,9 +43,17 @@ use super::resolve::{MeshStudy, Resolution, Verdict, REACH_TOLERANCE};
 use super::PATH_SEGMENTS;
 use super::{continue_family, sampling, ArmProblem, ArmScene, SearchOptions};
 use crate::continuation::{ContinuationError, Diagram, Family, Parameter, RunState};
-use crate::model::{Clamp, Frame, LinearElastic, ModelLevel, Profile, Rod};
+use crate::model::{Clamp, Frame, LinearElastic, ModelError, ModelLevel, Profile, Rod};
 use crate::numerics::integrator::Tolerances;
 use crate::stability::{critical_load_spatial, SpatialShape, TURN_PER_ELEMENT};
+
+/// The equal pieces of the designed rod's κ̄⁰ ([`SpatialArm::designed_rod`]).
+pub const KAPPA0_PIECES: usize = 8;
+
+/// The tolerance of the designed rod's κ̄⁰ on each piece, relative to its
+/// largest value there or 1/L: the rounding of the loaded shape's moment
+/// (DOP853 at 10⁻¹², the shape's samples).
+pub const KAPPA0_TOLERANCE: f64 = 1e-12;
 
 /// The spatial arm to design: the planar problem (stiffness ratios,
 /// direction, κ̄2's bounds as c2..cM, mesh) and the bounds of the
@@ -450,27 +458,40 @@ impl SpatialArm {
         })
     }
 
-    /// The rod of a design at its design load: κ̄⁰ as natural cubic splines
-    /// through `points` uniform nodes, the design's clamp, the scene's loads
-    /// scaled by γ_crit.
-    pub fn designed_rod(
-        &self,
-        scene: &ArmScene,
-        design: &SpatialDesign,
-        points: usize,
-    ) -> Option<Rod> {
+    /// The rod of a design at its design load: κ̄⁰ = κ̄ − γ H⁻¹M of the
+    /// loaded shape, interpolated on [`KAPPA0_PIECES`] equal pieces to
+    /// [`KAPPA0_TOLERANCE`] ([`Profile::piecewise_interpolant`]: smooth on
+    /// each, where a natural spline through many nodes has a third
+    /// derivative that jumps at every node, which the integrator's error
+    /// estimate misjudges — the noise floor of the loading path's
+    /// corrector, docs/extensions.md), the design's clamp, the scene's
+    /// loads scaled by γ_crit.
+    pub fn designed_rod(&self, scene: &ArmScene, design: &SpatialDesign) -> Option<Rod> {
         let rod = self.rod_with(scene, design.clamp_frame)?;
-        let s: Vec<f64> = (0..points)
-            .map(|i| i as f64 / (points - 1) as f64)
+        let shape = Self::shape(&design.curvature_coefficients);
+        let breaks: Vec<f64> = (0..=KAPPA0_PIECES)
+            .map(|i| i as f64 / KAPPA0_PIECES as f64)
             .collect();
-        let loaded = Self::shape(&design.curvature_coefficients)
-            .samples(&rod, &s)
-            .ok()?;
-        let kappa0 = SpatialShape::intrinsic_curvature(&rod, &loaded, design.gamma);
-        let shape = intrinsic_shape(&s, &kappa0).ok()?;
+        let component = |i: usize| {
+            Profile::piecewise_interpolant(
+                breaks.clone(),
+                &mut |s| {
+                    let loaded = shape
+                        .samples(&rod, s)
+                        .map_err(|e| ModelError::Profile(e.to_string()))?;
+                    Ok(
+                        SpatialShape::intrinsic_curvature(&rod, &loaded, design.gamma)
+                            .iter()
+                            .map(|k| k[i])
+                            .collect(),
+                    )
+                },
+                (KAPPA0_TOLERANCE, 1.0),
+            )
+        };
         let energy = LinearElastic::new(
             [self.planar.b1, 1.0, self.planar.b3].map(Profile::Constant),
-            shape.curvature,
+            [component(0).ok()?, component(1).ok()?, component(2).ok()?],
         )
         .ok()?;
         let loads = rod.loads().scaled(design.gamma);
@@ -485,20 +506,19 @@ impl SpatialArm {
     /// while it ends undecided: a branch that stops short with no fold and
     /// no loss of stability ("step size below 10⁻⁷: the corrector does not
     /// converge") has met the noise floor of its residual, not a property
-    /// of the arm. On 32 Kirchhoff segments the integration error carried
-    /// across a segment of a twisted, coiled arm leaves a scaled residual
-    /// above the corrector's τ = 10⁻¹¹ (the 45° optimum of the shipped arm
-    /// stops at λ = 0.0078, the 60° one at 0.26; with τ = 10⁻⁹ both reach
-    /// λ = 1); on 128 segments the same τ is met and the path is followed
-    /// to λ = 1, where its end agrees with the τ = 10⁻⁹ run on 32 segments
-    /// to 10⁻¹⁰ L. A verdict is returned from the first run that decides.
+    /// of the arm. Measured cause of that floor (issue 20): κ̄⁰ as a natural
+    /// spline through 2001 nodes, whose third derivative jumps at every
+    /// node, so that DOP853's error estimate failed there (the 45° optimum
+    /// of the shipped arm stopped at λ = 0.0078 on 32 segments, decided
+    /// only on 128); with κ̄⁰ smooth on each piece ([`Self::designed_rod`])
+    /// the same path is decided on 32.
     pub fn loading_path(
         &self,
         scene: &ArmScene,
         optimum: &SpatialOptimum,
         stop: &dyn Fn() -> bool,
     ) -> (Option<Diagram>, PathVerdict) {
-        let Some(rod) = self.designed_rod(scene, &optimum.design, 2001) else {
+        let Some(rod) = self.designed_rod(scene, &optimum.design) else {
             return (
                 None,
                 PathVerdict::Undecided("the designed rod could not be built".into()),

@@ -33,6 +33,13 @@
 
 use thiserror::Error;
 
+/// The joint ascent of shape and section (`taper_arm.rs`), named here with
+/// the section it optimizes: its result, its feasible set and its
+/// stopping tolerance.
+pub use super::taper_arm::{
+    ascend, AscentSummary, Feasible, JointAscent, JointEnd, Slope, ASCENT_TOLERANCE,
+};
+
 use crate::model::{ModelError, Profile, Rod};
 use crate::numerics::banded::SymmetricBanded;
 use crate::numerics::eigen::smallest_positive_load_factor;
@@ -172,18 +179,22 @@ impl Section {
     }
 
     /// The stiffness profile b·A(s̄)² on a rod of unit length, for the
-    /// equilibrium solvers: the natural cubic spline through 32 points per
-    /// knot interval. A² is quadratic between knots with kinks at them; a
-    /// table's 32 kinks per interval stalled the shooting Newton of the
-    /// loading path at a residual of 10⁻⁷ (DOP853 on a right-hand side that
-    /// is not smooth), the C² spline does not. Its distance from A² is
-    /// O((Δs)² Δ(A²)') at the knots, where the fixed-shape pencil of the
-    /// same rod ([`crate::stability::critical_load`]) checks it.
+    /// equilibrium solvers, exactly: a quadratic on each knot interval
+    /// (A = m + d t there, t ∈ [−1, 1], so A² = (m² + d²/2) T0 + 2md T1 +
+    /// (d²/2) T2), kinked at the knots, where the solvers stop
+    /// ([`crate::model::Rod::breaks`]). A natural spline through samples of
+    /// A² rang at the kinks instead, and its intrinsic curvature with it
+    /// (docs/extensions.md, "Loading path").
     pub fn stiffness(&self, b: f64) -> Result<Profile, ModelError> {
-        let n = 32 * (self.values.len() - 1);
-        let s: Vec<f64> = (0..=n).map(|i| i as f64 / n as f64).collect();
-        let v = s.iter().map(|t| b * self.at(*t).powi(2)).collect();
-        Profile::spline(s, v)
+        let pieces = self
+            .values
+            .windows(2)
+            .map(|w| {
+                let (m, d) = (0.5 * (w[0] + w[1]), 0.5 * (w[1] - w[0]));
+                vec![b * (m * m + 0.5 * d * d), b * 2.0 * m * d, b * 0.5 * d * d]
+            })
+            .collect();
+        Profile::piecewise(self.knots(), pieces)
     }
 }
 
