@@ -17,7 +17,31 @@ const EULER: &str = include_str!("../../../problems/euler_column.toml");
 
 #[test]
 fn euler_branch_point_curve_is_pi_squared_over_four_l_squared() {
-    let problem = Problem::from_str_with(EULER, &["continuation.switch_depth=0".into()]).unwrap();
+    euler_curve(&[]);
+}
+
+/// The same curve on collocation with 400 intervals (1597 unknowns): the
+/// augmented system is solved in F_x's band shape
+/// (`continuation/bordering.rs`), O(N) per Newton step — it was dense,
+/// with a finite-difference gradient of g costing N + 2 Jacobians.
+#[test]
+#[cfg_attr(
+    debug_assertions,
+    ignore = "a 1597-unknown curve, ≈ 3 s in release: run with --release"
+)]
+fn the_curve_is_followed_on_a_large_collocation_family() {
+    euler_curve(&[
+        "solver.method=\"collocation\"",
+        "continuation.intervals=400",
+    ]);
+}
+
+/// Follows Euler's branch point in (load, length) on the problem with
+/// `sets` and checks every point against π²/(4L²).
+fn euler_curve(sets: &[&str]) {
+    let mut all = vec!["continuation.switch_depth=0".to_string()];
+    all.extend(sets.iter().map(|s| (*s).to_string()));
+    let problem = Problem::from_str_with(EULER, &all).unwrap();
     let (family, opts) = problem.continuation.clone().unwrap();
     let d = continuation(&family, &opts, &mut |_, _| true).unwrap();
     let bp = d
@@ -42,6 +66,11 @@ fn euler_branch_point_curve_is_pi_squared_over_four_l_squared() {
         &curve_opts,
     )
     .unwrap();
+    eprintln!(
+        "{} unknowns, {} points of the curve",
+        family.size(),
+        curve.points.len()
+    );
     assert_eq!(curve.keys, ["load_scale", "rod.length"]);
     assert!(curve.points.len() > 10, "{} points", curve.points.len());
     let (mut shortest, mut longest) = (f64::INFINITY, 0.0f64);

@@ -114,6 +114,16 @@ impl BorderedJacobian {
         })
     }
 
+    /// K's border column b.
+    pub fn column(&self) -> &DVector<f64> {
+        &self.column
+    }
+
+    /// K's border row c.
+    pub fn row(&self) -> &DVector<f64> {
+        &self.row
+    }
+
     /// K⁻¹ rhs (length N + 1); None where it is not finite.
     pub fn solve(&mut self, rhs: &DVector<f64>) -> Option<DVector<f64>> {
         self.solve_either(rhs, false)

@@ -23,9 +23,9 @@
 
 use std::sync::Arc;
 
-use nalgebra::{DMatrix, DVector};
+use nalgebra::DVector;
 
-use super::bordering::BorderedJacobian;
+use super::bordering::{low_rank_solve, BorderedJacobian};
 use super::corrector::Linearization;
 
 use super::{ContinuationError, Family, FamilyError, Lens, PointError};
@@ -138,11 +138,25 @@ struct Augmented<'a> {
     branch: bool,
 }
 
-/// F, F_x at z.
-type Evaluated = (DVector<f64>, DMatrix<f64>);
+/// A corrected point: z, the linearized system there, Newton iterations.
+type Corrected = (Vec<f64>, Linearized, usize);
 
-/// A corrected point: z, the Jacobian there, Newton iterations.
-type Corrected = (Vec<f64>, DMatrix<f64>, usize);
+/// The augmented system linearized at z: its residual and the pieces of
+/// its Jacobian, kept in F_x's shape (`bordering.rs`). In the unknowns'
+/// order (x, [ψ,] p₁, p₂) the Jacobian of (F [+ ψb], [phase,] g), closed
+/// by an arclength row, is diag(K, I) — K = [F_x b; cᵀ 0], whose border
+/// row is the phase of a branch point — plus the columns F_p₁, F_p₂ (and
+/// F_p₁ − b for a fold, whose p₁ takes K's border column) and the rows of
+/// g and of the arclength: a Woodbury correction of rank ≤ 4 of K's
+/// factors, O(N) per solve.
+struct Linearized {
+    residual: DVector<f64>,
+    k: BorderedJacobian,
+    /// F_p₁ and F_p₂.
+    fp: [DVector<f64>; 2],
+    /// ∇g = (g_x, [0,] g_p₁, g_p₂) in the unknowns' order.
+    gradient: DVector<f64>,
+}
 
 impl Augmented<'_> {
     fn slice(&self, second: f64) -> Family {
@@ -152,25 +166,14 @@ impl Augmented<'_> {
         }))
     }
 
-    fn evaluate(&self, z: &[f64]) -> Result<Evaluated, PointError> {
+    /// F and F_x at z, F_x in the corrector's shape.
+    fn evaluate(&self, z: &[f64]) -> Result<(DVector<f64>, Linearization), PointError> {
         let n = self.n;
-        let (mut r, mut fx) = (DVector::zeros(n), DMatrix::zeros(n, n));
-        self.slice(z[n + 1])
-            .residual(&z[..n], z[n], &mut r, &mut fx)?;
+        let family = self.slice(z[n + 1]);
+        let mut fx = Linearization::of(&family);
+        let mut r = DVector::zeros(n);
+        fx.evaluate(&family, &z[..n], z[n], &mut r)?;
         Ok((r, fx))
-    }
-
-    /// g and v of the bordered system at F_x (None where it is singular:
-    /// a kernel of dimension two, or borders orthogonal to it).
-    fn singularity(
-        fx: &DMatrix<f64>,
-        b: &DVector<f64>,
-        c: &DVector<f64>,
-    ) -> Option<(f64, DVector<f64>)> {
-        let n = fx.nrows();
-        let mut k = BorderedJacobian::new(Linearization::Dense(fx.clone()), b.clone(), c.clone())?;
-        let vg = k.solve(&super::fold::unit(n + 1, n))?;
-        Some((vg[n], vg.rows(0, n).into_owned()))
     }
 
     /// Unknowns: x, p₁, p₂ and, at a branch point, ψ.
@@ -178,71 +181,174 @@ impl Augmented<'_> {
         self.n + 2 + usize::from(self.branch)
     }
 
-    /// The residual (F [+ ψ b], [phase,] g) and its Jacobian in z
-    /// ((m − 1) × m, m = [`Self::unknowns`]); `anchor` is the x the phase
-    /// is measured from.
+    /// Where p₁ and p₂ sit in the solver's order (x, [ψ,] p₁, p₂).
+    fn parameter_slots(&self) -> (usize, usize) {
+        let m = self.unknowns();
+        (m - 2, m - 1)
+    }
+
+    /// z = (x, p₁, p₂, [ψ]) in the solver's order (x, [ψ,] p₁, p₂), and
+    /// back ([`Self::in_z_order`]).
+    fn in_solver_order(&self, z: &[f64]) -> DVector<f64> {
+        let n = self.n;
+        let mut y = DVector::from_column_slice(z);
+        if self.branch {
+            y[n] = z[n + 2];
+            y[n + 1] = z[n];
+            y[n + 2] = z[n + 1];
+        }
+        y
+    }
+
+    fn in_z_order(&self, y: &DVector<f64>) -> Vec<f64> {
+        let n = self.n;
+        let mut z = y.as_slice().to_vec();
+        if self.branch {
+            z[n] = y[n + 1];
+            z[n + 1] = y[n + 2];
+            z[n + 2] = y[n];
+        }
+        z
+    }
+
+    /// The residual (F [+ ψ b], [phase,] g) at z, in the equations' order
+    /// (F, [phase,] g), and its linearization; `anchor` is the x the phase
+    /// is measured from. g and its gradient come from K = [F_x b; cᵀ 0]:
+    /// K[v; g] = e, Kᵀ[w; ·] = e, g_z = −wᵀF_xz v (Govaerts 2000, §3.2;
+    /// `fold.rs`), the second derivatives by central differences of the
+    /// exact F_x.
     fn system(
         &self,
         z: &[f64],
         b: &DVector<f64>,
         c: &DVector<f64>,
         anchor: &[f64],
-    ) -> Result<(DVector<f64>, DMatrix<f64>), PointError> {
+    ) -> Result<Linearized, PointError> {
         let n = self.n;
         let m = self.unknowns();
         let singular = || PointError::SingularTangent(z[n]);
+        let (x, p1, p2) = (&z[..n], z[n], z[n + 1]);
         let (mut f, fx) = self.evaluate(z)?;
-        let (g, _) = Self::singularity(&fx, b, c).ok_or_else(singular)?;
-        let mut jac = DMatrix::zeros(m - 1, m);
-        jac.view_mut((0, 0), (n, n)).copy_from(&fx);
-        let fp1 = self.slice(z[n + 1]).parameter_derivative(&z[..n], z[n])?;
-        jac.view_mut((0, n), (n, 1)).copy_from(&fp1);
-        let h2 = 1e-6 * z[n + 1].abs().max(1.0);
+        let mut k = BorderedJacobian::new(fx, b.clone(), c.clone()).ok_or_else(singular)?;
+        let e = super::fold::unit(n + 1, n);
+        let vg = k.solve(&e).ok_or_else(singular)?;
+        let (v, g) = (vg.rows(0, n).into_owned(), vg[n]);
+        let w = k
+            .solve_transposed(&e)
+            .ok_or_else(singular)?
+            .rows(0, n)
+            .into_owned();
+        let here = self.slice(p2);
+        let fp1 = here.parameter_derivative(x, p1)?;
+        let h2 = 1e-6 * p2.abs().max(1.0);
+        let (up2, down2) = (self.slice(p2 + h2), self.slice(p2 - h2));
         let (mut up, mut down) = (DVector::zeros(n), DVector::zeros(n));
-        self.slice(z[n + 1] + h2)
-            .residual_only(&z[..n], z[n], &mut up)?;
-        self.slice(z[n + 1] - h2)
-            .residual_only(&z[..n], z[n], &mut down)?;
-        jac.view_mut((0, n + 1), (n, 1))
-            .copy_from(&((up - down) / (2.0 * h2)));
-        let mut r = DVector::zeros(m - 1);
+        up2.residual_only(x, p1, &mut up)?;
+        down2.residual_only(x, p1, &mut down)?;
+        let fp2 = (up - down) / (2.0 * h2);
+        // g_x by a central difference of wᵀF_x along v.
+        let eps = 1e-6 * x.iter().fold(1.0f64, |m, v| m.max(v.abs())) / v.amax();
+        let shifted =
+            |sign: f64| -> Vec<f64> { x.iter().zip(&v).map(|(a, d)| a + sign * eps * d).collect() };
+        let along = |family: &Family, x: &[f64], p: f64| -> Result<Linearization, PointError> {
+            let mut fx = Linearization::of(family);
+            let mut r = DVector::zeros(n);
+            fx.evaluate(family, x, p, &mut r)?;
+            Ok(fx)
+        };
+        let gx = -(along(&here, &shifted(1.0), p1)?.mul_transposed(&w)
+            - along(&here, &shifted(-1.0), p1)?.mul_transposed(&w))
+            / (2.0 * eps);
+        let h1 = 1e-6 * p1.abs().max(1.0);
+        let gp1 = -w.dot(&(along(&here, x, p1 + h1)?.mul(&v) - along(&here, x, p1 - h1)?.mul(&v)))
+            / (2.0 * h1);
+        let gp2 =
+            -w.dot(&(along(&up2, x, p1)?.mul(&v) - along(&down2, x, p1)?.mul(&v))) / (2.0 * h2);
+        let mut residual = DVector::zeros(m - 1);
+        let mut gradient = DVector::zeros(m);
+        gradient.rows_mut(0, n).copy_from(&gx);
+        let (s1, s2) = self.parameter_slots();
+        gradient[s1] = gp1;
+        gradient[s2] = gp2;
         if self.branch {
             f += b * z[n + 2];
-            jac.view_mut((0, n + 2), (n, 1)).copy_from(b);
-            jac.view_mut((n, 0), (1, n)).copy_from(&c.transpose());
-            r[n] = c
+            residual[n] = c
                 .iter()
-                .zip(&z[..n])
+                .zip(x)
                 .zip(anchor)
                 .map(|((c, x), a)| c * (x - a))
                 .sum();
         }
-        let row = m - 2;
-        for j in 0..n + 2 {
-            let eps = 1e-7 * z[j].abs().max(1.0);
-            let mut zj = z.to_vec();
-            zj[j] += eps;
-            let (_, fxj) = self.evaluate(&zj)?;
-            let (gj, _) = Self::singularity(&fxj, b, c).ok_or_else(singular)?;
-            jac[(row, j)] = (gj - g) / eps;
-        }
-        r.rows_mut(0, n).copy_from(&f);
-        r[row] = g;
-        Ok((r, jac))
+        residual.rows_mut(0, n).copy_from(&f);
+        residual[m - 2] = g;
+        Ok(Linearized {
+            residual,
+            k,
+            fp: [fp1, fp2],
+            gradient,
+        })
     }
 
-    /// The left and right null vectors of F_x (smallest singular vectors).
-    fn null_vectors(fx: &DMatrix<f64>) -> (DVector<f64>, DVector<f64>) {
-        let svd = fx.clone().svd(true, true);
-        let k = svd.singular_values.imin();
-        let u = svd.u.expect("asked for U").column(k).into_owned();
-        let v = svd
-            .v_t
-            .expect("asked for Vᵀ")
-            .row(k)
-            .transpose()
-            .into_owned();
-        (u, v)
+    /// The solution y (solver's order) of [J; rowᵀ] y = rhs, J the
+    /// Jacobian of `at`, by Woodbury on diag(K, I) (see [`Linearized`]).
+    fn solve(
+        &self,
+        at: &mut Linearized,
+        row: &DVector<f64>,
+        rhs: &DVector<f64>,
+    ) -> Option<DVector<f64>> {
+        let n = self.n;
+        let m = self.unknowns();
+        let (s1, s2) = self.parameter_slots();
+        let unit = |k: usize| super::fold::unit(m, k);
+        let padded = |v: &DVector<f64>| {
+            DVector::from_iterator(m, v.iter().copied().chain(std::iter::repeat(0.0)).take(m))
+        };
+        // K occupies rows and columns 0..=n; the identity the rest.
+        let mut u = vec![padded(&at.fp[1])];
+        let mut v = vec![unit(s2)];
+        if self.branch {
+            // Columns p₁ (slot n + 1), p₂ (n + 2); rows g (n + 1), arc (n + 2).
+            u.push(padded(&at.fp[0]));
+            v.push(unit(s1));
+            let mut g_row = at.gradient.clone();
+            g_row[s1] -= 1.0;
+            u.push(unit(n + 1));
+            v.push(g_row);
+        } else {
+            // p₁ takes K's border column b; g takes K's border row c.
+            let b = at.k.column().clone();
+            u.push(padded(&(&at.fp[0] - b)));
+            v.push(unit(s1));
+            let mut g_row = at.gradient.clone();
+            g_row.rows_mut(0, n).axpy(-1.0, at.k.row(), 1.0);
+            u.push(unit(n));
+            v.push(g_row);
+        }
+        let mut arc = row.clone();
+        arc[m - 1] -= 1.0;
+        u.push(unit(m - 1));
+        v.push(arc);
+        let k = &mut at.k;
+        let solve_k = |r: &DVector<f64>| -> Option<DVector<f64>> {
+            let head = k.solve(&r.rows(0, n + 1).into_owned())?;
+            Some(DVector::from_iterator(
+                m,
+                head.iter().copied().chain(r.iter().skip(n + 1).copied()),
+            ))
+        };
+        low_rank_solve(solve_k, &u, &v, rhs)
+    }
+
+    /// The left and right null vectors of F_x at a point of parameter p₁
+    /// (`bordering.rs`).
+    fn null_vectors(
+        fx: &Linearization,
+        p: f64,
+    ) -> Result<(DVector<f64>, DVector<f64>), PointError> {
+        let (right, left) =
+            super::bordering::null_vectors(fx).ok_or(PointError::SingularTangent(p))?;
+        Ok((left, right))
     }
 
     /// Newton on (F, g) = 0 and ⟨z − z_pred, τ⟩ = 0 from z_pred.
@@ -256,36 +362,29 @@ impl Augmented<'_> {
     ) -> Result<Option<Corrected>, PointError> {
         let m = self.unknowns();
         let mut z = pred.to_vec();
+        let row = self.in_solver_order(tau);
         for iteration in 1..=10 {
-            let (r, jac) = self.system(&z, borders.0, borders.1, anchor)?;
-            let mut a = DMatrix::zeros(m, m);
-            a.view_mut((0, 0), (m - 1, m)).copy_from(&jac);
-            for (j, t) in tau.iter().enumerate() {
-                a[(m - 1, j)] = *t;
-            }
+            let mut at = self.system(&z, borders.0, borders.1, anchor)?;
             let mut rhs = DVector::zeros(m);
-            rhs.rows_mut(0, m - 1).copy_from(&r);
+            rhs.rows_mut(0, m - 1).copy_from(&at.residual);
             rhs[m - 1] = z
                 .iter()
                 .zip(pred)
                 .zip(tau)
                 .map(|((a, b), t)| (a - b) * t)
                 .sum();
-            let Some(dz) = a
-                .lu()
-                .solve(&rhs)
-                .filter(|d| d.iter().all(|v| v.is_finite()))
-            else {
+            let Some(dy) = self.solve(&mut at, &row, &rhs) else {
                 return Ok(None);
             };
-            for (zi, d) in z.iter_mut().zip(dz.iter()) {
+            let dz = self.in_z_order(&dy);
+            for (zi, d) in z.iter_mut().zip(&dz) {
                 *zi -= d;
             }
             let size = z.iter().fold(1.0f64, |m, v| m.max(v.abs()));
-            if Self::converged(&r, &jac, tolerance) && dz.amax() <= 100.0 * tolerance * size {
-                let (r, jac) = self.system(&z, borders.0, borders.1, anchor)?;
-                if Self::converged(&r, &jac, tolerance) {
-                    return Ok(Some((z, jac, iteration)));
+            if Self::converged(&at, tolerance) && dy.amax() <= 100.0 * tolerance * size {
+                let at = self.system(&z, borders.0, borders.1, anchor)?;
+                if Self::converged(&at, tolerance) {
+                    return Ok(Some((z, at, iteration)));
                 }
             }
         }
@@ -297,28 +396,36 @@ impl Augmented<'_> {
     /// length of its gradient, a distance in z — g itself has the scale of
     /// F_x's smallest singular value, which says nothing of how far the
     /// point is.
-    fn converged(r: &DVector<f64>, jac: &DMatrix<f64>, tolerance: f64) -> bool {
+    fn converged(at: &Linearized, tolerance: f64) -> bool {
+        let r = &at.residual;
         let row = r.len() - 1;
-        let gradient = jac.row(row).norm();
-        r.rows(0, row).amax() <= tolerance && r[row].abs() <= tolerance * gradient
+        r.rows(0, row).amax() <= tolerance && r[row].abs() <= tolerance * at.gradient.norm()
     }
 
-    /// The unit null vector of the (n + 1) × (n + 2) Jacobian, oriented
-    /// along `previous`.
-    fn tangent(jac: &DMatrix<f64>, previous: &[f64]) -> Option<Vec<f64>> {
-        let m = jac.ncols();
-        let mut a = DMatrix::zeros(m, m);
-        a.view_mut((0, 0), (m - 1, m)).copy_from(jac);
-        for (j, t) in previous.iter().enumerate() {
-            a[(m - 1, j)] = *t;
-        }
-        let mut rhs = DVector::zeros(m);
-        rhs[m - 1] = 1.0;
-        let t = a
-            .lu()
-            .solve(&rhs)
-            .filter(|t| t.iter().all(|v| v.is_finite()) && t.norm() > 0.0)?;
-        Some(t.normalize().as_slice().to_vec())
+    /// The unit null vector of the Jacobian at `at` (z's order), oriented
+    /// along `previous`: [J; previousᵀ] t = e_last.
+    fn tangent(&self, at: &mut Linearized, previous: &[f64]) -> Option<Vec<f64>> {
+        let m = self.unknowns();
+        let rhs = super::fold::unit(m, m - 1);
+        let y = self.solve(at, &self.in_solver_order(previous), &rhs)?;
+        let t = DVector::from_vec(self.in_z_order(&y));
+        (t.iter().all(|v| v.is_finite()) && t.norm() > 0.0)
+            .then(|| t.normalize().as_slice().to_vec())
+    }
+
+    /// g and v at z with the borders (b, c).
+    fn singularity(
+        &self,
+        z: &[f64],
+        b: &DVector<f64>,
+        c: &DVector<f64>,
+    ) -> Result<(f64, DVector<f64>), PointError> {
+        let n = self.n;
+        let singular = PointError::SingularTangent(z[n]);
+        let (_, fx) = self.evaluate(z)?;
+        let mut k = BorderedJacobian::new(fx, b.clone(), c.clone()).ok_or(singular.clone())?;
+        let vg = k.solve(&super::fold::unit(n + 1, n)).ok_or(singular)?;
+        Ok((vg[n], vg.rows(0, n).into_owned()))
     }
 }
 
@@ -354,16 +461,17 @@ pub fn follow_singular(
     z0.extend_from_slice(&p);
     z0.resize(m, 0.0);
     let (_, fx) = aug.evaluate(&z0)?;
-    let (b, c) = Augmented::null_vectors(&fx);
+    let (b, c) = Augmented::null_vectors(&fx, p[0])?;
     // Land on the curve at the given p₂ (the constraint row fixes p₂).
     let mut fix = vec![0.0; m];
     fix[n + 1] = 1.0;
-    let (z, jac, _) = aug
+    let (z, mut at, _) = aug
         .correct(&z0, &fix, (&b, &c), x, opts.tolerance)?
         .ok_or_else(|| {
             start_err("no singular point near the given one at this second parameter".into())
         })?;
-    let tau = Augmented::tangent(&jac, &fix)
+    let tau = aug
+        .tangent(&mut at, &fix)
         .ok_or_else(|| start_err("the curve has no tangent at the start".into()))?;
     let first = curve_point(&aug, &z, tau, &b, &c)?;
     let mut halves = vec![];
@@ -420,17 +528,19 @@ fn locate_cusp(
         .map(|((x, y), t)| (y - x) * t)
         .sum();
     let (_, fx) = aug.evaluate(&z0)?;
-    let (left, right) = Augmented::null_vectors(&fx);
+    let (left, right) = Augmented::null_vectors(&fx, a.parameters[0])?;
     let along = projected(a, n);
     let at = |s: f64| -> Result<(Vec<f64>, Vec<f64>), ContinuationError> {
         let pred: Vec<f64> = z0.iter().zip(&tau).map(|(z, t)| z + s * t).collect();
-        let (z, jac, _) = aug
+        let (z, mut at, _) = aug
             .correct(&pred, &tau, (&left, &right), &a.unknowns, opts.tolerance)?
             .ok_or_else(|| ContinuationError::Start {
                 p: a.parameters[0],
                 message: "the cusp could not be located: a corrector did not converge".into(),
             })?;
-        let t = Augmented::tangent(&jac, &tau).ok_or(PointError::SingularTangent(z[n]))?;
+        let t = aug
+            .tangent(&mut at, &tau)
+            .ok_or(PointError::SingularTangent(z[n]))?;
         Ok((z, t))
     };
     let (mut lo, mut hi) = (0.0, span);
@@ -464,8 +574,7 @@ fn curve_point(
     c: &DVector<f64>,
 ) -> Result<CurvePoint, PointError> {
     let n = aug.n;
-    let (_, fx) = aug.evaluate(z)?;
-    let (g, v) = Augmented::singularity(&fx, b, c).ok_or(PointError::SingularTangent(z[n]))?;
+    let (g, v) = aug.singularity(z, b, c)?;
     Ok(CurvePoint {
         parameters: [z[n], z[n + 1]],
         unknowns: z[..n].to_vec(),
@@ -505,11 +614,13 @@ fn walk(
         let pred: Vec<f64> = z.iter().zip(&tau).map(|(a, t)| a + ds * t).collect();
         // Borders: the last point's null vectors (right v; left from Fᵀ).
         let (_, fx) = aug.evaluate(&z)?;
-        let (b, c) = Augmented::null_vectors(&fx);
-        if let Some((z, jac, iterations)) =
+        let (b, c) = Augmented::null_vectors(&fx, p1)?;
+        if let Some((z, mut at, iterations)) =
             aug.correct(&pred, &tau, (&b, &c), &last.unknowns, opts.tolerance)?
         {
-            let t = Augmented::tangent(&jac, &tau).ok_or(PointError::SingularTangent(z[n]))?;
+            let t = aug
+                .tangent(&mut at, &tau)
+                .ok_or(PointError::SingularTangent(z[n]))?;
             let stored: Vec<f64> = t.iter().map(|v| v * sign).collect();
             points.push(curve_point(aug, &z, stored, &b, &c)?);
             if iterations <= 3 {

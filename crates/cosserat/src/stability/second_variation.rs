@@ -202,7 +202,7 @@ impl FormCoefficients {
 /// Cosserat rod"), body components.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TipMotion {
-    /// T₀ = −[ν]× + H_νν⁻¹([N]× − H_νκ[κ]×).
+    /// T₀ = −\[ν\]× + H_νν⁻¹(\[N\]× − H_νκ\[κ\]×).
     pub t0: Matrix3<f64>,
     /// T₁ = −H_νν⁻¹H_νκ.
     pub t1: Matrix3<f64>,
