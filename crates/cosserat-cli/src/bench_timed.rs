@@ -237,7 +237,7 @@ fn bench_continue(path: &Path, problem: &Problem, repeat: usize) -> Measured {
 }
 
 fn bench_optimize(path: &Path, problem: &Problem, repeat: usize) -> Measured {
-    use crate::optimize_command::{after_search, search_only};
+    use crate::optimize_command::{after_search, search_only, with_straight};
     if problem.arm_taper.is_some() {
         return Err(fail(
             BAD_INPUT,
@@ -266,13 +266,15 @@ fn bench_optimize(path: &Path, problem: &Problem, repeat: usize) -> Measured {
         ));
     };
     let (times, (opt, straight)) = time_runs(repeat, || {
-        let opt = search_only(arm, search, scene).ok_or_else(|| {
+        let (opt, beside) =
+            with_straight(arm, scene, *straight, || search_only(arm, search, scene));
+        let opt = opt.ok_or_else(|| {
             fail(
                 NO_RESULT,
                 "arm.bounds: no design with a finite critical load was found in the bounds",
             )
         })?;
-        let (straight, _map) = after_search(arm, search, scene, (*samples, *straight), &opt);
+        let (straight, _map) = after_search(arm, search, scene, (*samples, beside), &opt);
         Ok((opt, straight))
     })?;
     let work = Work {

@@ -89,8 +89,10 @@ pub fn run_optimize(run: &OptimizeRun) -> ExitCode {
     };
     report_problem(path, arm, scene);
     let t = Instant::now();
-    let (optimum, progress, was_interrupted) =
-        run_search(run, &problem.text, arm, search, scene, progress);
+    let ((optimum, progress, was_interrupted), beside) =
+        with_straight(arm, scene, *straight, || {
+            run_search(run, &problem.text, arm, search, scene, progress)
+        });
     let Some(opt) = optimum else {
         let limit = scene.max_curvature.map_or(String::new(), |k| {
             format!(" that the actuator limit arm.max_curvature = {k} can hold")
@@ -122,7 +124,7 @@ pub fn run_optimize(run: &OptimizeRun) -> ExitCode {
     // study then stays marked interrupted (its search complete), so that
     // `--resume` computes the rest.
     signals::set_mode(signals::Mode::NextPoint);
-    let (straight, extras) = after_search(arm, search, scene, (*map_samples, *straight), &opt);
+    let (straight, extras) = after_search(arm, search, scene, (*map_samples, beside), &opt);
     if signals::requested() {
         return keep_interrupted(run, &problem.text, &opt, &progress);
     }
@@ -208,19 +210,43 @@ pub fn search_only(
     .0
 }
 
-/// What `cosserat optimize` computes after its search: the intrinsically
-/// straight arm's R0 (when `straight` asks for it and the arm is
-/// weightless) and the Fig. 5 data set of `samples` map points.
+/// The intrinsically straight arm's R0 as computed beside the search: None
+/// where it is not asked for (`arm.straight = false`, or an arm with
+/// weight), else the arm (None where no stable level equilibrium was
+/// found) and the seconds it took.
+pub type StraightRun = Option<(Option<StraightArm>, f64)>;
+
+/// `search()` and the straight arm's R0 (where `straight` asks for it and
+/// the arm is weightless) at the same time on rayon's threads: R0 does
+/// not depend on the search, and the search leaves a thread idle at its
+/// stages' ends. Both stop at once on a signal.
+pub fn with_straight<T: Send>(
+    arm: &ArmProblem,
+    scene: &ArmScene,
+    straight: bool,
+    search: impl FnOnce() -> T + Send,
+) -> (T, StraightRun) {
+    let wanted = straight && scene.weight == ArmWeight::Weightless;
+    rayon::join(search, || {
+        wanted.then(|| {
+            let t = Instant::now();
+            let s = arm.straight_until(&signals::requested);
+            (s, t.elapsed().as_secs_f64())
+        })
+    })
+}
+
+/// What `cosserat optimize` computes after its search: the report of the
+/// intrinsically straight arm's R0 computed beside it ([`with_straight`])
+/// and the Fig. 5 data set of `samples` map points.
 pub fn after_search(
     arm: &ArmProblem,
     search: &SearchOptions,
     scene: &ArmScene,
-    (samples, straight): (usize, bool),
+    (samples, straight): (usize, StraightRun),
     opt: &ArmOptimum,
 ) -> (Option<StraightArm>, MapExtras) {
-    let straight = (straight && scene.weight == ArmWeight::Weightless)
-        .then(|| straight_optimum(arm, opt))
-        .flatten();
+    let straight = straight.and_then(|(s, seconds)| report_straight(s, seconds, opt));
     (straight, map_extras(arm, search, scene, samples, opt))
 }
 
@@ -453,6 +479,33 @@ fn report_optimum(opt: &ArmOptimum, time: f64) {
     report_mesh(opt);
 }
 
+/// `value ± bound` with the digits down to the bound's: every printed digit
+/// is converged.
+fn with_bound(value: f64, bound: f64) -> String {
+    let digits = (-bound.max(f64::EPSILON * value.abs()).log10())
+        .floor()
+        .clamp(0.0, 15.0);
+    format!("{value:.0$} ± {bound:.1e}", digits as usize)
+}
+
+/// The mesh-converged optimum (`ReachLimit`): its three order-2 meshes and
+/// Richardson's limit with its bound, or why there is none.
+fn report_limit(l: &cosserat::study::arm::ReachLimit) {
+    let s = &l.study;
+    let limit = match (l.converged(), s.order()) {
+        (Some((limit, bound)), Some(p)) => format!(
+            "R*(N → ∞) = {} (Richardson at the measured order {p:.2}; ± the finest mesh's \
+             estimated error)",
+            with_bound(limit, bound)
+        ),
+        _ => "R*(N → ∞) undecided (the differences do not converge geometrically)".into(),
+    };
+    println!(
+        "limit     R* = {:.9} / {:.9} / {:.9} on {} / {} / {} elements of order {}: {limit}",
+        s.reach[0], s.reach[1], s.reach[2], s.elements[0], s.elements[1], s.elements[2], l.order
+    );
+}
+
 /// The discretization error of R* (`optimize::Resolution`), and a warning on
 /// stderr when the search's mesh did not resolve its optimum.
 fn report_mesh(opt: &ArmOptimum) {
@@ -465,24 +518,23 @@ fn report_mesh(opt: &ArmOptimum) {
         _ => "error undecided (the differences do not converge geometrically)".into(),
     };
     println!(
-        "mesh      R* = {:.6} / {:.6} / {:.6} on {} / {} / {} elements: {error}; {}",
+        "mesh      R* = {:.6} / {:.6} / {:.6} on {} / {} / {} elements of order {}: {error}; {}",
         s.reach[0],
         s.reach[1],
         s.reach[2],
         s.elements[0],
         s.elements[1],
         s.elements[2],
+        opt.mesh.order(),
         r.verdict.name()
     );
-    if let Some((limit, bound)) = s.converged() {
-        // Digits down to the bound's: every printed digit is converged.
-        let digits = (-bound.max(f64::EPSILON * limit.abs()).log10())
-            .floor()
-            .clamp(0.0, 15.0);
+    if let Some(l) = &opt.limit {
+        report_limit(l);
+    } else if let Some((limit, bound)) = s.converged() {
         println!(
-            "          R*(N → ∞) = {limit:.0$} ± {bound:.1e} (Richardson at the measured order; \
-             ± the finest mesh's estimated error)",
-            digits as usize
+            "          R*(N → ∞) = {} (Richardson at the measured order; ± the finest mesh's \
+             estimated error)",
+            with_bound(limit, bound)
         );
     }
     if s.local_optima {
@@ -494,10 +546,12 @@ fn report_mesh(opt: &ArmOptimum) {
     for (n, coarse, fine) in &r.rejected {
         eprintln!(
             "warning: R* = {coarse:.6} on {n} elements but {fine:.6} on {}: the mesh does not \
-             resolve the optimum (tolerance {:.0e}); searched again on {} elements",
+             resolve the optimum (tolerance {:.0e}); searched again, reported on {} elements \
+             of order {}",
             4 * n,
             cosserat::study::arm::REACH_TOLERANCE,
-            4 * n
+            opt.mesh.elements(),
+            opt.mesh.order()
         );
     }
     if r.verdict == cosserat::study::arm::Verdict::Unresolved {
@@ -513,19 +567,14 @@ fn report_mesh(opt: &ArmOptimum) {
     }
 }
 
-fn straight_optimum(
-    arm: &ArmProblem,
-    opt: &ArmOptimum,
-) -> Option<cosserat::study::arm::StraightArm> {
-    let t = Instant::now();
-    let s = arm.straight_until(&signals::requested);
+fn report_straight(s: Option<StraightArm>, seconds: f64, opt: &ArmOptimum) -> Option<StraightArm> {
     match &s {
         Some(s) => println!(
-            "straight  R0 = {:.6}, γ_crit = {:.6}, clamp angle {:.3}° ({:.2} s); R*/R0 = {:.3}",
+            "straight  R0 = {:.6}, γ_crit = {:.6}, clamp angle {:.3}° ({seconds:.2} s, beside \
+             the search); R*/R0 = {:.3}",
             s.reach,
             s.gamma,
             s.clamp_angle.to_degrees(),
-            t.elapsed().as_secs_f64(),
             opt.design.reach / s.reach
         ),
         None => println!("straight  no stable level equilibrium found"),

@@ -271,7 +271,8 @@ fn write_polyline(path: &Path, eq: &Equilibrium) -> Result<(), String> {
 }
 
 /// What `cosserat solve` computes: the equilibrium and its stability
-/// verdict ([`cosserat::stability::decide`]).
+/// verdict ([`cosserat::stability::decide_verdict`]: the verdict alone, from
+/// the coarsest meshes that settle it).
 pub struct Solved {
     /// The equilibrium.
     pub eq: Equilibrium,
@@ -283,8 +284,12 @@ pub struct Solved {
 /// what `cosserat bench solve` times).
 pub fn compute_solve(problem: &Problem) -> Result<Solved, cosserat::bvp::SolveError> {
     let eq = solve(&problem.rod, &problem.model, &problem.options)?;
-    let decision =
-        cosserat::stability::decide(&problem.rod, &eq, &problem.options, &problem.stability);
+    let decision = cosserat::stability::decide_verdict(
+        &problem.rod,
+        &eq,
+        &problem.options,
+        &problem.stability,
+    );
     Ok(Solved { eq, decision })
 }
 

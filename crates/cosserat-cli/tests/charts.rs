@@ -594,6 +594,8 @@ fn arm_design(reach: f64, c: [f64; 3], b: [f64; 2]) -> cosserat::study::arm::Arm
         critical_load: 4.0,
         scene: ArmScene::default(),
         resolution: None,
+        limit: None,
+        mesh: cosserat::stability::StabilityOptions::default(),
     }
 }
 

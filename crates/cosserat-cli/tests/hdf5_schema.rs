@@ -29,9 +29,11 @@ const COUNT_DATASETS: &[&str] = &[
     "iterations",
     "elements",
     "evaluations",
+    "limit_elements",
+    "element_order",
 ];
 /// Sweep count columns: i64, −1 where the point has no value.
-const SIGNED_DATASETS: &[&str] = &["iterations", "elements", "evaluations"];
+const SIGNED_DATASETS: &[&str] = &["iterations", "elements", "evaluations", "element_order"];
 /// Datasets holding flags, enumerations or names: strings.
 const TEXT_DATASETS: &[&str] = &[
     "stable",
@@ -66,6 +68,8 @@ const COUNT_ATTRS: &[&str] = &[
     "evaluations",
     "index",
     "elements",
+    "element_order",
+    "limit_order",
 ];
 /// The one signed attribute: a branch's `parent`, −1 for a primary branch.
 const SIGNED_ATTRS: &[&str] = &["parent"];

@@ -24,7 +24,13 @@
 //! polished from it), the attribute `mesh` (`resolved`, `refined`: searched again on a finer mesh
 //! because the search's did not resolve it, `unresolved`), and
 //! `rejected_elements` (k: the mesh of each design given up on the way)
-//! and `rejected_reach` (k×2: R̂ there, R̂ on 4× the elements).
+//! and `rejected_reach` (k×2: R̂ there, R̂ on 4× the elements); the
+//! attribute `element_order` (the Lagrange order of those meshes' elements:
+//! a search redone on a finer discretization may use order 2). The
+//! mesh-converged optimum (`ArmOptimum::limit`, in `/optimum`):
+//! `reach_limit` (R*(N → ∞), Richardson on three meshes of order-2
+//! elements), `reach_limit_bound` (its bound), `limit_elements`,
+//! `limit_meshes` (the optimum on each) and the attribute `limit_order`.
 //!
 //! With a reach map (the Fig. 5 data set): `/map/reach` (n),
 //! `/map/load_factor` (n), `/map/shape_coefficients` (n×M),
@@ -165,6 +171,16 @@ fn write_design(g: &mut Group, o: &ArmOptimum) -> StoreResult<()> {
     g.float("reach", o.design.reach)?;
     if let Some(r) = &o.resolution {
         write_resolution(g, r)?;
+        g.attrs.set_count("element_order", o.mesh.order() as u64);
+    }
+    if let Some(l) = &o.limit {
+        let (limit, bound) = l.converged().unwrap_or((f64::NAN, f64::NAN));
+        g.float("reach_limit", limit)?;
+        g.float("reach_limit_bound", bound)?;
+        let elements: Vec<u64> = l.study.elements.iter().map(|n| *n as u64).collect();
+        g.counts("limit_elements", &elements)?;
+        g.floats("limit_meshes", &[3], &l.study.reach)?;
+        g.attrs.set_count("limit_order", l.order as u64);
     }
     g.float("load_factor", o.design.gamma)?;
     let c = &o.design.shape_coefficients;

@@ -91,6 +91,11 @@ fn entry(parent: &str, name: &str) -> (&'static str, &'static str) {
         (_, "rejected_elements") => ("", "elements of the mesh of each design given up"),
         (_, "rejected_reach") => ("1", "reach per rod length of each design given up: on its mesh, on 4× its elements"),
         (_, "reach_order") => ("1", "measured order of the mesh convergence"),
+        (_, "reach_limit") => ("1", "mesh-converged optimum R*(N → ∞) per rod length: Richardson's limit of the optimum on three meshes of order-2 elements"),
+        (_, "reach_limit_bound") => ("1", "error bound of reach_limit: the finest order-2 mesh's estimated error (NaN: undecided)"),
+        (_, "limit_elements") => ("", "elements of the order-2 meshes of reach_limit"),
+        (_, "limit_meshes") => ("1", "the optimum's reach per rod length on each order-2 mesh of reach_limit"),
+        (_, "element_order") => ("", "Lagrange order of the elements of the mesh the result was computed on"),
         (_, "clamp_angle") => ("rad", "clamp angle of the straight arm"),
         (_, "leader_points") => ("1", "the best samples' coefficients"),
         (_, "leader_reach") => ("1", "the best samples' reach per rod length"),
@@ -125,7 +130,10 @@ fn entry(parent: &str, name: &str) -> (&'static str, &'static str) {
 /// stored as integers, not floats (docs/hdf5-schema.md, "Types").
 pub fn is_count_column(name: &str) -> bool {
     let last = name.rsplit('/').next().unwrap_or(name);
-    matches!(last, "iterations" | "elements" | "evaluations")
+    matches!(
+        last,
+        "iterations" | "elements" | "evaluations" | "element_order"
+    )
 }
 
 /// Describes every dataset of a file's tree and stamps the schema version

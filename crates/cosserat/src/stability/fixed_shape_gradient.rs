@@ -112,28 +112,106 @@ pub fn critical_load_gradient(
             count,
         });
     }
-    let points = fe.interpolate(block, &v);
-    let weights = fe.quadrature_weights();
-    let load_form = factored::form(&fe, &c1, block, &v);
-    let gradient = (0..coefficients.len())
-        .map(|i| {
-            let change: f64 = points
-                .iter()
-                .zip(&weights)
-                .enumerate()
-                .map(|(q, ((w, dw), weight))| {
-                    let r = &rates[q][i];
-                    let (d0, d1) = coefficient_rates(&c0[q], &samples[q], r);
-                    weight * (d0.evaluate(w, dw) + lambda * d1.evaluate(w, dw))
-                })
-                .sum();
-            -change / load_form
-        })
-        .collect();
+    let shape = ShapeForms {
+        fe: &fe,
+        samples: &samples,
+        rates: &rates,
+        forms: (&c0, &c1),
+    };
     Ok(LoadGradient::Simple {
         load_factor: lambda,
-        gradient,
+        gradient: shape.gradient(block, lambda, &v, coefficients.len()),
     })
+}
+
+/// One block's lowest critical load and, where it is simple within its
+/// block, its exact gradient in the shape's coefficients.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BlockLoad {
+    /// The block.
+    pub block: Block,
+    /// Its lowest positive critical load factor.
+    pub load_factor: f64,
+    /// ∂λ/∂c_1, …, ∂λ/∂c_M; None where a second critical load of the same
+    /// block lies within [`SIMPLE_GAP`].
+    pub gradient: Option<Vec<f64>>,
+}
+
+/// Each block's lowest critical load with its gradient (module doc), in
+/// block order (in-plane, out-of-plane); a block stable under any load is
+/// left out. λ_crit = the least of them is the minimum of smooth branches
+/// where two blocks' loads meet: an optimizer needs both branches' slopes
+/// there (a max–min step), which [`critical_load_gradient`] withholds.
+/// Refused as [`super::critical_load`] refuses.
+pub fn critical_load_gradients(
+    rod: &Rod,
+    coefficients: &[f64],
+    opts: &StabilityOptions,
+) -> Result<Vec<BlockLoad>, StabilityError> {
+    check_scene(rod)?;
+    let fe = FiniteElements::new(rod.length(), opts.elements(), opts.order());
+    let (samples, rates) = shape_rates(rod, coefficients, &fe.quadrature_points())?;
+    let (c0, c1) = split_coefficients(rod, &samples);
+    let shape = ShapeForms {
+        fe: &fe,
+        samples: &samples,
+        rates: &rates,
+        forms: (&c0, &c1),
+    };
+    let mut loads = Vec::with_capacity(2);
+    for block in [Block::InPlane, Block::OutOfPlane] {
+        let (k0, k1) = (fe.stiffness(&c0, block), fe.stiffness(&c1, block));
+        let Some((l, v)) = smallest_positive_load_factor(&k0, &k1)? else {
+            continue;
+        };
+        let l = factored::load_factor(&fe, (&c0, &c1), block, &v).unwrap_or(l);
+        // A zero pivot: λ(1 + gap) is a critical load to round-off.
+        let simple = k0
+            .combine(1.0, &k1, l * (1.0 + SIMPLE_GAP))
+            .ldlt()
+            .is_ok_and(|factors| factors.negative_pivots() == 1);
+        loads.push(BlockLoad {
+            block,
+            load_factor: l,
+            gradient: simple.then(|| shape.gradient(block, l, &v, coefficients.len())),
+        });
+    }
+    Ok(loads)
+}
+
+/// A shape's samples, their rates in the coefficients and its forms K0,
+/// K1 at the quadrature points: what a mode's gradient is summed from.
+struct ShapeForms<'a> {
+    fe: &'a FiniteElements,
+    samples: &'a [RodSample],
+    rates: &'a [Vec<SampleRate>],
+    forms: (&'a [FormCoefficients], &'a [FormCoefficients]),
+}
+
+impl ShapeForms<'_> {
+    /// ∂λ/∂c_i (i = 1..m) of the critical load λ with null vector `v` in
+    /// `block`: −vᵀ(∂K0/∂c_i + λ ∂K1/∂c_i)v / vᵀK1v (module doc).
+    fn gradient(&self, block: Block, lambda: f64, v: &[f64], m: usize) -> Vec<f64> {
+        let (c0, c1) = self.forms;
+        let points = self.fe.interpolate(block, v);
+        let weights = self.fe.quadrature_weights();
+        let load_form = factored::form(self.fe, c1, block, v);
+        (0..m)
+            .map(|i| {
+                let change: f64 = points
+                    .iter()
+                    .zip(&weights)
+                    .enumerate()
+                    .map(|(q, ((w, dw), weight))| {
+                        let r = &self.rates[q][i];
+                        let (d0, d1) = coefficient_rates(&c0[q], &self.samples[q], r);
+                        weight * (d0.evaluate(w, dw) + lambda * d1.evaluate(w, dw))
+                    })
+                    .sum();
+                -change / load_form
+            })
+            .collect()
+    }
 }
 
 /// ∂/∂c_i of K0's and K1's coefficients at a point: with A = H fixed (a

@@ -13,7 +13,9 @@ mod fixed_shape_spatial;
 mod second_variation;
 
 pub use fixed_shape::{critical_load, CriticalLoad, FixedShape};
-pub use fixed_shape_gradient::{critical_load_gradient, LoadGradient, SIMPLE_GAP};
+pub use fixed_shape_gradient::{
+    critical_load_gradient, critical_load_gradients, BlockLoad, LoadGradient, SIMPLE_GAP,
+};
 pub use fixed_shape_spatial::{critical_load_spatial, SpatialShape};
 pub use second_variation::{Block, FiniteElements, FormCoefficients, TipMotion};
 
@@ -412,6 +414,63 @@ pub fn decide(
     solver: &SolverOptions,
     opts: &StabilityOptions,
 ) -> Result<Decision, StabilityError> {
+    decide_from(rod, eq, solver, opts, |_, first| first)
+}
+
+/// The fewest elements [`decide_verdict`] starts from.
+pub const VERDICT_ELEMENTS: usize = 12;
+
+/// [`decide`] where only the verdict is wanted (`cosserat solve`, which
+/// prints it and writes no spectrum): the same test on the same doubling
+/// meshes, from the coarsest that resolves the frame's turn — at least
+/// [`VERDICT_ELEMENTS`], at most `opts`' — up to the same finest mesh
+/// [`decide`] may reach, computing the lowest eigenvalue above the Morse
+/// index in each block (the one nearest to changing sign; [`decide`] also
+/// checks the higher ones it computes for its report, which lie farther
+/// from zero). Where that eigenvalue is far from zero, two coarse meshes
+/// already agree to less than its distance from zero and settle it — by
+/// the same test as [`decide`]'s: the Morse index unchanged and the
+/// eigenvalue's change between the meshes (an upper bound of the finer
+/// mesh's error: quadratic elements converge at O(h⁴), so it is ~15× that
+/// error) smaller than the eigenvalue; near zero the doubling goes on to
+/// [`decide`]'s finest mesh (the last doubling within it), so a verdict
+/// [`decide`] reaches only on its finest meshes is reached too. The
+/// reported spectrum, elements and eigenvalue error are those of the
+/// meshes where it settled (coarser than [`decide`]'s: a larger error
+/// estimate, printed with the verdict).
+pub fn decide_verdict(
+    rod: &Rod,
+    eq: &Equilibrium,
+    solver: &SolverOptions,
+    opts: &StabilityOptions,
+) -> Result<Decision, StabilityError> {
+    // The eigenvalue just above the Morse index is the sign nearest to
+    // changing, and the only one the verdict needs: decide_from raises the
+    // count to the Morse index + 1 after each mesh.
+    let opts = opts.with_eigenvalues(1)?;
+    decide_from(rod, eq, solver, &opts, |needed, first| {
+        // Halvings of decide's first mesh, so that the doublings meet its
+        // meshes' sizes (to rounding) and end at its finest.
+        let floor = needed.max(VERDICT_ELEMENTS);
+        let mut begin = first;
+        while begin / 2 >= floor {
+            begin /= 2;
+        }
+        begin
+    })
+}
+
+/// [`decide`] from `start(needed, first)` elements (needed: the mesh that
+/// resolves the frame's turn; first: the mesh [`decide`] starts from,
+/// max(`opts`' elements, needed)), doubling up to [`decide`]'s finest
+/// mesh.
+fn decide_from(
+    rod: &Rod,
+    eq: &Equilibrium,
+    solver: &SolverOptions,
+    opts: &StabilityOptions,
+    start: impl Fn(usize, usize) -> usize,
+) -> Result<Decision, StabilityError> {
     let mut opts = *opts;
     let needed = resolved_elements(rod, eq, solver, &opts)?;
     if needed > MAX_RESOLVED_ELEMENTS {
@@ -425,13 +484,12 @@ pub fn decide(
             opts.elements,
         ));
     }
-    if needed > opts.elements {
-        opts = opts.with_elements(needed)?;
-    }
-    let first = opts.elements;
+    let first = opts.elements.max(needed);
+    let finest = (first << REFINEMENTS).min(MAX_VERDICT_ELEMENTS.max(2 * first));
+    opts = opts.with_elements(start(needed, first).clamp(needed.max(1), first))?;
     let mut previous: Option<Stability> = None;
     let mut last_error = f64::INFINITY;
-    for _ in 0..=REFINEMENTS {
+    while opts.elements <= finest {
         let current = match analyze(rod, eq, solver, &opts) {
             Ok(st) => st,
             Err(StabilityError::Undecided(block, why)) => {
@@ -473,9 +531,6 @@ pub fn decide(
         opts.eigenvalues = opts.eigenvalues.max(most + 1);
         previous = Some(current);
         opts.elements *= 2;
-        if opts.elements > MAX_VERDICT_ELEMENTS.max(2 * first) {
-            break;
-        }
     }
     let elements = opts.elements / 2;
     let mut decision = undecided(

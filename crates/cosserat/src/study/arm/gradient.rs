@@ -17,7 +17,7 @@
 //! limit the load (λ is then a root of the curvature limit, not an
 //! eigenvalue), the reach is given without a gradient.
 
-use crate::stability::{critical_load_gradient, LoadGradient};
+use crate::stability::{critical_load_gradients, SIMPLE_GAP};
 
 use super::design::{polynomial, quadrature};
 use super::{ArmDesign, ArmProblem, ArmScene};
@@ -30,6 +30,11 @@ pub struct ReachSlope {
     /// ∂R̂/∂c_2, …, ∂R̂/∂c_M; None where R̂ is not differentiable (module
     /// doc).
     pub gradient: Option<Vec<f64>>,
+    /// The reach of each block's critical load (in-plane, out-of-plane;
+    /// R̂ is the least) with its gradient where that block's load is
+    /// simple: the smooth branches whose minimum R̂ is, for a max–min step
+    /// where two blocks' loads meet.
+    pub branches: Vec<(f64, Option<Vec<f64>>)>,
 }
 
 impl ArmProblem {
@@ -39,39 +44,55 @@ impl ArmProblem {
         if scene.max_curvature.is_some() {
             let design = self.design_in(scene, rest)?;
             return Some(ReachSlope {
+                branches: vec![(design.reach, None)],
                 design,
                 gradient: None,
             });
         }
         let (c, chord) = self.full_coefficients(rest);
         let rod = self.rod_in(scene).ok()?;
-        let found = critical_load_gradient(&rod, &c, &self.stability).ok()?;
-        let (lambda, dlambda) = match found {
-            LoadGradient::Stable => return None,
-            LoadGradient::Multiple { load_factor, .. } => (load_factor, None),
-            LoadGradient::Simple {
-                load_factor,
-                gradient,
-            } => (load_factor, Some(gradient)),
-        };
-        let length = scene.length(lambda);
-        let gradient = dlambda.map(|dl| {
-            let (dchord, dc1) = chord_rates(&c);
-            let e = scene.length_exponent();
-            (1..c.len())
-                .map(|j| {
-                    let total = dl[j] + dl[0] * dc1[j - 1];
-                    e * length / lambda * chord * total + length * dchord[j - 1]
-                })
-                .collect()
-        });
+        let loads = critical_load_gradients(&rod, &c, &self.stability).ok()?;
+        let lowest = loads
+            .iter()
+            .min_by(|a, b| a.load_factor.total_cmp(&b.load_factor))?;
+        let lambda = lowest.load_factor;
+        let (dchord, dc1) = chord_rates(&c);
+        let e = scene.length_exponent();
+        let branches = loads
+            .iter()
+            .map(|load| {
+                let length = scene.length(load.load_factor);
+                let gradient = load.gradient.as_ref().map(|dl| {
+                    (1..c.len())
+                        .map(|j| {
+                            let total = dl[j] + dl[0] * dc1[j - 1];
+                            e * length / load.load_factor * chord * total + length * dchord[j - 1]
+                        })
+                        .collect()
+                });
+                (length * chord, gradient)
+            })
+            .collect::<Vec<(f64, Option<Vec<f64>>)>>();
+        let index = loads
+            .iter()
+            .position(|l| std::ptr::eq(l, lowest))
+            .expect("the lowest is one of them");
+        // Differentiable where no other block's load is within the gap.
+        let alone = loads
+            .iter()
+            .all(|l| std::ptr::eq(l, lowest) || l.load_factor > lambda * (1.0 + SIMPLE_GAP));
         Some(ReachSlope {
             design: ArmDesign {
-                reach: length * chord,
+                reach: scene.length(lambda) * chord,
                 gamma: lambda,
                 shape_coefficients: c,
             },
-            gradient,
+            gradient: if alone {
+                branches[index].1.clone()
+            } else {
+                None
+            },
+            branches,
         })
     }
 }

@@ -42,7 +42,10 @@ pub use control_path::{
     shape_holding_path_until,
 };
 pub use fig5::{ClosestStraight, ReachMap};
-pub use resolve::{MeshStudy, Resolution, Verdict, MAX_ELEMENTS, REACH_TOLERANCE};
+pub use resolve::{
+    MeshStudy, ReachLimit, Resolution, Verdict, LIMIT_MIN_ELEMENTS, LIMIT_ORDER, MAX_ELEMENTS,
+    REACH_TOLERANCE,
+};
 pub use scene::{ArmScene, ArmWeight};
 pub use spatial::{DirectionComparison, PathVerdict, SpatialArm, SpatialDesign, SpatialOptimum};
 pub use taper_arm::{loading_verdict, LoadingVerdict, TaperedArm, TaperedOptimum};
@@ -133,6 +136,14 @@ pub struct ArmOptimum {
     /// where no check was made (a sample, the best so far of an
     /// interrupted search).
     pub resolution: Option<Resolution>,
+    /// The mesh-converged optimum R*(N → ∞) with its error bound, from the
+    /// optimum polished again on meshes of order-2 elements
+    /// ([`ArmProblem::resolve`]); None where no check was made or the
+    /// values have no gradient to polish with (an actuator limit).
+    pub limit: Option<ReachLimit>,
+    /// The discretization the design was optimized on (the search's, or
+    /// the finer one [`ArmProblem::resolve`] searched again on).
+    pub mesh: StabilityOptions,
 }
 
 /// How far a search has come: what `cosserat optimize --resume` keeps of an

@@ -6,25 +6,29 @@
 //! γ_crit the mesh overestimates most: with a ±10 box at N = 100 linear
 //! elements the Sec. 4.4 arm reports R* inflated by 18 %.
 //!
-//! Every reported optimum is therefore evaluated again on 2N and 4N
+//! Every reported optimum is therefore polished again on 2N and 4N
 //! elements ([`MeshStudy`]): the measured convergence order p and
 //! Richardson's estimate of the error of R̂_N. When the estimated error
 //! (or the spread of the three values) exceeds [`REACH_TOLERANCE`], the
-//! search is redone on the finest mesh, and its optimum checked there the
-//! same way, until the reported design is an optimum of a discretization
-//! that resolves it ([`Verdict::Refined`]) or [`MAX_ELEMENTS`] is reached
-//! ([`Verdict::Unresolved`], said so). Re-polishing the rejected design
+//! search is redone on a finer discretization ([`ArmProblem::refined`]:
+//! order-2 elements first, then 4× the elements), and its optimum checked
+//! there the same way, until the reported design is an optimum of a
+//! discretization that resolves it ([`Verdict::Refined`]) or
+//! [`MAX_ELEMENTS`] is reached ([`Verdict::Unresolved`], said so). The
+//! optimum is also polished on three meshes of order-2 elements
+//! ([`ReachLimit`]): R*(N → ∞) with a bound ~1e-8. Re-polishing the rejected design
 //! alone is not enough: from the ±10 box's spurious optimum it ends on a
 //! poor local optimum of the finer mesh (R̂ = 1.77 for the circular arm,
 //! whose box holds designs reaching 1.9458).
 
 use super::{ArmDesign, ArmOptimum, ArmProblem, ArmScene, SearchOptions, SearchProgress};
+use crate::stability::StabilityOptions;
 
 /// The relative discretization error of R̂ a reported optimum may have.
 /// The paper gives R* to two or three digits; this is four.
 pub const REACH_TOLERANCE: f64 = 1e-4;
 
-/// The finest mesh a repeated search uses (elements); its check uses 4×.
+/// The most elements a repeated search uses; its check uses 4×.
 pub const MAX_ELEMENTS: usize = 1600;
 
 /// The reach of one design on N, 2N and 4N elements.
@@ -93,6 +97,36 @@ impl MeshStudy {
     }
 }
 
+/// The Lagrange order of the elements of a [`ReachLimit`] (at least; the
+/// search's own where higher): eigenvalues converge at O(h⁴) on quadratic
+/// elements against O(h²) on linear ones, so three modest meshes give the
+/// limit to ~1e-8 where linear elements on N, 2N, 4N leave ~1e-6.
+pub const LIMIT_ORDER: usize = 2;
+
+/// The fewest elements of a [`ReachLimit`]'s coarsest mesh.
+pub const LIMIT_MIN_ELEMENTS: usize = 8;
+
+/// The mesh-converged optimum R*(N → ∞): the reported optimum polished
+/// again on three meshes of [`LIMIT_ORDER`] elements (max(N/4, 8), twice
+/// and four times that, N the search's mesh), and Richardson's limit of
+/// those optima at their measured order with its bound
+/// ([`MeshStudy::converged`]: the finest mesh's estimated error).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReachLimit {
+    /// The Lagrange order of the study's elements.
+    pub order: usize,
+    /// The optimum on the three meshes (local optima).
+    pub study: MeshStudy,
+}
+
+impl ReachLimit {
+    /// (R*(N → ∞), its error bound); None where the order is not measured
+    /// (undecided, never a value).
+    pub fn converged(&self) -> Option<(f64, f64)> {
+        self.study.converged()
+    }
+}
+
 /// What became of the search's optimum on finer meshes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Verdict {
@@ -141,6 +175,14 @@ impl ArmProblem {
         p
     }
 
+    /// This problem on `elements` elements of Lagrange order `order`.
+    fn on_mesh_of_order(&self, elements: usize, order: usize) -> ArmProblem {
+        let mut p = self.clone();
+        p.stability = StabilityOptions::new(elements, order, p.stability.eigenvalues())
+            .expect("at least one element of order 1 to 3");
+        p
+    }
+
     /// R̂ of the design c2..cM on N (its value `reach`, already known), 2N
     /// and 4N elements, N = this problem's mesh; the evaluations used.
     ///
@@ -162,6 +204,24 @@ impl ArmProblem {
         design: &ArmDesign,
         iterations: u64,
     ) -> (MeshStudy, usize) {
+        let (study, _, evaluations) = self.mesh_checks(scene, design, iterations);
+        (study, evaluations)
+    }
+
+    /// [`Self::mesh_study`] and, where the values are re-polished optima,
+    /// the [`ReachLimit`] of the optimum from meshes of order-2 elements;
+    /// the evaluations used by both.
+    ///
+    /// The order-2 polish on the coarsest limit mesh goes first, from the
+    /// design; its final quasi-Newton Hessian (R̂'s curvature hardly depends
+    /// on the mesh) warm-starts the four others, which run in parallel:
+    /// the order-2 meshes from its optimum, 2N and 4N from the design.
+    fn mesh_checks(
+        &self,
+        scene: &ArmScene,
+        design: &ArmDesign,
+        iterations: u64,
+    ) -> (MeshStudy, Option<ReachLimit>, usize) {
         let n = self.stability.elements();
         let rest = &design.shape_coefficients[1..];
         // Without a gradient (an actuator limit) a re-polish is a whole
@@ -182,21 +242,55 @@ impl ArmProblem {
                 reach: [design.reach, r2.unwrap_or(f64::NAN), r4.unwrap_or(f64::NAN)],
                 local_optima: false,
             };
-            return (study, 2);
+            return (study, None, 2);
         }
         let mut evaluations = if own { 2 } else { 0 };
-        let mut polished = |m: usize| {
-            let (d, used) = self.on_mesh(m).polish(scene, rest, iterations, &|| false);
-            evaluations += used;
-            d.map_or(f64::NAN, |d| d.reach)
+        let order = self.stability.order().max(LIMIT_ORDER);
+        let base = (n / 4).max(LIMIT_MIN_ELEMENTS);
+        let coarse = self.on_mesh_of_order(base, order).polish_from(
+            scene,
+            rest,
+            iterations,
+            &|| false,
+            None,
+        );
+        evaluations += coarse.evaluations;
+        let hessian = coarse.hessian.as_ref();
+        let from_coarse = coarse
+            .design
+            .as_ref()
+            .map_or(rest, |d| &d.shape_coefficients[1..]);
+        let jobs = [
+            (self.on_mesh_of_order(2 * base, order), from_coarse),
+            (self.on_mesh_of_order(4 * base, order), from_coarse),
+            (self.on_mesh(2 * n), rest),
+            (self.on_mesh(4 * n), rest),
+        ];
+        let polished = super::search::in_parallel(jobs.len(), &|| false, |k, _| {
+            let (problem, start) = &jobs[k];
+            Some(problem.polish_from(scene, start, iterations, &|| false, hessian))
+        });
+        let mut value = |p: Option<super::search::Polished>| {
+            let p = p.expect("a job without a stop test runs");
+            evaluations += p.evaluations;
+            p.design.map_or(f64::NAN, |d| d.reach)
         };
-        let (r2, r4) = (polished(2 * n), polished(4 * n));
+        let values: Vec<f64> = polished.into_iter().map(&mut value).collect();
+        let [l2, l4, r2, r4] = <[f64; 4]>::try_from(values).expect("four jobs");
         let study = MeshStudy {
             elements: [n, 2 * n, 4 * n],
             reach: [design.reach, r2, r4],
             local_optima: true,
         };
-        (study, evaluations)
+        let limit = coarse.design.map(|d| ReachLimit {
+            order,
+            study: MeshStudy {
+                elements: [base, 2 * base, 4 * base],
+                reach: [d.reach, l2, l4],
+                local_optima: true,
+            },
+        });
+        (study, limit, evaluations)
     }
 
     /// A reported design that is not a reach optimum (the map's 'Q', the
@@ -218,16 +312,32 @@ impl ArmProblem {
         optimum
     }
 
+    /// The mesh a search is redone on where this problem's does not resolve
+    /// its optimum: the same elements of order [`LIMIT_ORDER`] where they
+    /// are of a lower order (p-refinement: the eigenvalue error drops from
+    /// O(h²) to O(h⁴), as 4× the linear elements would only quarter it, at
+    /// twice the cost of an evaluation instead of four times), else 4× the
+    /// elements; None past [`MAX_ELEMENTS`].
+    pub fn refined(&self) -> Option<ArmProblem> {
+        let (n, order) = (self.stability.elements(), self.stability.order());
+        if order < LIMIT_ORDER {
+            Some(self.on_mesh_of_order(n, LIMIT_ORDER))
+        } else {
+            (4 * n <= MAX_ELEMENTS).then(|| self.on_mesh(4 * n))
+        }
+    }
+
     /// The optimum `optimum` (found on this problem's mesh by a search with
     /// `opts`), checked on finer meshes and, where they disagree beyond
-    /// `tolerance`, searched for again on 4× the mesh — the whole search
-    /// (the coarse mesh's ranking of the samples is what misled it), plus a
-    /// polish from the rejected design, the better of the two kept — and
-    /// checked there, until resolved or past [`MAX_ELEMENTS`]. Returns the
-    /// reported optimum (its shapes from the mesh it was optimized on) with
-    /// its [`Resolution`]; the evaluations used are added to its count.
-    /// `stop()` ends a finer search: the optimum so far is then returned,
-    /// unresolved.
+    /// `tolerance`, searched for again on the [`Self::refined`] mesh — the
+    /// whole search (the coarse mesh's ranking of the samples is what
+    /// misled it), plus a polish from the rejected design, the better of
+    /// the two kept — and checked there, until resolved or past
+    /// [`MAX_ELEMENTS`]. Returns the reported optimum (its shapes from the
+    /// mesh it was optimized on, [`ArmOptimum::mesh`]) with its
+    /// [`Resolution`] and [`ReachLimit`]; the evaluations used are added to
+    /// its count. `stop()` ends a finer search: the optimum so far is then
+    /// returned, unresolved.
     pub fn resolve(
         &self,
         scene: &ArmScene,
@@ -240,30 +350,31 @@ impl ArmProblem {
         let mut optimum = optimum;
         let mut rejected = vec![];
         loop {
-            let (study, used) = problem.mesh_study(scene, &optimum.design, opts.iterations);
+            let (study, limit, used) = problem.mesh_checks(scene, &optimum.design, opts.iterations);
             optimum.evaluations += used;
-            let fine = 4 * problem.stability.elements();
+            optimum.limit = limit;
+            optimum.mesh = problem.stability;
+            let finer = problem.refined();
             let verdict = if study.resolved(tolerance) {
                 Some(if rejected.is_empty() {
                     Verdict::Resolved
                 } else {
                     Verdict::Refined
                 })
-            } else if fine > MAX_ELEMENTS || stop() {
+            } else if finer.is_none() || stop() {
                 Some(Verdict::Unresolved)
             } else {
                 None
             };
-            if let Some(verdict) = verdict {
+            let (None, Some(finer)) = (verdict, finer) else {
                 optimum.resolution = Some(Resolution {
                     study,
-                    verdict,
+                    verdict: verdict.unwrap_or(Verdict::Unresolved),
                     rejected,
                 });
                 return optimum;
-            }
+            };
             rejected.push((study.elements[0], study.reach[0], study.reach[2]));
-            let finer = problem.on_mesh(fine);
             let (searched, progress, interrupted) =
                 finer.search_on_mesh(scene, opts, SearchProgress::default(), stop, &mut |_| {});
             let start = &optimum.design.shape_coefficients[1..];

@@ -14,6 +14,8 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::OnceLock;
 use std::time::Duration;
 
+use nalgebra::DMatrix;
+
 use crate::model::Profile;
 use crate::stability::{critical_load, FixedShape};
 
@@ -210,26 +212,54 @@ impl ArmProblem {
         iterations: u64,
         stop: &dyn Fn() -> bool,
     ) -> (Option<ArmDesign>, usize) {
+        let p = self.polish_from(scene, start, iterations, stop, None);
+        (p.design, p.evaluations)
+    }
+
+    /// [`Self::polish`] with the ascent's Hessian model started from `warm`
+    /// (where given) and returned with the design.
+    pub(super) fn polish_from(
+        &self,
+        scene: &ArmScene,
+        start: &[f64],
+        iterations: u64,
+        stop: &dyn Fn() -> bool,
+        warm: Option<&DMatrix<f64>>,
+    ) -> Polished {
         let ascent = ascend_in_box(
             start,
             &self.bounds,
             usize::try_from(iterations).unwrap_or(usize::MAX),
-            &|x| {
-                self.reach_slope(scene, x)
-                    .map(|r| (r.design.reach, r.gradient))
-            },
+            &|x| self.reach_slope(scene, x).map(|r| r.branches),
             stop,
+            warm,
         );
         let from = match (&ascent.end, &ascent.best) {
-            (AscentEnd::Stopped, _) => return (None, ascent.evaluations),
+            (AscentEnd::Stopped, _) => {
+                return Polished {
+                    design: None,
+                    evaluations: ascent.evaluations,
+                    hessian: None,
+                }
+            }
             (AscentEnd::NoGradient, Some((x, _))) => x.clone(),
             // An infeasible start: the simplex may find feasible designs
             // around it.
             (AscentEnd::Infeasible, _) | (_, None) => start.to_vec(),
-            (_, Some((x, _))) => return (self.design_in(scene, x), ascent.evaluations + 1),
+            (_, Some((x, _))) => {
+                return Polished {
+                    design: self.design_in(scene, x),
+                    evaluations: ascent.evaluations + 1,
+                    hessian: ascent.hessian,
+                }
+            }
         };
         let (design, used) = self.nelder_mead(scene, self.simplex(&from), iterations, stop);
-        (design, ascent.evaluations + used)
+        Polished {
+            design,
+            evaluations: ascent.evaluations + used,
+            hessian: None,
+        }
     }
 
     /// Nelder–Mead on −R̂ from a simplex; the polished design and the
@@ -298,8 +328,18 @@ impl ArmProblem {
             critical_load: critical,
             scene: *scene,
             resolution: None,
+            limit: None,
+            mesh: self.stability,
         })
     }
+}
+
+/// A polish's result: the design, the evaluations used, and the ascent's
+/// final Hessian model where it ended by gradient steps.
+pub(super) struct Polished {
+    pub design: Option<ArmDesign>,
+    pub evaluations: usize,
+    pub hessian: Option<DMatrix<f64>>,
 }
 
 /// Samples evaluated between two looks at the stop test and checkpoints.
@@ -314,7 +354,7 @@ const SAMPLE_BATCH: usize = 64;
 /// it polls `stop()` between running queued jobs itself
 /// (`rayon::yield_now`: on a one-thread pool it runs them all) and raises
 /// `halt`, which the jobs read.
-fn in_parallel<T, F>(count: usize, stop: &dyn Fn() -> bool, job: F) -> Vec<Option<T>>
+pub(super) fn in_parallel<T, F>(count: usize, stop: &dyn Fn() -> bool, job: F) -> Vec<Option<T>>
 where
     T: Send + Sync,
     F: Fn(usize, &AtomicBool) -> Option<T> + Sync,

@@ -2,24 +2,40 @@
 //! two families of local optima across the grid.
 //!
 //! Cold (the first point of a line): the global stage of
-//! [`ArmProblem::optimize`] — Sobol' samples of the box, Nelder–Mead from
-//! the best `starts` samples — plus, with two families, `starts` more
-//! polishes from samples spread evenly over the ranking, so that a basin
-//! other than the best one is entered. Family 0 is the best polished
-//! design; family 1 the best one that is a distinct local optimum
-//! ([`distinct_optima`]: another loaded shape, and a valley in between;
-//! paper Sec. 4.2: "two local optimum values of C for each value of B̄1
-//! and B̄3").
+//! [`ArmProblem::optimize`] — Sobol' samples of the box, the exact-gradient
+//! polish (projected BFGS) from the best `starts` samples — plus, with two
+//! families, `starts` more polishes from samples spread evenly over the
+//! ranking, so that a basin other than the best one is entered. Family 0
+//! is the best polished design; family 1 the best one that is a distinct
+//! local optimum ([`distinct_optima`]: another loaded shape, and a valley
+//! in between; paper Sec. 4.2: "two local optimum values of C for each
+//! value of B̄1 and B̄3").
 //!
 //! Warm (the next points of the line): each family is polished from its
-//! predecessor's optimum with a small simplex (1 % of the bounds), and
-//! family 0 also from `warm_samples` Sobol' samples; family 1 is marked
-//! `merged` when its polish lands on family 0's shape. Family 0 is the
-//! better of the two at each point (they swap labels where they cross).
+//! predecessor's optimum, on the predecessor's discretization (where its
+//! optimum needed a finer one, the neighbour starts there instead of
+//! searching the whole box again on it), and family 0 also from
+//! `warm_samples` Sobol' samples; family 1 is marked `merged` when its
+//! polish lands on family 0's shape. Family 0 is the better of the two at
+//! each point (they swap labels where they cross).
+//!
+//! A family absent at the predecessor (`not_found`: the cold search's
+//! spread polishes all ended on family 0) is carried as absent (`start` =
+//! `carried`) instead of searched for cold again at every point. The
+//! argument: a nondegenerate local maximum persists under a small change
+//! of (B̄1, B̄3) (implicit function theorem on its KKT conditions), so a
+//! second optimum appears along a line only in a fold, born together with
+//! a saddle; the cold search at the line's first point is where the
+//! second family is looked for, and a line keeps the families its first
+//! point found (as it did for the wide box's map, README "Sweeps"). A
+//! family that failed at the predecessor (no critical load, an evaluation
+//! failure) is still searched cold (`cold_after_failure`).
 
 use super::{Job, Record};
+use crate::stability::StabilityOptions;
 use crate::study::arm::{
-    ArmDesign, ArmOptimum, ArmProblem, ArmScene, SearchOptions, Verdict, REACH_TOLERANCE,
+    ArmDesign, ArmOptimum, ArmProblem, ArmScene, ReachLimit, SearchOptions, Verdict,
+    REACH_TOLERANCE,
 };
 use crate::study::Problem;
 
@@ -27,12 +43,6 @@ use crate::study::Problem;
 /// turning angle φ(s̄) over [0, 1], rad) are one local optimum: the reach
 /// is flat along a ridge of nearly equal shapes whose tips differ.
 pub const SAME_SHAPE: f64 = 0.1;
-
-/// Simplex size of a warm polish (fraction of each bound's width).
-const WARM_STEP: f64 = 0.01;
-
-/// Simplex size of a cold polish (the search's own).
-const COLD_STEP: f64 = 0.05;
 
 /// The arm job: the optimization of the point's `[arm]` table.
 #[derive(Debug, Clone, Copy)]
@@ -80,6 +90,8 @@ pub fn distinct_optima(arm: &ArmProblem, scene: &ArmScene, a: &ArmDesign, b: &Ar
 /// A family's outcome at a point.
 struct Found {
     design: Option<ArmDesign>,
+    /// The discretization the design was polished on.
+    mesh: StabilityOptions,
     status: &'static str,
     /// `cold`, `warm` or `cold_after_failure`.
     start: &'static str,
@@ -114,7 +126,7 @@ impl ArmJob {
             if stop() {
                 break;
             }
-            let (d, used) = arm.polish_with_step(scene, start, search.iterations, COLD_STEP);
+            let (d, used) = arm.polished(scene, start, search.iterations);
             evaluations += used;
             polished.extend(d);
         }
@@ -128,6 +140,7 @@ impl ArmJob {
         });
         let found = |design: Option<ArmDesign>, missing: &'static str| Found {
             status: if design.is_some() { "optimum" } else { missing },
+            mesh: arm.stability,
             start: "cold",
             design,
             evaluations,
@@ -148,6 +161,37 @@ impl ArmJob {
         f: usize,
         stop: &dyn Fn() -> bool,
     ) -> Found {
+        if previous
+            .labels
+            .get(&format!("family_{f}/status"))
+            .map(String::as_str)
+            == Some("not_found")
+        {
+            // Absent at the predecessor: carried, not searched for again
+            // (module doc).
+            return Found {
+                design: None,
+                mesh: arm.stability,
+                status: "not_found",
+                start: "carried",
+                evaluations: 0,
+            };
+        }
+        // The predecessor's discretization (where its optimum needed a
+        // finer one, so does its neighbour's, most likely: a line does not
+        // redo the whole refined search at every point).
+        // (Not where the reach has no gradient, an actuator limit: there
+        // the warm polish is Nelder–Mead's, and the search's own mesh and
+        // refinement are kept.)
+        let mesh = if scene.max_curvature.is_some() {
+            arm.stability
+        } else {
+            carried_mesh(previous, f, arm.stability.eigenvalues()).unwrap_or(arm.stability)
+        };
+        let arm = &ArmProblem {
+            stability: mesh,
+            ..arm.clone()
+        };
         let coefficients = previous
             .numbers
             .get(&format!("family_{f}/shape_coefficients"));
@@ -157,13 +201,18 @@ impl ArmJob {
         let Some(start) = start else {
             return Found {
                 design: None,
+                mesh,
                 status: "not_found",
                 start: "warm",
                 evaluations: 0,
             };
         };
-        let (mut design, mut evaluations) =
-            arm.polish_with_step(scene, &start, self.warm_iterations, WARM_STEP);
+        // The search's own polish. Without a gradient (an actuator limit)
+        // that is Nelder–Mead from the search's 5 % simplex: a 1 % one (the
+        // step between neighbours) stopped 2.5e-4 short of the cold optimum
+        // within its iterations where the limit changes by half between
+        // points (tests/optimizer_trust.rs, the warm line).
+        let (mut design, mut evaluations) = arm.polished(scene, &start, self.warm_iterations);
         if f == 0 && self.warm_samples > 0 && !stop() {
             let best_sample = (1..=self.warm_samples)
                 .take_while(|_| !stop())
@@ -174,7 +223,7 @@ impl ArmJob {
                 .max_by(|a, b| a.0.total_cmp(&b.0));
             evaluations += self.warm_samples;
             if let Some((_, p)) = best_sample {
-                let (d, used) = arm.polish_with_step(scene, &p, self.warm_iterations, COLD_STEP);
+                let (d, used) = arm.polished(scene, &p, self.warm_iterations);
                 evaluations += used;
                 if d.as_ref().map(|d| d.reach) > design.as_ref().map(|d| d.reach) {
                     design = d;
@@ -187,6 +236,7 @@ impl ArmJob {
             } else {
                 "no_critical_load"
             },
+            mesh,
             start: "warm",
             design,
             evaluations,
@@ -225,6 +275,21 @@ impl ArmJob {
         record.set(
             &key("elements"),
             vec![study(|r| r.study.elements[0] as f64)],
+        );
+        record.set(
+            &key("element_order"),
+            vec![value(|o| o.mesh.order() as f64)],
+        );
+        let limit = optimum
+            .and_then(|o| o.limit.as_ref())
+            .and_then(ReachLimit::converged);
+        record.set(
+            &key("reach_limit"),
+            vec![limit.map_or(f64::NAN, |(r, _)| r)],
+        );
+        record.set(
+            &key("reach_limit_bound"),
+            vec![limit.map_or(f64::NAN, |(_, e)| e)],
         );
         record.set(&key("evaluations"), vec![outcome.evaluations as f64]);
         record.label(&key("status"), outcome.status);
@@ -275,7 +340,10 @@ impl Job for ArmJob {
                 let warm: Vec<Found> = (0..self.families)
                     .map(|f| self.warm(arm, scene, p, f, stop))
                     .collect();
-                if warm.iter().all(|w| w.design.is_some()) {
+                if warm
+                    .iter()
+                    .all(|w| w.design.is_some() || w.start == "carried")
+                {
                     warm
                 } else {
                     // A family without a predecessor to start from (it
@@ -287,6 +355,7 @@ impl Job for ArmJob {
                         .zip(cold)
                         .map(|(w, c)| match w.design {
                             Some(_) => w,
+                            None if w.start == "carried" => w,
                             None => Found {
                                 evaluations: w.evaluations + c.evaluations,
                                 start: "cold_after_failure",
@@ -308,6 +377,10 @@ impl Job for ArmJob {
             .into_iter()
             .map(|f| {
                 let had_design = f.design.is_some();
+                let arm = ArmProblem {
+                    stability: f.mesh,
+                    ..arm.clone()
+                };
                 let optimum = f
                     .design
                     .and_then(|d| arm.complete(scene, d, 0))
@@ -339,8 +412,8 @@ impl Job for ArmJob {
         let m = arm.coefficients();
         for (f, outcome) in outcomes.iter().enumerate() {
             Self::write(&mut record, m, f, outcome);
-            if let Some(r) = outcome.optimum.as_ref().and_then(|o| o.resolution.as_ref()) {
-                warn_mesh(index, f, r);
+            if let Some(o) = &outcome.optimum {
+                warn_mesh(index, f, o);
             }
         }
         if *straight {
@@ -350,22 +423,40 @@ impl Job for ArmJob {
     }
 }
 
+/// The discretization family `f`'s optimum was reported on at the
+/// predecessor (its `elements` and `element_order`); None where the record
+/// has none (no optimum, or a file written before the order was kept).
+fn carried_mesh(previous: &Record, f: usize, eigenvalues: usize) -> Option<StabilityOptions> {
+    let number = |name: &str| {
+        previous
+            .number(&format!("family_{f}/{name}"))
+            .filter(|v| v.is_finite() && *v >= 1.0)
+    };
+    let (elements, order) = (number("elements")?, number("element_order")?);
+    StabilityOptions::new(elements as usize, order as usize, eigenvalues).ok()
+}
+
 /// Says on stderr when a family's optimum was not resolved by the search's
 /// mesh (the reported one is then the finer mesh's, or carries its error).
-fn warn_mesh(index: usize, f: usize, r: &crate::study::arm::Resolution) {
+fn warn_mesh(index: usize, f: usize, o: &ArmOptimum) {
+    let Some(r) = &o.resolution else { return };
     let Some(&(n, coarse, fine)) = r.rejected.first() else {
         if r.verdict == Verdict::Unresolved {
             eprintln!(
-                "warning: point {index}, family {f}: R* = {:.6} on {} elements is not resolved \
-                 ({:.6} on {}); reported with its error",
-                r.study.reach[0], r.study.elements[0], r.study.reach[2], r.study.elements[2]
+                "warning: point {index}, family {f}: R* = {:.6} on {} elements of order {} is \
+                 not resolved ({:.6} on {}); reported with its error",
+                r.study.reach[0],
+                r.study.elements[0],
+                o.mesh.order(),
+                r.study.reach[2],
+                r.study.elements[2]
             );
         }
         return;
     };
     eprintln!(
         "warning: point {index}, family {f}: R* = {coarse:.6} on {n} elements but {fine:.6} \
-         on {}: {} on {} elements, R* = {:.6}",
+         on {}: {} on {} elements of order {}, R* = {:.6}",
         4 * n,
         if r.verdict == Verdict::Refined {
             "searched again"
@@ -373,6 +464,7 @@ fn warn_mesh(index: usize, f: usize, r: &crate::study::arm::Resolution) {
             "still unresolved"
         },
         r.study.elements[0],
+        o.mesh.order(),
         r.study.reach[0]
     );
 }
