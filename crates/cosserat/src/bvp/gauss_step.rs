@@ -71,6 +71,8 @@ struct StageWork {
     dk: Vec<f64>,
     /// Φ0, then Φ1, by rows (n × cols).
     rows: Vec<f64>,
+    /// The nonzeros (row, column, value) of Φ0.
+    nonzeros: Vec<(usize, usize, f64)>,
     /// The exact stage matrix in Z-form, eliminated by blocks.
     zform: ZForm,
 }
@@ -121,6 +123,7 @@ impl StageWork {
             fp: Vec::new(),
             dk: Vec::new(),
             rows: Vec::new(),
+            nonzeros: Vec::new(),
             zform: ZForm {
                 b0: vec![0.0; n * n],
                 piv0: vec![0; n],
@@ -570,7 +573,18 @@ fn sensitivity(
     for r in 0..n {
         rows.extend(phi0.row(r).iter());
     }
-    // The right-hand sides J_i Φ0 (+ ∂f/∂p), mn × cols row-major.
+    // The nonzeros of Φ0's rows: at an interior node Φ0 = [I | 0], so
+    // J_i Φ0 costs n² per stage, not n²·cols.
+    let mut nz = std::mem::take(&mut ws.nonzeros);
+    nz.clear();
+    nz.extend(
+        rows.iter()
+            .enumerate()
+            .filter(|&(_, &v)| v != 0.0)
+            .map(|(k, &v)| (k / cols, k % cols, v)),
+    );
+    // The right-hand sides J_i Φ0 (+ ∂f/∂p), mn × cols row-major, each
+    // entry summed over c in order.
     let mut dk = std::mem::take(&mut ws.dk);
     dk.clear();
     dk.resize(mn * cols, 0.0);
@@ -578,14 +592,15 @@ fn sensitivity(
         let ji = &ws.jac[i * nn..(i + 1) * nn];
         for r in 0..n {
             let row = &mut dk[(i * n + r) * cols..(i * n + r + 1) * cols];
-            for (c, p0) in rows.chunks_exact(cols).enumerate() {
+            for &(c, q, v) in &nz {
                 let j = ji[c * n + r];
                 if j != 0.0 {
-                    row.iter_mut().zip(p0).for_each(|(d, p)| *d += j * p);
+                    row[q] += j * v;
                 }
             }
         }
     }
+    ws.nonzeros = nz;
     if forcing.is_some() {
         for (row, f) in dk.chunks_exact_mut(cols).zip(&fp) {
             row[cols - 1] += f;
