@@ -13,7 +13,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::collocation::Tableau;
-use super::gauss_step::gauss_step;
+use super::gauss_step::GaussStepper;
 use super::newton::NonlinearSystem;
 use crate::equations::{RodEquations, RodSample};
 use crate::model::RodTangent;
@@ -29,7 +29,7 @@ pub struct ShootingSystem<'a> {
     scales: Vec<f64>,
     /// Segments as single Gauss–Legendre steps (the collocation equations
     /// of the segment mesh) instead of adaptive DOP853 integration.
-    gauss: Option<Tableau>,
+    gauss: Option<GaussStepper>,
     /// The interior points where the right-hand side jumps
     /// ([`RodEquations::jumps`]): every integration stops there.
     jumps: Vec<f64>,
@@ -67,7 +67,7 @@ impl<'a> ShootingSystem<'a> {
     ) -> Option<Self> {
         let tab = Tableau::gauss(stages)?;
         Some(ShootingSystem {
-            gauss: Some(tab),
+            gauss: Some(GaussStepper::new(tab)),
             ..ShootingSystem::new(eq, intervals, tol)
         })
     }
@@ -114,14 +114,15 @@ impl<'a> ShootingSystem<'a> {
         forcing: Option<&RodTangent>,
     ) -> Result<(Vec<f64>, DMatrix<f64>), IntegrationError> {
         let n = self.eq.dim();
-        if let Some(tab) = &self.gauss {
+        let span = pieces(&self.jumps, self.node(j), self.node(j + 1));
+        if let Some(stepper) = &mut self.gauss {
             // A jump inside the interval splits the Gauss step there: the
             // state and its sensitivities are continuous across a point
             // force, so the pieces chain.
             let mut y = (start.to_vec(), phi0.clone());
-            for (a, b) in pieces(&self.jumps, self.node(j), self.node(j + 1)) {
+            for (a, b) in span {
                 self.stats.accepted += 1;
-                y = gauss_step(self.eq, tab, a, b - a, &y.0, &y.1, forcing)?;
+                y = stepper.step(self.eq, a, b - a, &y.0, &y.1, forcing)?;
             }
             return Ok(y);
         }
@@ -147,7 +148,7 @@ impl<'a> ShootingSystem<'a> {
         let controlled = y.len();
         // The state and Φ are continuous across a point force: the pieces
         // between jumps chain with the same y.
-        for (a, b) in pieces(&self.jumps, self.node(j), self.node(j + 1)) {
+        for (a, b) in span {
             let stats = self.dop.integrate(
                 &mut rhs,
                 a,
