@@ -702,7 +702,7 @@ fn ascent_direction(hessian: &DMatrix<f64>, g: &[f64], held: &[bool]) -> Option<
 
 /// The first Hessian model of −f: diag(1/w_i²)/θ, θ such that the first
 /// step moves no variable by more than 5 % of its bound's width.
-fn initial_hessian(widths: &[f64], g: &[f64]) -> DMatrix<f64> {
+pub(crate) fn initial_hessian(widths: &[f64], g: &[f64]) -> DMatrix<f64> {
     let largest = widths
         .iter()
         .zip(g)
@@ -722,7 +722,7 @@ fn initial_hessian(widths: &[f64], g: &[f64]) -> DMatrix<f64> {
 /// B ← B − B s sᵀB / sᵀBs + y yᵀ / yᵀs (Nocedal & Wright, eq. 6.19), with
 /// y the change of −∇f; skipped where yᵀs ≤ 1e-12 |s||y| (no positive
 /// curvature measured), so that B stays positive definite.
-fn bfgs_update(b: &mut DMatrix<f64>, s: &[f64], y: &[f64]) {
+pub(crate) fn bfgs_update(b: &mut DMatrix<f64>, s: &[f64], y: &[f64]) {
     let (s, y) = (DVector::from_column_slice(s), DVector::from_column_slice(y));
     let sy = s.dot(&y);
     if sy <= 1e-12 * s.norm() * y.norm() || sy <= 0.0 {

@@ -26,6 +26,8 @@
 
 use nalgebra::{DMatrix, DVector};
 
+use crate::study::arm::polish::{bfgs_update, initial_hessian};
+
 /// Distance (relative to the bound, absolute below 1) within which a
 /// variable counts as on its bound.
 const BOUND_SLACK: f64 = 1e-12;
@@ -410,41 +412,6 @@ fn reduced_step(
         d[i] = step[k];
     }
     Some(d)
-}
-
-/// The first model of −f's Hessian: diag(1/w_i²)/θ, θ such that the first
-/// step moves no variable by more than 5 % of its scale.
-fn initial_hessian(scales: &[f64], g: &[f64]) -> DMatrix<f64> {
-    let largest = scales
-        .iter()
-        .zip(g)
-        .map(|(w, gi)| (w * gi).abs())
-        .fold(0.0, f64::max);
-    let theta = if largest > 0.0 { 0.05 / largest } else { 1.0 };
-    DMatrix::from_fn(scales.len(), scales.len(), |i, j| {
-        if i == j {
-            1.0 / (theta * scales[i] * scales[i])
-        } else {
-            0.0
-        }
-    })
-}
-
-/// B ← B − B s sᵀB / sᵀBs + y yᵀ / yᵀs (Nocedal & Wright, eq. 6.19), with
-/// y the change of −∇f; skipped where yᵀs ≤ 1e-12 |s||y|, so that B stays
-/// positive definite.
-fn bfgs_update(b: &mut DMatrix<f64>, s: &[f64], y: &[f64]) {
-    let (s, y) = (DVector::from_column_slice(s), DVector::from_column_slice(y));
-    let sy = s.dot(&y);
-    if sy <= 1e-12 * s.norm() * y.norm() || sy <= 0.0 {
-        return;
-    }
-    let bs = &*b * &s;
-    let sbs = s.dot(&bs);
-    if sbs <= 0.0 {
-        return;
-    }
-    *b += &y * y.transpose() / sy - &bs * bs.transpose() / sbs;
 }
 
 #[cfg(test)]
