@@ -501,7 +501,27 @@ impl Run<'_> {
                 self.refined_branch_point(a, b, sign, root, (branch, index), wanted);
             return (point.into_iter().collect(), note.into_iter().collect());
         }
-        let note = self.unresolved(&root, kind.name(), (branch, index));
+        let (point, note) = self.bracketed(a, b, sign, root, (branch, index), wanted, kind.name());
+        (point.into_iter().collect(), note.into_iter().collect())
+    }
+
+    /// The special point kept at the bracketed root, recorded as
+    /// [`Location::Bracketed`]; where its bracket could not be closed to
+    /// the event tolerance, with the bracket's spread as its
+    /// `parameter_error` and a note saying so.
+    #[allow(clippy::too_many_arguments)]
+    fn bracketed(
+        &self,
+        a: &Point,
+        b: &Point,
+        sign: f64,
+        root: Root,
+        (branch, index): (usize, usize),
+        wanted: Wanted,
+        what: &str,
+    ) -> (Option<SpecialPoint>, Option<String>) {
+        let unresolved = self.unresolved(&root, what, (branch, index));
+        let spread = root.spread;
         let point = self
             .special_point(
                 a,
@@ -512,10 +532,10 @@ impl Run<'_> {
                 (wanted, Location::Bracketed),
             )
             .map(|mut sp| {
-                sp.parameter_error = note.is_some().then_some(root.spread);
+                sp.parameter_error = unresolved.is_some().then_some(spread);
                 sp
             });
-        (point.into_iter().collect(), note.into_iter().collect())
+        (point, unresolved)
     }
 
     /// The simple branch point bracketed at `best` on det F_x, refined by
@@ -534,21 +554,8 @@ impl Run<'_> {
         wanted: Wanted,
     ) -> (Option<SpecialPoint>, Option<String>) {
         let bracketed = |root: Root, note: Option<String>| {
-            let unresolved = self.unresolved(&root, "branch point", (branch, index));
-            let spread = root.spread;
-            let point = self
-                .special_point(
-                    a,
-                    b,
-                    sign,
-                    root.located,
-                    (branch, index),
-                    (wanted, Location::Bracketed),
-                )
-                .map(|mut sp| {
-                    sp.parameter_error = unresolved.is_some().then_some(spread);
-                    sp
-                });
+            let (point, unresolved) =
+                self.bracketed(a, b, sign, root, (branch, index), wanted, "branch point");
             (point, note.or(unresolved))
         };
         if self.sliced {
