@@ -41,11 +41,13 @@ pub enum BenchCommand {
         /// Directory for work_precision.csv, .png and .svg.
         #[arg(short, long, default_value = "work-precision")]
         output: PathBuf,
-        /// Draw the chart of a stored measurement (a work_precision.csv)
-        /// into the output directory instead of measuring again: the
-        /// timings stay those of the machine that measured them.
+        /// Draw the chart of stored measurements (work_precision.csv files,
+        /// or another tool's points in that format, such as
+        /// scripts/scipy_work_precision.py's; repeat to draw several
+        /// together) into the output directory instead of measuring again:
+        /// the timings stay those of the machine that measured them.
         #[arg(long, value_name = "CSV")]
-        redraw: Option<PathBuf>,
+        redraw: Vec<PathBuf>,
     },
     /// Wall time of `cosserat solve`'s computation (the equilibrium and
     /// its stability verdict; no file written): median, min, max after
@@ -67,20 +69,25 @@ pub enum BenchCommand {
 /// Runs a benchmark; the exit code of the command.
 pub fn run(command: BenchCommand) -> ExitCode {
     match command {
-        BenchCommand::WorkPrecision {
-            output,
-            redraw: Some(csv),
-        } => match read_points(&csv) {
-            Ok(points) => match draw_work_precision(&output, &points) {
+        BenchCommand::WorkPrecision { output, redraw } if !redraw.is_empty() => {
+            let mut points = Vec::new();
+            for csv in &redraw {
+                match read_points(csv) {
+                    Ok(p) => points.extend(p),
+                    Err(e) => {
+                        return crate::exit::fail(
+                            crate::exit::BAD_INPUT,
+                            format!("{}: {e}", csv.display()),
+                        )
+                    }
+                }
+            }
+            match draw_work_precision(&output, &points) {
                 Ok(()) => ExitCode::SUCCESS,
                 Err(e) => crate::exit::fail(crate::exit::OUTPUT, e),
-            },
-            Err(e) => crate::exit::fail(crate::exit::BAD_INPUT, format!("{}: {e}", csv.display())),
-        },
-        BenchCommand::WorkPrecision {
-            output,
-            redraw: None,
-        } => match work_precision(&output) {
+            }
+        }
+        BenchCommand::WorkPrecision { output, .. } => match work_precision(&output) {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => {
                 eprintln!("error: {e}");
@@ -347,6 +354,7 @@ fn work_precision(dir: &Path) -> Result<(), Box<dyn std::error::Error>> {
 
 /// Draws `points` to work_precision.png and .svg in `dir`.
 fn draw_work_precision(dir: &Path, points: &[Point]) -> Result<(), Box<dyn std::error::Error>> {
+    std::fs::create_dir_all(dir)?;
     let png = dir.join("work_precision.png");
     let svg = dir.join("work_precision.svg");
     let chart = WorkPrecision { points };
@@ -434,7 +442,7 @@ impl crate::chart_style::Figure for WorkPrecision<'_> {
         let entries: Vec<LegendEntry> = order
             .iter()
             .enumerate()
-            .map(|(i, m)| LegendEntry::new(Glyph::Line(colour(i), Stroke::Solid), m.clone()))
+            .map(|(i, m)| LegendEntry::new(Glyph::Line(colour(i), stroke_of(m)), m.clone()))
             .collect();
         legend(&top.margin(10, 0, 90, 0), &entries, entries.len())?;
         let panels = body.split_evenly((1, names.len()));
@@ -474,7 +482,12 @@ impl crate::chart_style::Figure for WorkPrecision<'_> {
                     .filter(|p| &p.method == m)
                     .map(|p| (p.time, p.error.clamp(FLOOR, 1.0)))
                     .collect();
-                c.draw_series(LineSeries::new(series.clone(), color.stroke_width(2)))?;
+                let style = color.stroke_width(2);
+                if stroke_of(m) == Stroke::Dashed {
+                    c.draw_series(DashedLineSeries::new(series.clone(), 9, 6, style))?;
+                } else {
+                    c.draw_series(LineSeries::new(series.clone(), style))?;
+                }
                 c.draw_series(
                     series
                         .iter()
@@ -484,6 +497,17 @@ impl crate::chart_style::Figure for WorkPrecision<'_> {
             frame(c.plotting_area())?;
         }
         Ok(())
+    }
+}
+
+/// Another tool's curve (a method named for its tool, e.g. "scipy
+/// solve_bvp" from scripts/scipy_work_precision.py) dashed, this
+/// project's methods solid.
+fn stroke_of(method: &str) -> crate::chart_style::Stroke {
+    if method.starts_with("scipy") {
+        crate::chart_style::Stroke::Dashed
+    } else {
+        crate::chart_style::Stroke::Solid
     }
 }
 
