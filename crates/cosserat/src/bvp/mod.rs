@@ -15,6 +15,7 @@ pub use crate::numerics::integrator;
 pub mod newton;
 mod shooting;
 
+use std::sync::Arc;
 use std::time::Instant;
 
 use nalgebra::DMatrix;
@@ -22,7 +23,7 @@ use nalgebra::DMatrix;
 use crate::equations::{KirchhoffEquations, PlanarEquations, RodEquations, RodSample};
 use crate::model::energy_check;
 use crate::model::{ModelChoice, ModelLevel, Rod};
-use crate::numerics::integrator::{IntegrationStats, Tolerances};
+use crate::numerics::integrator::{DenseRecord, IntegrationStats, Tolerances};
 pub use collocation::{
     solve_collocation, solve_collocation_from, CollocationError, CollocationOptions,
     CollocationSolution,
@@ -185,6 +186,10 @@ pub struct Equilibrium {
     pub integration: IntegrationStats,
     /// Wall time of the solve (s).
     pub wall_time: f64,
+    /// Shooting: the continuous extension of the integration that sampled
+    /// the solution, with the tolerances it was made with (what
+    /// [`Equilibrium::resample`] reads instead of integrating again).
+    recorded: Option<(Tolerances, Arc<DenseRecord>)>,
 }
 
 impl Equilibrium {
@@ -195,11 +200,14 @@ impl Equilibrium {
             .expect("an equilibrium has at least two samples")
     }
 
-    /// The solution at other points (sorted, in [0, L]), re-integrated from
-    /// the converged unknowns with the tolerances in `opts` (shooting) or
-    /// evaluated from the collocation solution
-    /// ([`CollocationSolution::sample`]); used by the stability analysis at
-    /// its quadrature points.
+    /// The solution at other points (sorted, in [0, L]) of `rod` (the rod
+    /// it was solved for): evaluated from the collocation solution
+    /// ([`CollocationSolution::sample`]); for shooting read from the
+    /// continuous extension recorded when the solve sampled it, where that
+    /// integration had the tolerances in `opts` (its steps do not depend
+    /// on the points, so this is what integrating again would give), else
+    /// re-integrated from the converged unknowns with them. Used by the
+    /// stability analysis at its quadrature points.
     pub fn resample(
         &self,
         rod: &Rod,
@@ -210,12 +218,39 @@ impl Equilibrium {
         if let Discretization::Collocation(sol) = &self.discretization {
             return Ok(sol.sample(eq.as_ref(), points));
         }
+        if let Some((tol, record)) = &self.recorded {
+            if *tol == opts.integration {
+                if let Some(samples) = read_record(eq.as_ref(), record, points) {
+                    return Ok(samples);
+                }
+            }
+        }
         let mut sys = ShootingSystem::new(eq.as_ref(), self.method.segments(), opts.integration);
         let (samples, _) = sys
             .sample(&self.unknowns, points)
             .map_err(SolveError::Sampling)?;
         Ok(samples)
     }
+}
+
+/// The samples of `eq` at `points` from a recorded continuous extension,
+/// each state projected as the integrator projects its stops; None when a
+/// point lies outside the record.
+fn read_record(
+    eq: &dyn RodEquations,
+    record: &DenseRecord,
+    points: &[f64],
+) -> Option<Vec<RodSample>> {
+    let mut y = vec![0.0; eq.dim()];
+    points
+        .iter()
+        .map(|&s| {
+            record.state_at(s, &mut y).then(|| {
+                eq.project(&mut y);
+                eq.sample(s, &y)
+            })
+        })
+        .collect()
 }
 
 /// Why no equilibrium was returned.
@@ -332,7 +367,9 @@ pub fn solve(
         Solved::Shooting { x, report } => {
             let mut sys =
                 ShootingSystem::new(eq.as_ref(), opts.method.segments(), opts.integration);
-            let (samples, drift) = sys.sample(&x, &points).map_err(SolveError::Sampling)?;
+            let (samples, drift, record) = sys
+                .sample_recorded(&x, &points)
+                .map_err(SolveError::Sampling)?;
             stats += sys.stats;
             Equilibrium {
                 model: model.clone(),
@@ -349,6 +386,7 @@ pub fn solve(
                 director_drift: drift,
                 integration: stats,
                 wall_time: 0.0,
+                recorded: Some((opts.integration, Arc::new(record))),
             }
         }
         Solved::Collocation(sol) => {
@@ -369,6 +407,7 @@ pub fn solve(
                 director_drift: drift,
                 integration: stats,
                 wall_time: 0.0,
+                recorded: None,
             }
         }
     };

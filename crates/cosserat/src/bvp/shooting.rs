@@ -17,7 +17,9 @@ use super::gauss_step::GaussStepper;
 use super::newton::NonlinearSystem;
 use crate::equations::{RodEquations, RodSample};
 use crate::model::RodTangent;
-use crate::numerics::integrator::{Dop853, IntegrationError, IntegrationStats, Stops, Tolerances};
+use crate::numerics::integrator::{
+    DenseRecord, Dop853, IntegrationError, IntegrationStats, Stops, Tolerances,
+};
 use crate::numerics::staircase::Staircase;
 
 /// The shooting formulation of a rod BVP on K segments.
@@ -458,13 +460,38 @@ impl<'a> ShootingSystem<'a> {
         self.sample(x, points)
     }
 
+    /// [`ShootingSystem::sample`], and the continuous extension of every
+    /// step of the integration ([`DenseRecord`], segments and pieces in
+    /// order of s): the solution anywhere on [0, L] afterwards without
+    /// integrating again ([`crate::bvp::Equilibrium::resample`]). Same
+    /// steps and samples as [`ShootingSystem::sample`]; three more
+    /// evaluations on each step that holds no output point.
+    pub fn sample_recorded(
+        &mut self,
+        x: &[f64],
+        points: &[f64],
+    ) -> Result<(Vec<RodSample>, f64, DenseRecord), IntegrationError> {
+        self.served(x, points, Stops::Recorded)
+    }
+
     fn sample_served(
         &mut self,
         x: &[f64],
         points: &[f64],
     ) -> Result<(Vec<RodSample>, f64), IntegrationError> {
+        let (samples, drift, _) = self.served(x, points, Stops::Interpolated)?;
+        Ok((samples, drift))
+    }
+
+    fn served(
+        &mut self,
+        x: &[f64],
+        points: &[f64],
+        serve: Stops,
+    ) -> Result<(Vec<RodSample>, f64, DenseRecord), IntegrationError> {
         let n = self.eq.dim();
         let mut samples = Vec::with_capacity(points.len());
+        let mut record = DenseRecord::new(n);
         for j in 0..self.segments {
             let (a, b) = (self.node(j), self.node(j + 1));
             let last = j + 1 == self.segments;
@@ -482,10 +509,11 @@ impl<'a> ShootingSystem<'a> {
                     &mut y,
                     &self.tol,
                     stops,
-                    Stops::Interpolated,
+                    serve,
                     |s, y| samples.push(eq.sample(s, y)),
                     |y| eq.project(y),
                 )?;
+                record.append(self.dop.take_record());
                 self.stats += stats;
             }
         }
@@ -493,7 +521,7 @@ impl<'a> ShootingSystem<'a> {
             .iter()
             .map(RodSample::director_drift)
             .fold(0.0, f64::max);
-        Ok((samples, drift))
+        Ok((samples, drift, record))
     }
 }
 

@@ -15,6 +15,8 @@
 
 mod dense;
 
+pub use dense::DenseRecord;
+
 /// Tolerances and limits of one integration.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Tolerances {
@@ -148,6 +150,8 @@ pub struct Dop853 {
     next: Vec<f64>,
     /// The continuous extension, built on the first interpolated stop.
     dense: Option<dense::Interpolant>,
+    /// The extensions of the steps integrated with [`Stops::Recorded`].
+    record: DenseRecord,
 }
 
 impl Dop853 {
@@ -158,7 +162,15 @@ impl Dop853 {
             stage: vec![0.0; n],
             next: vec![0.0; n],
             dense: None,
+            record: DenseRecord::new(n),
         }
+    }
+
+    /// The continuous extensions recorded since the last call (in the
+    /// order integrated), leaving an empty record.
+    pub fn take_record(&mut self) -> DenseRecord {
+        let n = self.stage.len();
+        std::mem::replace(&mut self.record, DenseRecord::new(n))
     }
 
     fn resize(&mut self, n: usize) {
@@ -244,7 +256,7 @@ impl Dop853 {
             }
             let target = match serve {
                 Stops::Landed => stops.get(next_stop).copied().unwrap_or(s1).min(s1),
-                Stops::Interpolated => s1,
+                Stops::Interpolated | Stops::Recorded => s1,
             };
             let lands = s + h >= target - 1e-14 * target.abs().max(1.0);
             let step = if lands { target - s } else { h };
@@ -269,7 +281,12 @@ impl Dop853 {
                 let start = s;
                 s = if lands { target } else { s + step };
                 let inside = stops[next_stop..].partition_point(|&t| t <= s);
-                if serve == Stops::Interpolated && inside > 0 {
+                let extended = match serve {
+                    Stops::Landed => false,
+                    Stops::Interpolated => inside > 0,
+                    Stops::Recorded => true,
+                };
+                if extended {
                     // The extension needs y and f at the step's start.
                     self.interpolant(n).start(y);
                 }
@@ -278,9 +295,12 @@ impl Dop853 {
                 if y.iter().any(|v| !v.is_finite()) {
                     return Err(IntegrationError::NotFinite { s });
                 }
-                if serve == Stops::Interpolated && inside > 0 {
+                if extended {
                     stats.evaluations += self.extend(&mut f, start, step, y);
                     let mut dense = self.dense.take().expect("built by interpolant");
+                    if serve == Stops::Recorded {
+                        self.record.push(start, step, &dense);
+                    }
                     for &t in &stops[next_stop..next_stop + inside] {
                         // The step's end is the state itself, as when landed.
                         if t == s {
@@ -418,6 +438,11 @@ pub enum Stops {
     Landed,
     /// Stops inside a step are read from the continuous extension.
     Interpolated,
+    /// As [`Stops::Interpolated`], and every accepted step's continuous
+    /// extension is kept ([`Dop853::take_record`]): the whole solution,
+    /// readable at any later point without integrating again (three more
+    /// evaluations on a step that holds no stop).
+    Recorded,
 }
 
 /// y += a x.

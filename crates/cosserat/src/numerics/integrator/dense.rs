@@ -128,6 +128,86 @@ impl Interpolant {
     }
 }
 
+/// The continuous extensions of consecutive accepted steps (one
+/// integration, or several appended in increasing s): the solution at any
+/// point of the steps' span from seven coefficient vectors and the step's
+/// start state, as [`Interpolant::at`] reads them, without integrating
+/// again. Flat storage: per step its start, its size and 8 n numbers.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct DenseRecord {
+    n: usize,
+    starts: Vec<f64>,
+    steps: Vec<f64>,
+    /// Per step: y_old, then F₀ … F₆.
+    data: Vec<f64>,
+}
+
+impl DenseRecord {
+    /// An empty record of states of dimension n.
+    pub fn new(n: usize) -> Self {
+        DenseRecord {
+            n,
+            ..Default::default()
+        }
+    }
+
+    /// Whether no step is recorded.
+    pub fn is_empty(&self) -> bool {
+        self.starts.is_empty()
+    }
+
+    /// The recorded span [first step's start, last step's end].
+    pub fn span(&self) -> Option<(f64, f64)> {
+        Some((
+            *self.starts.first()?,
+            self.starts.last()? + self.steps.last()?,
+        ))
+    }
+
+    /// Appends another record whose steps follow this one's.
+    pub fn append(&mut self, mut other: DenseRecord) {
+        if self.is_empty() {
+            self.n = other.n;
+        }
+        self.starts.append(&mut other.starts);
+        self.steps.append(&mut other.steps);
+        self.data.append(&mut other.data);
+    }
+
+    pub(super) fn push(&mut self, start: f64, step: f64, step_extension: &Interpolant) {
+        self.starts.push(start);
+        self.steps.push(step);
+        self.data.extend_from_slice(&step_extension.y_old);
+        for c in &step_extension.coefficients {
+            self.data.extend_from_slice(c);
+        }
+    }
+
+    /// The state at t into `y` (not projected), from the last step that
+    /// starts at or before t (so that at a jump s_k, where one piece ends
+    /// an ulp below s_k and the next starts at s_k, the right limit), θ
+    /// held in [0, 1]; false when t lies outside the recorded span.
+    pub fn state_at(&self, t: f64, y: &mut [f64]) -> bool {
+        let Some((a, b)) = self.span() else {
+            return false;
+        };
+        if !(a..=b).contains(&t) {
+            return false;
+        }
+        let i = self.starts.partition_point(|&s| s <= t).saturating_sub(1);
+        let theta = ((t - self.starts[i]) / self.steps[i]).clamp(0.0, 1.0);
+        let n = self.n;
+        let block = &self.data[i * 8 * n..(i + 1) * 8 * n];
+        y.fill(0.0);
+        for (j, f) in block[n..].chunks_exact(n).rev().enumerate() {
+            let w = if j % 2 == 0 { theta } else { 1.0 - theta };
+            y.iter_mut().zip(f).for_each(|(v, c)| *v = (*v + c) * w);
+        }
+        axpy(y, 1.0, &block[..n]);
+        true
+    }
+}
+
 impl Dop853 {
     /// The interpolant's storage for dimension n.
     pub(super) fn interpolant(&mut self, n: usize) -> &mut Interpolant {
@@ -250,5 +330,52 @@ mod tests {
         let (e1, e2) = (inside(0.2), inside(0.1));
         let order = (e1 / e2).log2();
         assert!(order > 7.5, "local order {order} ({e1:e}, {e2:e})");
+    }
+
+    /// y' = y from 0 to 1 recorded: the record read anywhere afterwards
+    /// gives the states the served stops gave, with the same steps, and
+    /// matches eˢ to the tolerance; outside the span it says so.
+    #[test]
+    fn recorded_steps_give_the_served_states() {
+        let tol = Tolerances {
+            rtol: 1e-12,
+            atol: 1e-12,
+            max_steps: 10_000,
+        };
+        let stops: Vec<f64> = (0..=37).map(|i| f64::from(i) / 37.0).collect();
+        let rhs = |_: f64, y: &[f64], d: &mut [f64]| d[0] = y[0];
+        let serve = |how| {
+            let mut seen = vec![];
+            let mut dop = Dop853::new(1);
+            let stats = dop
+                .integrate_serving(
+                    rhs,
+                    (0.0, 1.0, 1),
+                    &mut [1.0],
+                    &tol,
+                    &stops,
+                    how,
+                    |_, y| seen.push(y[0]),
+                    |_| {},
+                )
+                .unwrap();
+            (seen, stats, dop.take_record())
+        };
+        let (served, plain, none) = serve(super::super::Stops::Interpolated);
+        let (recorded, stats, record) = serve(super::super::Stops::Recorded);
+        assert!(none.is_empty());
+        assert_eq!(stats.accepted, plain.accepted);
+        assert_eq!(served, recorded);
+        let mut y = [0.0];
+        for (&t, &v) in stops.iter().zip(&served) {
+            assert!(record.state_at(t, &mut y));
+            assert!((y[0] - v).abs() <= 4.0 * f64::EPSILON * v, "{t}: {} against {v}", y[0]);
+        }
+        for t in [0.123, 0.5, 0.999] {
+            assert!(record.state_at(t, &mut y));
+            assert!((y[0] - f64::exp(t)).abs() < 1e-11);
+        }
+        assert!(!record.state_at(1.0 + 1e-9, &mut y));
+        assert!(!record.state_at(-1e-9, &mut y));
     }
 }
