@@ -554,6 +554,28 @@ fn work_precision_chart_redrawn_from_its_csv() {
     let text = read(&d.join("work_precision.svg"));
     assert_legends_outside(&text);
     assert_eq!(frames(&text).len(), 3);
+    // With scipy's points (scripts/scipy_work_precision.py) beside them:
+    // one more legend entry, the same panels.
+    let scipy = format!(
+        "{}/docs/work-precision/scipy_solve_bvp.csv",
+        common::problems::ROOT
+    );
+    let o = run(&[
+        "bench",
+        "work-precision",
+        "--redraw",
+        &csv,
+        "--redraw",
+        &scipy,
+        "-o",
+        d.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = read(&d.join("work_precision.svg"));
+    let words: Vec<String> = texts(&text).into_iter().map(|t| t.text).collect();
+    assert!(words.iter().any(|w| w == "scipy solve_bvp"), "{words:?}");
+    assert_legends_outside(&text);
+    assert_eq!(frames(&text).len(), 3);
     // A file that is not such a CSV is bad input, named.
     let o = run(&[
         "bench",

@@ -369,7 +369,11 @@ mod tests {
         let mut y = [0.0];
         for (&t, &v) in stops.iter().zip(&served) {
             assert!(record.state_at(t, &mut y));
-            assert!((y[0] - v).abs() <= 4.0 * f64::EPSILON * v, "{t}: {} against {v}", y[0]);
+            assert!(
+                (y[0] - v).abs() <= 4.0 * f64::EPSILON * v,
+                "{t}: {} against {v}",
+                y[0]
+            );
         }
         for t in [0.123, 0.5, 0.999] {
             assert!(record.state_at(t, &mut y));

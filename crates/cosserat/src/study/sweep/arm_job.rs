@@ -366,6 +366,13 @@ impl Job for ArmJob {
                 }
             }
         };
+        // A point that finishes after the stop is discarded
+        // (`schedule::run`): its optima are not checked on finer meshes,
+        // whose re-polishes do not poll the stop (from an interrupted
+        // search's poor start they ran for a minute past SIGTERM).
+        if stop() {
+            return record;
+        }
         if let [first, second] = &mut found[..] {
             if let (Some(a), Some(b)) = (&first.design, &second.design) {
                 if !distinct_optima(arm, scene, a, b) {
