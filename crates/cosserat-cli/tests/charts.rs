@@ -537,41 +537,25 @@ fn reach_envelopes_are_to_scale_with_the_legend_aside() {
 #[test]
 fn work_precision_chart_redrawn_from_its_csv() {
     let d = dir("bench");
-    let csv = format!(
-        "{}/docs/work-precision/work_precision.csv",
-        common::problems::ROOT
-    );
-    let o = run(&[
-        "bench",
-        "work-precision",
-        "--redraw",
-        &csv,
-        "-o",
-        d.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let stored = |name: &str| format!("{}/docs/work-precision/{name}", common::problems::ROOT);
+    let redraw = |csvs: &[String]| {
+        let mut args = vec!["bench".to_string(), "work-precision".to_string()];
+        for c in csvs {
+            args.extend(["--redraw".to_string(), c.clone()]);
+        }
+        args.extend(["-o".to_string(), d.to_str().unwrap().to_string()]);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let o = run(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        read(&d.join("work_precision.svg"))
+    };
+    let text = redraw(&[stored("work_precision.csv")]);
     assert_png(&d.join("work_precision.png"));
-    let text = read(&d.join("work_precision.svg"));
     assert_legends_outside(&text);
     assert_eq!(frames(&text).len(), 3);
     // With scipy's points (scripts/scipy_work_precision.py) beside them:
     // one more legend entry, the same panels.
-    let scipy = format!(
-        "{}/docs/work-precision/scipy_solve_bvp.csv",
-        common::problems::ROOT
-    );
-    let o = run(&[
-        "bench",
-        "work-precision",
-        "--redraw",
-        &csv,
-        "--redraw",
-        &scipy,
-        "-o",
-        d.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let text = read(&d.join("work_precision.svg"));
+    let text = redraw(&[stored("work_precision.csv"), stored("scipy_solve_bvp.csv")]);
     let words: Vec<String> = texts(&text).into_iter().map(|t| t.text).collect();
     assert!(words.iter().any(|w| w == "scipy solve_bvp"), "{words:?}");
     assert_legends_outside(&text);
