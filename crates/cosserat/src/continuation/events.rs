@@ -29,7 +29,7 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use super::corrector::DENSE_UP_TO;
+use super::corrector::{Linearization, DENSE_UP_TO};
 use super::engine;
 use super::kernel::BandedJacobian;
 use super::Tracker;
@@ -41,6 +41,10 @@ use crate::stability::Block;
 
 /// A test function along the step from a point: f(σ) and the point there.
 type Located = (f64, Vec<f64>, f64, Vec<f64>);
+
+/// A point of [`Run::point_at`]: unknowns, parameter, tangent, and F_x
+/// there where its corrector evaluated it.
+type Cut = (Vec<f64>, f64, Vec<f64>, Option<Linearization>);
 
 /// A converged point of a location and its arclength σ from the start.
 type Anchor = (f64, Located);
@@ -202,12 +206,14 @@ impl Run<'_> {
         near: Option<&Anchor>,
         test: &Test,
     ) -> Option<Located> {
-        let (x, p, tangent) = self.point_at(a, sign, sigma, near)?;
+        let (x, p, tangent, fx) = self.point_at(a, sign, sigma, near)?;
         let n = x.len();
         let value = match test {
             Test::Fold => tangent[n],
-            Test::Determinant => self.det(&x, p)?,
-            Test::Bordered { right, left, entry } => self.bordered(&x, p, right, left)?[*entry],
+            Test::Determinant => self.det_with(&x, p, fx)?,
+            Test::Bordered { right, left, entry } => {
+                self.bordered_with(&x, p, right, left, fx)?[*entry]
+            }
             Test::Eigenvalue(block) => {
                 self.tracker
                     .nearest_zero(self.family, &x, p, *block)
@@ -221,7 +227,9 @@ impl Run<'_> {
         Some((value, x, p, tangent))
     }
 
-    /// The point where the plane τ_aᵀ(z − z_a) = σ cuts the branch. From
+    /// The point where the plane τ_aᵀ(z − z_a) = σ cuts the branch, with
+    /// F_x there where its corrector gave it (for the test functions, which
+    /// would otherwise evaluate it again). From
     /// `a` the predictor is z_a + σ τ_a; from a converged point `near` of
     /// the same plane family (at σ_n, tangent τ_n) it is
     /// z_n + (σ − σ_n)/(τ_aᵀτ_n) τ_n, which lies on the same plane. Near a
@@ -231,13 +239,7 @@ impl Run<'_> {
     /// arch's asymmetric branch points were bracketed but never located),
     /// one from the nearer bracket end does not. None where the corrector
     /// does not converge.
-    fn point_at(
-        &self,
-        a: &Point,
-        sign: f64,
-        sigma: f64,
-        near: Option<&Anchor>,
-    ) -> Option<(Vec<f64>, f64, Vec<f64>)> {
+    fn point_at(&self, a: &Point, sign: f64, sigma: f64, near: Option<&Anchor>) -> Option<Cut> {
         let travel = |t: &[f64]| -> Vec<f64> { t.iter().map(|v| v * sign).collect() };
         let t_a = travel(&a.tangent);
         let anchored = near.and_then(|(sigma_n, (_, x, p, t))| {
@@ -252,9 +254,21 @@ impl Run<'_> {
                     .collect::<Vec<f64>>()
             })
         });
-        let Some(pred) = anchored else {
-            let (x, p, tangent, _) = self.step(a, sign, sigma).ok()??;
-            return Some((x, p, tangent));
+        let pred = match anchored {
+            Some(pred) => pred,
+            // The step from `a` itself (`Run::step`): sliced, or its
+            // corrector below from the same predictor z_a + σ τ_a.
+            None if self.sliced => {
+                let (x, p, tangent, _) = self.step(a, sign, sigma).ok()??;
+                return Some((x, p, tangent, None));
+            }
+            None => a
+                .unknowns
+                .iter()
+                .chain([&a.parameter])
+                .zip(&t_a)
+                .map(|(z, t)| z + sigma * t)
+                .collect(),
         };
         if self.sliced {
             // The slice through `a` (its copies' null vectors), as the
@@ -265,12 +279,12 @@ impl Run<'_> {
                 .ok()??;
             let n = z.len() - 1;
             let t = self.sliced_tangent(&z[..n], z[n], &kernel, &t_a).ok()?;
-            return Some((z[..n].to_vec(), z[n], travel(&t)));
+            return Some((z[..n].to_vec(), z[n], travel(&t), None));
         }
         let (z, _, fu) = self.correct(&pred, &t_a).ok()??;
         let n = z.len() - 1;
         let t = engine::tangent_from(self.family, &fu, &z[..n], z[n], &t_a).ok()?;
-        Some((z[..n].to_vec(), z[n], travel(&t)))
+        Some((z[..n].to_vec(), z[n], travel(&t), Some(fu)))
     }
 
     fn jacobian(&self, x: &[f64], p: f64) -> Option<DMatrix<f64>> {
@@ -301,11 +315,21 @@ impl Run<'_> {
     /// geometric mean of the pivots: the same sign and root, without the
     /// overflow of a product of thousands of pivots).
     fn det(&self, x: &[f64], p: f64) -> Option<f64> {
+        self.det_with(x, p, None)
+    }
+
+    /// [`Self::det`] with F_x at (x, p) where it is known (`fx`, as the
+    /// corrector evaluated it: the same matrix).
+    fn det_with(&self, x: &[f64], p: f64, fx: Option<Linearization>) -> Option<f64> {
         let n = x.len();
         if n > super::corrector::DENSE_UP_TO {
             if let Some(mut a) = self.family.staircase() {
-                let mut r = DVector::zeros(n);
-                self.family.residual_staircase(x, p, &mut r, &mut a).ok()?;
+                if let Some(Linearization::Staircase(known)) = fx {
+                    a = known;
+                } else {
+                    let mut r = DVector::zeros(n);
+                    self.family.residual_staircase(x, p, &mut r, &mut a).ok()?;
+                }
                 let mut lu = StaircaseLu::default();
                 if lu.factor(&a, None).is_err() {
                     return Some(0.0);
@@ -314,7 +338,10 @@ impl Run<'_> {
                 return Some(sign * (log / n as f64).exp());
             }
         }
-        Some(self.jacobian(x, p)?.determinant())
+        match fx {
+            Some(Linearization::Dense(known)) => Some(known.determinant()),
+            _ => Some(self.jacobian(x, p)?.determinant()),
+        }
     }
 
     /// Govaerts' G (m × m) at (x, p): [F_x Ψ; Φᵀ 0] [V; G] = [0; I_m].
@@ -327,10 +354,30 @@ impl Run<'_> {
         right: &DMatrix<f64>,
         left: &DMatrix<f64>,
     ) -> Option<DMatrix<f64>> {
+        self.bordered_with(x, p, right, left, None)
+    }
+
+    /// [`Self::bordered`] with F_x at (x, p) where it is known (`fx`, as
+    /// the corrector evaluated it: the same matrix).
+    fn bordered_with(
+        &self,
+        x: &[f64],
+        p: f64,
+        right: &DMatrix<f64>,
+        left: &DMatrix<f64>,
+        fx: Option<Linearization>,
+    ) -> Option<DMatrix<f64>> {
         if self.is_large(x.len()) {
-            return self.bordered_banded(x, p, right, left);
+            let a = match fx {
+                Some(Linearization::Staircase(known)) => known,
+                _ => self.large_jacobian(x, p)?,
+            };
+            return bordered_banded(&a, right, left);
         }
-        let fx = self.jacobian(x, p)?;
+        let fx = match fx {
+            Some(Linearization::Dense(known)) => known,
+            _ => self.jacobian(x, p)?,
+        };
         let (n, m) = (x.len(), right.ncols());
         let mut big = DMatrix::zeros(n + m, n + m);
         big.view_mut((0, 0), (n, n)).copy_from(&fx);
@@ -340,39 +387,6 @@ impl Run<'_> {
         rhs.view_mut((n, 0), (m, m)).fill_with_identity();
         let solution = big.lu().solve(&rhs)?;
         let g = solution.rows(n, m).into_owned();
-        g.iter().all(|v| v.is_finite()).then_some(g)
-    }
-
-    /// Govaerts' G in O(N) where F_x is a large staircase: with F_x
-    /// regular, block elimination of [F_x Ψ; Φᵀ 0] [V; G] = [0; I_m]
-    /// gives V = −F_x⁻¹ Ψ G and G = −(Φᵀ F_x⁻¹ Ψ)⁻¹ (the Schur
-    /// complement; det of the bordered matrix = det F_x · det(−Φᵀ F_x⁻¹ Ψ),
-    /// so G exists exactly where the bordered matrix is regular). m band
-    /// solves with the LU of F_x; None where F_x has an exactly zero pivot
-    /// or the Schur complement is singular.
-    fn bordered_banded(
-        &self,
-        x: &[f64],
-        p: f64,
-        right: &DMatrix<f64>,
-        left: &DMatrix<f64>,
-    ) -> Option<DMatrix<f64>> {
-        let a = self.large_jacobian(x, p)?;
-        let mut lu = StaircaseLu::default();
-        lu.factor(&a, None).ok()?;
-        let m = right.ncols();
-        let mut schur = DMatrix::zeros(m, m);
-        let mut y = vec![0.0; x.len()];
-        for c in 0..m {
-            y.copy_from_slice(left.column(c).as_slice());
-            if !lu.solve(&mut y) {
-                return None;
-            }
-            for r in 0..m {
-                schur[(r, c)] = right.column(r).iter().zip(&y).map(|(u, v)| u * v).sum();
-            }
-        }
-        let g: DMatrix<f64> = -schur.try_inverse()?;
         g.iter().all(|v| v.is_finite()).then_some(g)
     }
 
@@ -824,7 +838,7 @@ impl Run<'_> {
             (s4, (p4 - p2).abs() + resolution)
         };
         let near = &finer[1];
-        let Some((x, p, tangent)) = self.point_at(a, sign, sigma, Some(near)) else {
+        let Some((x, p, tangent, _)) = self.point_at(a, sign, sigma, Some(near)) else {
             let point = self
                 .special_point(
                     a,
@@ -1339,4 +1353,34 @@ fn collinear(points: &[nalgebra::Vector3<f64>]) -> bool {
         && points
             .iter()
             .all(|q| (q - first).cross(&chord).norm() <= 1e-8 * length * length)
+}
+
+/// Govaerts' G in O(N) where F_x is a large staircase: with F_x
+/// regular, block elimination of [F_x Ψ; Φᵀ 0] [V; G] = [0; I_m]
+/// gives V = −F_x⁻¹ Ψ G and G = −(Φᵀ F_x⁻¹ Ψ)⁻¹ (the Schur
+/// complement; det of the bordered matrix = det F_x · det(−Φᵀ F_x⁻¹ Ψ),
+/// so G exists exactly where the bordered matrix is regular). m band
+/// solves with the LU of F_x; None where F_x has an exactly zero pivot
+/// or the Schur complement is singular.
+fn bordered_banded(
+    a: &Staircase,
+    right: &DMatrix<f64>,
+    left: &DMatrix<f64>,
+) -> Option<DMatrix<f64>> {
+    let mut lu = StaircaseLu::default();
+    lu.factor(a, None).ok()?;
+    let m = right.ncols();
+    let mut schur = DMatrix::zeros(m, m);
+    let mut y = vec![0.0; a.size()];
+    for c in 0..m {
+        y.copy_from_slice(left.column(c).as_slice());
+        if !lu.solve(&mut y) {
+            return None;
+        }
+        for r in 0..m {
+            schur[(r, c)] = right.column(r).iter().zip(&y).map(|(u, v)| u * v).sum();
+        }
+    }
+    let g: DMatrix<f64> = -schur.try_inverse()?;
+    g.iter().all(|v| v.is_finite()).then_some(g)
 }
