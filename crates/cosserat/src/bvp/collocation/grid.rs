@@ -20,7 +20,8 @@
 use nalgebra::DMatrix;
 
 use super::iteration::{Linearization, NewtonOutcome};
-use super::lu::{dense_lu, dense_solve, dense_solve_rows, BandLu};
+use super::lu::BandLu;
+use super::stage_lu::StageSplit;
 
 /// An output slice filled in order (the residual written in place).
 struct Slots<'o> {
@@ -59,6 +60,8 @@ pub(super) struct Grid<'a> {
     /// The n × n identity, column-major: the tangent vectors that make
     /// `rhs_linearized` return the Jacobian ∂f/∂y (one call per point).
     pub(super) ident: Vec<f64>,
+    /// The stage matrices' components without the position.
+    pub(super) split: StageSplit,
 }
 
 /// Buffers of one interval's stage computations, reused across intervals
@@ -68,23 +71,24 @@ pub(super) struct Scratch {
     pub(super) f: Vec<f64>,
     /// ∂f/∂y at the m stages, each n × n column-major.
     pub(super) jac: Vec<f64>,
-    /// The stage matrix W (mn × mn, row-major), factored in place.
+    /// The stage matrix W factored by [`StageSplit::factor`].
     pub(super) w: Vec<f64>,
-    pub(super) piv: Vec<usize>,
+    pub(super) piv: Vec<u8>,
     /// A stage-sized right-hand side (m·n).
     pub(super) g: Vec<f64>,
-    /// W⁻¹E of one interval (mn × n, row-major).
+    /// W_CC⁻¹E_C of one interval, or the work of a stage solve.
     pub(super) z: Vec<f64>,
 }
 
 impl Scratch {
-    pub(super) fn new(n: usize, m: usize) -> Self {
+    pub(super) fn new(grid: &Grid) -> Self {
+        let (n, m) = (grid.n, grid.tab.m);
         let mn = m * n;
         Scratch {
             f: vec![0.0; mn],
             jac: vec![0.0; m * n * n],
-            w: vec![0.0; mn * mn],
-            piv: vec![0; mn],
+            w: vec![0.0; grid.split.len()],
+            piv: vec![0; grid.split.coupled_rows()],
             g: vec![0.0; mn],
             z: vec![0.0; mn * n],
         }
@@ -94,6 +98,7 @@ impl Scratch {
 impl<'a> Grid<'a> {
     pub(super) fn new(eq: &'a dyn RodEquations, tab: Tableau, mesh: Vec<f64>) -> Self {
         let n = eq.dim();
+        let split = StageSplit::new(n, tab.m, eq.quadrature_components());
         Grid {
             eq,
             tab,
@@ -103,6 +108,7 @@ impl<'a> Grid<'a> {
             w: eq.state_scales().iter().map(|v| 1.0 / v).collect(),
             sens: eq.initial_sensitivity(),
             ident: DMatrix::<f64>::identity(n, n).as_slice().to_vec(),
+            split,
         }
     }
 
@@ -281,26 +287,6 @@ impl<'a> Grid<'a> {
         }
     }
 
-    /// W = I − h (A ⊗ I) diag(J_l) (row-major, into `w`): the stage block of
-    /// the Jacobian.
-    pub(super) fn stage_matrix(&self, h: f64, jac: &[f64], w: &mut [f64]) {
-        let (n, m) = (self.n, self.tab.m);
-        let mn = m * n;
-        for j in 0..m {
-            for l in 0..m {
-                let coef = h * self.tab.a(j, l);
-                let jl = &jac[l * n * n..(l + 1) * n * n];
-                for r in 0..n {
-                    let row = &mut w[(j * n + r) * mn + l * n..(j * n + r) * mn + (l + 1) * n];
-                    for (c, v) in row.iter_mut().enumerate() {
-                        let id = if j == l && r == c { 1.0 } else { 0.0 };
-                        *v = id - jl[c * n + r] * coef;
-                    }
-                }
-            }
-        }
-    }
-
     /// The scaled residual: per interval the m·n stage equations and the n
     /// node equations, then the p tip conditions.
     pub(super) fn residual(&self, x: &[f64]) -> Vec<f64> {
@@ -341,11 +327,10 @@ impl<'a> Grid<'a> {
 
     /// Storage for the Newton matrix of this mesh.
     pub(super) fn new_linearization(&self) -> Linearization {
-        let (n, m, p, k) = (self.n, self.tab.m, self.p, self.intervals());
-        let mn = m * n;
+        let (n, p, k) = (self.n, self.p, self.intervals());
         Linearization {
-            lu: vec![0.0; k * mn * mn],
-            piv: vec![0; k * mn],
+            lu: vec![0.0; k * self.split.len()],
+            piv: vec![0; k * self.split.coupled_rows()],
             band: BandLu::zeros(p + n * k, 2 * n - 1 - p, n + p - 1),
             valid: false,
         }
@@ -408,35 +393,22 @@ impl<'a> Grid<'a> {
         ws: &mut Scratch,
         gamma: &mut [f64],
     ) -> bool {
-        let (n, m, (s, h)) = (self.n, self.tab.m, self.span(i));
-        let mn = m * n;
+        let (s, h) = self.span(i);
+        let (len, rows) = (self.split.len(), self.split.coupled_rows());
         self.stage_jacobians(s, h, st, &mut ws.f, &mut ws.jac);
-        let lu = &mut lin.lu[i * mn * mn..(i + 1) * mn * mn];
-        let piv = &mut lin.piv[i * mn..(i + 1) * mn];
-        self.stage_matrix(h, &ws.jac, lu);
-        if !dense_lu(lu, mn, piv) {
-            return false;
-        }
-        let z = &mut ws.z;
-        for (r, row) in z.chunks_exact_mut(n).enumerate() {
-            row.iter_mut()
-                .enumerate()
-                .for_each(|(c, v)| *v = if r % n == c { 1.0 } else { 0.0 });
-        }
-        dense_solve_rows(lu, mn, piv, z, n);
-        if !z.iter().all(|v| v.is_finite()) {
-            return false;
-        }
-        let d = &self.tab.d;
-        let keep = 1.0 - d.iter().sum::<f64>();
-        for (q, g) in gamma.iter_mut().enumerate() {
-            let (r, c) = (q / n, q % n);
-            *g = if r == c { keep } else { 0.0 };
-            for (j, dj) in d.iter().enumerate() {
-                *g += dj * z[(j * n + r) * n + c];
-            }
-        }
-        true
+        let lu = &mut lin.lu[i * len..(i + 1) * len];
+        let piv = &mut lin.piv[i * rows..(i + 1) * rows];
+        self.split.factor(&self.tab, h, &ws.jac, lu, piv)
+            && self.split.node_map(&self.tab, h, lu, piv, gamma, &mut ws.z)
+    }
+
+    /// The factors of interval i's stage matrix in `lin`.
+    fn stage_factors<'l>(&self, lin: &'l Linearization, i: usize) -> (&'l [f64], &'l [u8]) {
+        let (len, rows) = (self.split.len(), self.split.coupled_rows());
+        (
+            &lin.lu[i * len..(i + 1) * len],
+            &lin.piv[i * rows..(i + 1) * rows],
+        )
     }
 
     /// −J⁻¹F for a scaled residual F, in the unknowns' layout: per interval
@@ -448,18 +420,16 @@ impl<'a> Grid<'a> {
         let mn = m * n;
         let d = &self.tab.d;
         let (head, stages) = dx.split_at_mut(p + n * k);
+        let mut work = vec![0.0; mn];
         for i in 0..k {
             let base = i * (m + 1) * n;
             let v = &mut stages[i * mn..(i + 1) * mn];
             v.iter_mut()
                 .enumerate()
                 .for_each(|(r, a)| *a = -f[base + r] / self.w[r % n]);
-            dense_solve(
-                &lin.lu[i * mn * mn..(i + 1) * mn * mn],
-                mn,
-                &lin.piv[i * mn..(i + 1) * mn],
-                v,
-            );
+            let (lu, piv) = self.stage_factors(lin, i);
+            self.split
+                .solve(&self.tab, self.span(i).1, lu, piv, v, &mut work);
             for r in 0..n {
                 let mut acc = -f[base + mn + r] / self.w[r];
                 for (j, dj) in d.iter().enumerate() {
@@ -486,12 +456,9 @@ impl<'a> Grid<'a> {
             for gj in g.chunks_exact_mut(n) {
                 gj.copy_from_slice(dyi);
             }
-            dense_solve(
-                &lin.lu[i * mn * mn..(i + 1) * mn * mn],
-                mn,
-                &lin.piv[i * mn..(i + 1) * mn],
-                &mut g,
-            );
+            let (lu, piv) = self.stage_factors(lin, i);
+            self.split
+                .solve(&self.tab, self.span(i).1, lu, piv, &mut g, &mut work);
             let v = &mut stages[i * mn..(i + 1) * mn];
             v.iter_mut().zip(&g).for_each(|(a, b)| *a += b);
         }

@@ -19,10 +19,10 @@ use crate::numerics::newton::{self, NewtonError, System, Trial};
 /// second solve with these factors, and the node rows are combined with
 /// the stage rows so that they hold no Jacobian ([`super::Tableau::d`]).
 pub(super) struct Linearization {
-    /// LU factors of the stage matrices W (mn × mn each, row-major).
+    /// The stage matrices W factored by [`super::stage_lu::StageSplit`].
     pub(super) lu: Vec<f64>,
     /// Their row interchanges.
-    pub(super) piv: Vec<usize>,
+    pub(super) piv: Vec<u8>,
     pub(super) band: BandLu,
     /// Whether the last `linearize` succeeded.
     pub(super) valid: bool,
@@ -111,7 +111,7 @@ pub(super) fn damped_newton(
         grid,
         n: x.len(),
         lin: grid.new_linearization(),
-        ws: Scratch::new(grid.n, grid.tab.m),
+        ws: Scratch::new(grid),
     };
     let fail = |reason: String, history: Vec<f64>| CollocationError::NoConvergence {
         intervals,

@@ -37,6 +37,7 @@ mod grid;
 mod iteration;
 pub(super) mod lu;
 mod mesh;
+mod stage_lu;
 mod tableau;
 
 use super::newton::NewtonOptions;
@@ -133,7 +134,7 @@ impl CollocationSolution {
         let tab = Tableau::gauss(self.stage_count).expect("stored stage count is valid");
         let grid = Grid::new(eq, tab, self.mesh.clone());
         let (n, m) = (grid.n, grid.tab.m);
-        let mut ws = Scratch::new(n, m);
+        let mut ws = Scratch::new(&grid);
         let last = self.mesh.len() - 1;
         points
             .iter()
