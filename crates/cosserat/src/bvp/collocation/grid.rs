@@ -62,6 +62,9 @@ pub(super) struct Grid<'a> {
     pub(super) ident: Vec<f64>,
     /// The stage matrices' components without the position.
     pub(super) split: StageSplit,
+    /// The place of each state component in a node's block of the band
+    /// ([`StageSplit::band_order`]).
+    band_order: Vec<usize>,
 }
 
 /// Buffers of one interval's stage computations, reused across intervals
@@ -108,6 +111,7 @@ impl<'a> Grid<'a> {
             w: eq.state_scales().iter().map(|v| 1.0 / v).collect(),
             sens: eq.initial_sensitivity(),
             ident: DMatrix::<f64>::identity(n, n).as_slice().to_vec(),
+            band_order: split.band_order(),
             split,
         }
     }
@@ -331,9 +335,22 @@ impl<'a> Grid<'a> {
         Linearization {
             lu: vec![0.0; k * self.split.len()],
             piv: vec![0; k * self.split.coupled_rows()],
-            band: BandLu::zeros(p + n * k, 2 * n - 1 - p, n + p - 1),
+            band: BandLu::zeros(p + n * k, self.band_lower(), p),
             valid: false,
         }
+    }
+
+    /// The lower half-bandwidth of the condensed node system: unknowns
+    /// [δu | δy_1 … δy_N], each node's components in [`Self::band_order`],
+    /// rows the node equations w (δy_{i+1} − Γ_i δy_i) in the same order,
+    /// then the tip. Row n·i + π(r) meets column p + n(i − 1) + π(c) where
+    /// Γ_i[r, c] ≠ 0, n − p + π(r) − π(c) below the diagonal: at most
+    /// n − p + n − 1 − |P| (Γ[C, C], with C after P), and the first node
+    /// rows and the tip rows at most n − 1 below. Above it, the identity
+    /// of δy_{i+1} is p to the right of its row and nothing further.
+    fn band_lower(&self) -> usize {
+        let (n, p) = (self.n, self.p);
+        (n - 1).max(2 * n - 1 - p - self.split.quadrature_count())
     }
 
     /// The Newton matrix at x, condensed and factored into `lin` (reusing
@@ -360,20 +377,28 @@ impl<'a> Grid<'a> {
             } else {
                 (&gamma, n)
             };
-            let col = if i == 0 { 0 } else { p + n * (i - 1) };
+            let order = &self.band_order;
             for r in 0..n {
-                for c in 0..cols {
-                    lin.band
-                        .add(n * i + r, col + c, -g[r * cols + c] * self.w[r]);
+                let row = n * i + order[r];
+                // Γ's structural zeros (Γ[C, P], off the diagonal of
+                // Γ[P, P]) lie outside the band: only the rest is added.
+                for c in (0..cols).filter(|&c| g[r * cols + c] != 0.0) {
+                    let col = if i == 0 {
+                        c
+                    } else {
+                        p + n * (i - 1) + order[c]
+                    };
+                    lin.band.add(row, col, -g[r * cols + c] * self.w[r]);
                 }
-                lin.band.add(n * i + r, p + n * i + r, self.w[r]);
+                lin.band.add(row, p + n * i + order[r], self.w[r]);
             }
         }
         let y_tip = self.node(x, k);
         let gt = self.eq.tip_residual_jacobian(&y_tip);
         for r in 0..p {
             for c in 0..n {
-                lin.band.add(n * k + r, p + n * (k - 1) + c, gt[(r, c)]);
+                let col = p + n * (k - 1) + self.band_order[c];
+                lin.band.add(n * k + r, col, gt[(r, c)]);
             }
         }
         lin.valid = lin.band.factor().is_ok();
@@ -435,13 +460,14 @@ impl<'a> Grid<'a> {
                 for (j, dj) in d.iter().enumerate() {
                     acc += dj * (f[base + j * n + r] / self.w[r] + v[j * n + r]);
                 }
-                head[n * i + r] = acc * self.w[r];
+                head[n * i + self.band_order[r]] = acc * self.w[r];
             }
         }
         for q in 0..p {
             head[n * k + q] = -f[k * (m + 1) * n + q];
         }
         lin.band.solve(head);
+        self.unpermute_nodes(&mut head[p..]);
         let mut dy0 = vec![0.0; n];
         for (r, d) in dy0.iter_mut().enumerate() {
             *d = (0..p).map(|c| self.sens[(r, c)] * head[c]).sum();
@@ -464,8 +490,21 @@ impl<'a> Grid<'a> {
         }
     }
 
-    /// A weighted Euclidean norm of a correction (δy_0 = S δu, nodes and
-    /// stages, each component divided by its scale).
+    /// The node states of the band's solution back in state order.
+    fn unpermute_nodes(&self, nodes: &mut [f64]) {
+        let order = &self.band_order;
+        if order.iter().enumerate().all(|(k, &slot)| k == slot) {
+            return;
+        }
+        let mut node = vec![0.0; self.n];
+        for block in nodes.chunks_exact_mut(self.n) {
+            node.iter_mut()
+                .zip(order)
+                .for_each(|(v, &slot)| *v = block[slot]);
+            block.copy_from_slice(&node);
+        }
+    }
+
     /// The typical magnitude of each unknown: the free initial values in
     /// the scale of the state component they set, node states in the
     /// state scales.
@@ -484,6 +523,8 @@ impl<'a> Grid<'a> {
             .collect()
     }
 
+    /// A weighted Euclidean norm of a correction (δy_0 = S δu, nodes and
+    /// stages, each component divided by its scale).
     pub(super) fn step_norm(&self, dx: &[f64]) -> f64 {
         let (n, p) = (self.n, self.p);
         let head: f64 = (0..n)

@@ -255,7 +255,15 @@ impl BandLu {
         self.data.fill(0.0);
     }
 
+    /// Aᵢⱼ += v; panics outside the band of the matrix (kl below, ku
+    /// above: a caller's error in the bandwidths).
     pub(super) fn add(&mut self, i: usize, j: usize, v: f64) {
+        assert!(
+            i <= j + self.kl && j <= i + self.ku,
+            "({i}, {j}) outside the band (kl {}, ku {})",
+            self.kl,
+            self.ku
+        );
         let k = self.idx(i, j);
         self.data[k] += v;
     }

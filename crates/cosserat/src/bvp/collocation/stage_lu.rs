@@ -48,6 +48,29 @@ impl StageSplit {
         }
     }
 
+    /// Where each component goes in a node's block of the condensed band
+    /// (`grid.rs`): P first, then C, so that the node map Γ, whose
+    /// Γ[P, P] = I and Γ[C, P] = 0, is block upper triangular but for
+    /// Γ[C, C] and the band's lower half-bandwidth shrinks by |P| (the
+    /// identity where P comes first, as planar).
+    pub(super) fn band_order(&self) -> Vec<usize> {
+        let mut order = vec![0; self.n];
+        for (slot, k) in self
+            .quadrature
+            .clone()
+            .chain(self.coupled.iter().copied())
+            .enumerate()
+        {
+            order[k] = slot;
+        }
+        order
+    }
+
+    /// |P|.
+    pub(super) fn quadrature_count(&self) -> usize {
+        self.quadrature.len()
+    }
+
     /// Rows of W_CC, m·|C|: the interchanges kept per interval.
     pub(super) fn coupled_rows(&self) -> usize {
         self.m * self.coupled.len()
