@@ -291,15 +291,9 @@ impl<'a> Grid<'a> {
         }
     }
 
-    /// The scaled residual: per interval the m·n stage equations and the n
-    /// node equations, then the p tip conditions.
-    pub(super) fn residual(&self, x: &[f64]) -> Vec<f64> {
-        let mut r = vec![0.0; self.size()];
-        self.residual_into(x, &mut r);
-        r
-    }
-
-    /// [`Self::residual`] into `out` (of the unknowns' size).
+    /// The scaled residual into `out` (of the unknowns' size): per interval
+    /// the m·n stage equations and the n node equations, then the p tip
+    /// conditions.
     pub(super) fn residual_into(&self, x: &[f64], out: &mut [f64]) {
         let (n, m, p) = (self.n, self.tab.m, self.p);
         let mut r = Slots { out, at: 0 };
@@ -436,25 +430,77 @@ impl<'a> Grid<'a> {
         )
     }
 
-    /// −J⁻¹F for a scaled residual F, in the unknowns' layout: per interval
-    /// v = W⁻¹(−F_stages), the combined node row's right-hand side
-    /// −F_node + Σ_j d_j (F_stage_j − v_j), the banded solve for the nodes,
-    /// then the stages δY = W⁻¹(−F_stages + E δy_i) by a second solve.
+    /// −J⁻¹F for a scaled residual F, in the unknowns' layout: the node
+    /// corrections ([`Self::node_correction`]), then per interval the
+    /// stages δY = W⁻¹(−F_stages + E δy_i).
     pub(super) fn newton_correction(&self, lin: &Linearization, f: &[f64], dx: &mut [f64]) {
         let (n, m, p, k) = (self.n, self.tab.m, self.p, self.intervals());
         let mn = m * n;
-        let d = &self.tab.d;
         let (head, stages) = dx.split_at_mut(p + n * k);
-        let mut work = vec![0.0; mn];
+        let mut work = vec![0.0; 2 * mn];
+        self.node_correction(lin, f, head, &mut work);
+        let dy0 = self.clamp_correction(head);
+        for (i, out) in stages.chunks_exact_mut(mn).enumerate() {
+            let dyi = if i == 0 {
+                &dy0[..]
+            } else {
+                &head[p + n * (i - 1)..p + n * i]
+            };
+            self.stage_correction(lin, f, i, dyi, out, &mut work[..mn]);
+        }
+    }
+
+    /// [`Self::step_norm`] of −J⁻¹F without keeping its stages: the node
+    /// corrections into `head` (p + n·N numbers), each interval's stages
+    /// in turn into a buffer of one interval. The sum runs in the order
+    /// of [`Self::step_norm`], so the norm is the same to the last bit.
+    pub(super) fn correction_norm(&self, lin: &Linearization, f: &[f64], head: &mut [f64]) -> f64 {
+        let (n, m, p) = (self.n, self.tab.m, self.p);
+        let mn = m * n;
+        let mut work = vec![0.0; 2 * mn];
+        self.node_correction(lin, f, head, &mut work);
+        let dy0 = self.clamp_correction(head);
+        let clamp: f64 = dy0
+            .iter()
+            .enumerate()
+            .map(|(r, d)| (d * self.w[r]).powi(2))
+            .sum();
+        let mut rest = 0.0;
+        for (q, d) in head[p..].iter().enumerate() {
+            rest += (d * self.w[q % n]).powi(2);
+        }
+        let (g, work) = work.split_at_mut(mn);
+        for i in 0..self.intervals() {
+            let dyi = if i == 0 {
+                &dy0[..]
+            } else {
+                &head[p + n * (i - 1)..p + n * i]
+            };
+            self.stage_correction(lin, f, i, dyi, g, work);
+            for (r, d) in g.iter().enumerate() {
+                rest += (d * self.w[r % n]).powi(2);
+            }
+        }
+        (clamp + rest).sqrt()
+    }
+
+    /// The node part [δu | δy_1 … δy_N] of −J⁻¹F into `head`: per interval
+    /// v = W⁻¹(−F_stages), the combined node row's right-hand side
+    /// −F_node + Σ_j d_j (F_stage_j − v_j), then the banded solve; `work`
+    /// holds 2·m·n numbers.
+    fn node_correction(&self, lin: &Linearization, f: &[f64], head: &mut [f64], work: &mut [f64]) {
+        let (n, m, p, k) = (self.n, self.tab.m, self.p, self.intervals());
+        let mn = m * n;
+        let d = &self.tab.d;
+        let (v, work) = work.split_at_mut(mn);
         for i in 0..k {
             let base = i * (m + 1) * n;
-            let v = &mut stages[i * mn..(i + 1) * mn];
             v.iter_mut()
                 .enumerate()
                 .for_each(|(r, a)| *a = -f[base + r] / self.w[r % n]);
             let (lu, piv) = self.stage_factors(lin, i);
             self.split
-                .solve(&self.tab, self.span(i).1, lu, piv, v, &mut work);
+                .solve(&self.tab, self.span(i).1, lu, piv, v, work);
             for r in 0..n {
                 let mut acc = -f[base + mn + r] / self.w[r];
                 for (j, dj) in d.iter().enumerate() {
@@ -468,26 +514,34 @@ impl<'a> Grid<'a> {
         }
         lin.band.solve(head);
         self.unpermute_nodes(&mut head[p..]);
-        let mut dy0 = vec![0.0; n];
-        for (r, d) in dy0.iter_mut().enumerate() {
-            *d = (0..p).map(|c| self.sens[(r, c)] * head[c]).sum();
+    }
+
+    /// δy_0 = S δu.
+    fn clamp_correction(&self, head: &[f64]) -> Vec<f64> {
+        (0..self.n)
+            .map(|r| (0..self.p).map(|c| self.sens[(r, c)] * head[c]).sum())
+            .collect()
+    }
+
+    /// Interval i's stage correction δY = W⁻¹(−F_stages + E δy_i) into
+    /// `out` (m·n numbers); `work` holds m·n.
+    fn stage_correction(
+        &self,
+        lin: &Linearization,
+        f: &[f64],
+        i: usize,
+        dyi: &[f64],
+        out: &mut [f64],
+        work: &mut [f64],
+    ) {
+        let (n, m) = (self.n, self.tab.m);
+        let base = i * (m + 1) * n;
+        for (r, a) in out.iter_mut().enumerate() {
+            *a = -f[base + r] / self.w[r % n] + dyi[r % n];
         }
-        let mut g = vec![0.0; mn];
-        for i in 0..k {
-            let dyi = if i == 0 {
-                &dy0[..]
-            } else {
-                &head[p + n * (i - 1)..p + n * i]
-            };
-            for gj in g.chunks_exact_mut(n) {
-                gj.copy_from_slice(dyi);
-            }
-            let (lu, piv) = self.stage_factors(lin, i);
-            self.split
-                .solve(&self.tab, self.span(i).1, lu, piv, &mut g, &mut work);
-            let v = &mut stages[i * mn..(i + 1) * mn];
-            v.iter_mut().zip(&g).for_each(|(a, b)| *a += b);
-        }
+        let (lu, piv) = self.stage_factors(lin, i);
+        self.split
+            .solve(&self.tab, self.span(i).1, lu, piv, out, work);
     }
 
     /// The node states of the band's solution back in state order.
