@@ -28,7 +28,9 @@
 //!
 //! Submodules: `tableau` (the Gauss–Legendre tableau), `mesh` (the mesh and
 //! its refinement), `grid` (the equations on one mesh and the condensed
-//! Newton step), `lu` (the dense and banded factorizations), `iteration`
+//! Newton step), `stage_lu` (an interval's stage matrix factored without
+//! the position, which f does not depend on), `lu` (the dense and banded
+//! factorizations), `iteration`
 //! (damped Newton) and `error_estimate` (step doubling); this module holds
 //! the options, the solution and the adaptation loop.
 
