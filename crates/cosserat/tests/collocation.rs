@@ -11,6 +11,7 @@ use cosserat::bvp::{
     equations, solve_collocation, CollocationError, CollocationOptions, CollocationSolution,
 };
 use cosserat::equations::RodEquations;
+use cosserat::input::Problem;
 use cosserat::model::ModelLevel;
 use cosserat::references::CantileverTip;
 use nalgebra::Vector3;
@@ -214,4 +215,55 @@ fn spatial_director_drift_is_discretization_error() {
         drifts.push(sol.director_drift);
     }
     assert!(drifts[2] < 1e-3 * drifts[0], "{drifts:?}");
+}
+
+/// The components each model declares as found by quadrature (the
+/// position, `RodEquations::quadrature_components`, which collocation's
+/// stage matrices leave out) never enter the right-hand side: f is the same
+/// bit for bit at a state moved by a large translation, and ∂f/∂y has zero
+/// columns there — planar, Kirchhoff and Cosserat, free and held tips
+/// (reaction states), at states off the straight rod.
+#[test]
+fn quadrature_components_never_enter_the_rates() {
+    let files = [
+        "cantilever_tip_load.toml",
+        "clamped_elastica_displacement.toml",
+        "helix_tip_load.toml",
+        "twisted_rod.toml",
+        "bathe_bolourchi_45.toml",
+        "extensible_column_displacement.toml",
+    ];
+    for file in files {
+        let path = format!("{}/../../problems/{file}", env!("CARGO_MANIFEST_DIR"));
+        let problem = Problem::from_path(std::path::Path::new(&path), &[]).unwrap();
+        let eq = equations(&problem.rod, problem.model.level);
+        let (n, range) = (eq.dim(), eq.quadrature_components());
+        assert!(!range.is_empty() && range.end <= n, "{file}: {range:?}");
+        let mut u = eq.initial_guess();
+        u.iter_mut()
+            .enumerate()
+            .for_each(|(i, v)| *v += 0.3 + 0.1 * i as f64);
+        let mut y = vec![0.0; n];
+        eq.initial_state(&u, &mut y);
+        let mut moved = y.clone();
+        for k in range.clone() {
+            moved[k] += 123.25 * (k as f64 + 1.0);
+        }
+        let s = 0.37 * eq.length();
+        let (mut f, mut g) = (vec![0.0; n], vec![0.0; n]);
+        eq.rhs(s, &y, &mut f);
+        eq.rhs(s, &moved, &mut g);
+        assert!(f.iter().all(|v| v.is_finite()), "{file}: {f:?}");
+        assert_eq!(f, g, "{file}: f moved with the position");
+        let ident = nalgebra::DMatrix::<f64>::identity(n, n);
+        let mut jac = vec![0.0; n * n];
+        eq.rhs_linearized(s, &moved, n, ident.as_slice(), &mut f, &mut jac);
+        for k in range {
+            let column = &jac[k * n..(k + 1) * n];
+            assert!(
+                column.iter().all(|&v| v == 0.0),
+                "{file}: ∂f/∂y{k} = {column:?}"
+            );
+        }
+    }
 }

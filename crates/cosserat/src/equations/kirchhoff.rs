@@ -641,6 +641,12 @@ impl RodEquations for KirchhoffEquations {
         scales
     }
 
+    /// The position r: f reads only the directors, the curvature and the
+    /// reaction.
+    fn quadrature_components(&self) -> std::ops::Range<usize> {
+        9..12
+    }
+
     /// A tangent whose energy rates are exact for this rod, and a support
     /// whose motion the support conditions' rates (`tip.rs`) cover.
     fn differentiates(&self, t: &RodTangent) -> bool {

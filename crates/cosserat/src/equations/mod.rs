@@ -103,6 +103,16 @@ pub trait RodEquations: Send + Sync {
     /// collocation residuals dimensionless: lengths L, curvatures 1/L,
     /// angles and directors 1.
     fn state_scales(&self) -> Vec<f64>;
+    /// The state components the right-hand side never depends on
+    /// (∂f/∂y_k ≡ 0 for k in the range): the centreline position, found by
+    /// quadrature (r' = ν_i d_i) since dead loads make the equations
+    /// translation invariant. Collocation factors its stage matrices
+    /// without their columns (a dense block of m·(n − 2) rows planar,
+    /// m·9 spatial, instead of m·n). Empty by default: no structure
+    /// claimed.
+    fn quadrature_components(&self) -> std::ops::Range<usize> {
+        0..0
+    }
 
     /// Whether the four `*_parameter` methods below give the exact
     /// p-derivatives for the rod moving along `t` (false by default: the

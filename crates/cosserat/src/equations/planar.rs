@@ -444,6 +444,12 @@ impl RodEquations for PlanarEquations {
         scales
     }
 
+    /// The position (x, z): f reads only the angle, the curvature and the
+    /// reaction.
+    fn quadrature_components(&self) -> std::ops::Range<usize> {
+        0..2
+    }
+
     /// A tangent whose energy rates are exact for this rod.
     fn differentiates(&self, t: &RodTangent) -> bool {
         t.fits(&self.rod)

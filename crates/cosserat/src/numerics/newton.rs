@@ -81,6 +81,18 @@ pub trait System {
         DVectorView::from_slice(delta, delta.len()).norm()
     }
 
+    /// The [`System::correction_norm`] of the correction −J⁻¹f for the
+    /// right-hand side `f` with the J of the last [`System::linearize`],
+    /// or None when the solve fails: the damping's simplified correction,
+    /// of which Newton needs only the norm. By default solved into `work`
+    /// (resized to n); a system that measures the correction without
+    /// keeping it whole overrides this and leaves `work` empty (collocation:
+    /// interval by interval, so that a fine mesh holds one vector fewer).
+    fn correction_norm_for(&mut self, f: &[f64], work: &mut Vec<f64>) -> Option<f64> {
+        work.resize(f.len(), 0.0);
+        self.solve(f, work).then(|| self.correction_norm(work))
+    }
+
     /// Whether the iterate x with scaled residual norm `residual` and
     /// correction `delta` is converged; by default the [`Convergence`]
     /// test. A system overrides it only when its stopping rule differs on
@@ -352,7 +364,9 @@ pub fn solve<S: System + ?Sized>(
     let mut r = vec![0.0; n];
     system.residual(x, &mut r).map_err(NewtonError::BadStart)?;
     let (mut r_try, mut trial) = (vec![0.0; n], vec![0.0; n]);
-    let (mut step, mut simplified) = (vec![0.0; n], vec![0.0; n]);
+    // The simplified corrections' buffer, sized only by a system that needs
+    // one (`System::correction_norm_for`).
+    let (mut step, mut simplified) = (vec![0.0; n], Vec::new());
     let mut history = vec![test.residual_norm(&r)];
     let mut damped_steps = 0;
     let (mut contraction, mut last_step_norm) = (0.0_f64, f64::NAN);
@@ -409,8 +423,9 @@ pub fn solve<S: System + ?Sized>(
                 Damping::NaturalMonotonicity { min_damping } => min_damping,
             };
             let accepted = outcome.is_ok()
-                && system.solve(&r_try, &mut simplified)
-                && system.correction_norm(&simplified) <= (1.0 - 0.25 * lambda) * step_norm;
+                && system
+                    .correction_norm_for(&r_try, &mut simplified)
+                    .is_some_and(|norm| norm <= (1.0 - 0.25 * lambda) * step_norm);
             if accepted {
                 break;
             }

@@ -10,7 +10,6 @@
 
 use super::grid::{Grid, Scratch};
 use super::iteration::Linearization;
-use super::lu::{dense_lu, dense_solve};
 use super::tableau::{interpolation_nodes, lagrange};
 
 impl Grid<'_> {
@@ -31,18 +30,19 @@ impl Grid<'_> {
         st: &mut [f64],
         out: &mut [f64],
         ws: &mut Scratch,
-        frozen: Option<(&[f64], &[usize])>,
+        frozen: Option<(&[f64], &[u8])>,
     ) -> bool {
         let (n, m) = (self.n, self.tab.m);
-        let mn = m * n;
         let mut use_frozen = frozen.is_some();
         let (mut factored, mut refresh) = (false, !use_frozen);
         let (mut small, mut prev) = (false, f64::NAN);
         for _ in 0..30 {
             if refresh {
                 self.stage_jacobians(s, h, st, &mut ws.f, &mut ws.jac);
-                self.stage_matrix(h, &ws.jac, &mut ws.w);
-                if !dense_lu(&mut ws.w, mn, &mut ws.piv) {
+                if !self
+                    .split
+                    .factor(&self.tab, h, &ws.jac, &mut ws.w, &mut ws.piv)
+                {
                     return false;
                 }
                 (factored, use_frozen) = (true, false);
@@ -54,10 +54,12 @@ impl Grid<'_> {
                 let acc: f64 = (0..m).map(|l| self.tab.a(j, l) * ws.f[l * n + k]).sum();
                 *g = y[k] + h * acc - v;
             }
-            match frozen.filter(|_| use_frozen) {
-                Some((lu, piv)) => dense_solve(lu, mn, piv, &mut ws.g),
-                None => dense_solve(&ws.w, mn, &ws.piv, &mut ws.g),
-            }
+            let (lu, piv) = match frozen.filter(|_| use_frozen) {
+                Some(f) => f,
+                None => (&ws.w[..], &ws.piv[..]),
+            };
+            self.split
+                .solve(&self.tab, h, lu, piv, &mut ws.g, &mut ws.z);
             st.iter_mut().zip(&ws.g).for_each(|(a, b)| *a += b);
             let size =
                 ws.g.iter()
@@ -100,6 +102,7 @@ impl Grid<'_> {
     pub(super) fn local_errors(&self, x: &[f64], lin: Option<&Linearization>) -> Vec<f64> {
         let (n, m, p) = (self.n, self.tab.m, self.p);
         let mn = m * n;
+        let (len, rows) = (self.split.len(), self.split.coupled_rows());
         let factor = 1.0 / (1.0 - 0.5f64.powi(2 * m as i32));
         let lin = lin.filter(|l| l.valid);
         // Lagrange weights on the nodes (0, c_1 … c_m) at the stage points of
@@ -127,7 +130,7 @@ impl Grid<'_> {
                 }
             }
         };
-        let mut ws = Scratch::new(n, m);
+        let mut ws = Scratch::new(self);
         let mut y0 = vec![0.0; n];
         self.eq.initial_state(&x[..p], &mut y0);
         let (mut st, mut a, mut mid, mut b) =
@@ -140,8 +143,8 @@ impl Grid<'_> {
                 st.copy_from_slice(stv);
                 let frozen = lin.map(|l| {
                     (
-                        &l.lu[i * mn * mn..(i + 1) * mn * mn],
-                        &l.piv[i * mn..(i + 1) * mn],
+                        &l.lu[i * len..(i + 1) * len],
+                        &l.piv[i * rows..(i + 1) * rows],
                     )
                 });
                 let full = self.local_step(s, h, y, &mut st, &mut a, &mut ws, frozen);

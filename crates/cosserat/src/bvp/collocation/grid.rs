@@ -20,7 +20,8 @@
 use nalgebra::DMatrix;
 
 use super::iteration::{Linearization, NewtonOutcome};
-use super::lu::{dense_lu, dense_solve, dense_solve_rows, BandLu};
+use super::lu::BandLu;
+use super::stage_lu::StageSplit;
 
 /// An output slice filled in order (the residual written in place).
 struct Slots<'o> {
@@ -59,6 +60,11 @@ pub(super) struct Grid<'a> {
     /// The n × n identity, column-major: the tangent vectors that make
     /// `rhs_linearized` return the Jacobian ∂f/∂y (one call per point).
     pub(super) ident: Vec<f64>,
+    /// The stage matrices' components without the position.
+    pub(super) split: StageSplit,
+    /// The place of each state component in a node's block of the band
+    /// ([`StageSplit::band_order`]).
+    band_order: Vec<usize>,
 }
 
 /// Buffers of one interval's stage computations, reused across intervals
@@ -68,23 +74,24 @@ pub(super) struct Scratch {
     pub(super) f: Vec<f64>,
     /// ∂f/∂y at the m stages, each n × n column-major.
     pub(super) jac: Vec<f64>,
-    /// The stage matrix W (mn × mn, row-major), factored in place.
+    /// The stage matrix W factored by [`StageSplit::factor`].
     pub(super) w: Vec<f64>,
-    pub(super) piv: Vec<usize>,
+    pub(super) piv: Vec<u8>,
     /// A stage-sized right-hand side (m·n).
     pub(super) g: Vec<f64>,
-    /// W⁻¹E of one interval (mn × n, row-major).
+    /// W_CC⁻¹E_C of one interval, or the work of a stage solve.
     pub(super) z: Vec<f64>,
 }
 
 impl Scratch {
-    pub(super) fn new(n: usize, m: usize) -> Self {
+    pub(super) fn new(grid: &Grid) -> Self {
+        let (n, m) = (grid.n, grid.tab.m);
         let mn = m * n;
         Scratch {
             f: vec![0.0; mn],
             jac: vec![0.0; m * n * n],
-            w: vec![0.0; mn * mn],
-            piv: vec![0; mn],
+            w: vec![0.0; grid.split.len()],
+            piv: vec![0; grid.split.coupled_rows()],
             g: vec![0.0; mn],
             z: vec![0.0; mn * n],
         }
@@ -94,6 +101,7 @@ impl Scratch {
 impl<'a> Grid<'a> {
     pub(super) fn new(eq: &'a dyn RodEquations, tab: Tableau, mesh: Vec<f64>) -> Self {
         let n = eq.dim();
+        let split = StageSplit::new(n, tab.m, eq.quadrature_components());
         Grid {
             eq,
             tab,
@@ -103,6 +111,8 @@ impl<'a> Grid<'a> {
             w: eq.state_scales().iter().map(|v| 1.0 / v).collect(),
             sens: eq.initial_sensitivity(),
             ident: DMatrix::<f64>::identity(n, n).as_slice().to_vec(),
+            band_order: split.band_order(),
+            split,
         }
     }
 
@@ -281,35 +291,9 @@ impl<'a> Grid<'a> {
         }
     }
 
-    /// W = I − h (A ⊗ I) diag(J_l) (row-major, into `w`): the stage block of
-    /// the Jacobian.
-    pub(super) fn stage_matrix(&self, h: f64, jac: &[f64], w: &mut [f64]) {
-        let (n, m) = (self.n, self.tab.m);
-        let mn = m * n;
-        for j in 0..m {
-            for l in 0..m {
-                let coef = h * self.tab.a(j, l);
-                let jl = &jac[l * n * n..(l + 1) * n * n];
-                for r in 0..n {
-                    let row = &mut w[(j * n + r) * mn + l * n..(j * n + r) * mn + (l + 1) * n];
-                    for (c, v) in row.iter_mut().enumerate() {
-                        let id = if j == l && r == c { 1.0 } else { 0.0 };
-                        *v = id - jl[c * n + r] * coef;
-                    }
-                }
-            }
-        }
-    }
-
-    /// The scaled residual: per interval the m·n stage equations and the n
-    /// node equations, then the p tip conditions.
-    pub(super) fn residual(&self, x: &[f64]) -> Vec<f64> {
-        let mut r = vec![0.0; self.size()];
-        self.residual_into(x, &mut r);
-        r
-    }
-
-    /// [`Self::residual`] into `out` (of the unknowns' size).
+    /// The scaled residual into `out` (of the unknowns' size): per interval
+    /// the m·n stage equations and the n node equations, then the p tip
+    /// conditions.
     pub(super) fn residual_into(&self, x: &[f64], out: &mut [f64]) {
         let (n, m, p) = (self.n, self.tab.m, self.p);
         let mut r = Slots { out, at: 0 };
@@ -341,14 +325,26 @@ impl<'a> Grid<'a> {
 
     /// Storage for the Newton matrix of this mesh.
     pub(super) fn new_linearization(&self) -> Linearization {
-        let (n, m, p, k) = (self.n, self.tab.m, self.p, self.intervals());
-        let mn = m * n;
+        let (n, p, k) = (self.n, self.p, self.intervals());
         Linearization {
-            lu: vec![0.0; k * mn * mn],
-            piv: vec![0; k * mn],
-            band: BandLu::zeros(p + n * k, 2 * n - 1 - p, n + p - 1),
+            lu: vec![0.0; k * self.split.len()],
+            piv: vec![0; k * self.split.coupled_rows()],
+            band: BandLu::zeros(p + n * k, self.band_lower(), p),
             valid: false,
         }
+    }
+
+    /// The lower half-bandwidth of the condensed node system: unknowns
+    /// [δu | δy_1 … δy_N], each node's components in [`Self::band_order`],
+    /// rows the node equations w (δy_{i+1} − Γ_i δy_i) in the same order,
+    /// then the tip. Row n·i + π(r) meets column p + n(i − 1) + π(c) where
+    /// Γ_i[r, c] ≠ 0, n − p + π(r) − π(c) below the diagonal: at most
+    /// n − p + n − 1 − |P| (Γ[C, C], with C after P), and the first node
+    /// rows and the tip rows at most n − 1 below. Above it, the identity
+    /// of δy_{i+1} is p to the right of its row and nothing further.
+    fn band_lower(&self) -> usize {
+        let (n, p) = (self.n, self.p);
+        (n - 1).max(2 * n - 1 - p - self.split.quadrature_count())
     }
 
     /// The Newton matrix at x, condensed and factored into `lin` (reusing
@@ -375,20 +371,28 @@ impl<'a> Grid<'a> {
             } else {
                 (&gamma, n)
             };
-            let col = if i == 0 { 0 } else { p + n * (i - 1) };
+            let order = &self.band_order;
             for r in 0..n {
-                for c in 0..cols {
-                    lin.band
-                        .add(n * i + r, col + c, -g[r * cols + c] * self.w[r]);
+                let row = n * i + order[r];
+                // Γ's structural zeros (Γ[C, P], off the diagonal of
+                // Γ[P, P]) lie outside the band: only the rest is added.
+                for c in (0..cols).filter(|&c| g[r * cols + c] != 0.0) {
+                    let col = if i == 0 {
+                        c
+                    } else {
+                        p + n * (i - 1) + order[c]
+                    };
+                    lin.band.add(row, col, -g[r * cols + c] * self.w[r]);
                 }
-                lin.band.add(n * i + r, p + n * i + r, self.w[r]);
+                lin.band.add(row, p + n * i + order[r], self.w[r]);
             }
         }
         let y_tip = self.node(x, k);
         let gt = self.eq.tip_residual_jacobian(&y_tip);
         for r in 0..p {
             for c in 0..n {
-                lin.band.add(n * k + r, p + n * (k - 1) + c, gt[(r, c)]);
+                let col = p + n * (k - 1) + self.band_order[c];
+                lin.band.add(n * k + r, col, gt[(r, c)]);
             }
         }
         lin.valid = lin.band.factor().is_ok();
@@ -408,97 +412,153 @@ impl<'a> Grid<'a> {
         ws: &mut Scratch,
         gamma: &mut [f64],
     ) -> bool {
-        let (n, m, (s, h)) = (self.n, self.tab.m, self.span(i));
-        let mn = m * n;
+        let (s, h) = self.span(i);
+        let (len, rows) = (self.split.len(), self.split.coupled_rows());
         self.stage_jacobians(s, h, st, &mut ws.f, &mut ws.jac);
-        let lu = &mut lin.lu[i * mn * mn..(i + 1) * mn * mn];
-        let piv = &mut lin.piv[i * mn..(i + 1) * mn];
-        self.stage_matrix(h, &ws.jac, lu);
-        if !dense_lu(lu, mn, piv) {
-            return false;
-        }
-        let z = &mut ws.z;
-        for (r, row) in z.chunks_exact_mut(n).enumerate() {
-            row.iter_mut()
-                .enumerate()
-                .for_each(|(c, v)| *v = if r % n == c { 1.0 } else { 0.0 });
-        }
-        dense_solve_rows(lu, mn, piv, z, n);
-        if !z.iter().all(|v| v.is_finite()) {
-            return false;
-        }
-        let d = &self.tab.d;
-        let keep = 1.0 - d.iter().sum::<f64>();
-        for (q, g) in gamma.iter_mut().enumerate() {
-            let (r, c) = (q / n, q % n);
-            *g = if r == c { keep } else { 0.0 };
-            for (j, dj) in d.iter().enumerate() {
-                *g += dj * z[(j * n + r) * n + c];
-            }
-        }
-        true
+        let lu = &mut lin.lu[i * len..(i + 1) * len];
+        let piv = &mut lin.piv[i * rows..(i + 1) * rows];
+        self.split.factor(&self.tab, h, &ws.jac, lu, piv)
+            && self.split.node_map(&self.tab, h, lu, piv, gamma, &mut ws.z)
     }
 
-    /// −J⁻¹F for a scaled residual F, in the unknowns' layout: per interval
-    /// v = W⁻¹(−F_stages), the combined node row's right-hand side
-    /// −F_node + Σ_j d_j (F_stage_j − v_j), the banded solve for the nodes,
-    /// then the stages δY = W⁻¹(−F_stages + E δy_i) by a second solve.
+    /// The factors of interval i's stage matrix in `lin`.
+    fn stage_factors<'l>(&self, lin: &'l Linearization, i: usize) -> (&'l [f64], &'l [u8]) {
+        let (len, rows) = (self.split.len(), self.split.coupled_rows());
+        (
+            &lin.lu[i * len..(i + 1) * len],
+            &lin.piv[i * rows..(i + 1) * rows],
+        )
+    }
+
+    /// −J⁻¹F for a scaled residual F, in the unknowns' layout: the node
+    /// corrections ([`Self::node_correction`]), then per interval the
+    /// stages δY = W⁻¹(−F_stages + E δy_i).
     pub(super) fn newton_correction(&self, lin: &Linearization, f: &[f64], dx: &mut [f64]) {
         let (n, m, p, k) = (self.n, self.tab.m, self.p, self.intervals());
         let mn = m * n;
-        let d = &self.tab.d;
         let (head, stages) = dx.split_at_mut(p + n * k);
+        let mut work = vec![0.0; 2 * mn];
+        self.node_correction(lin, f, head, &mut work);
+        let dy0 = self.clamp_correction(head);
+        for (i, out) in stages.chunks_exact_mut(mn).enumerate() {
+            let dyi = if i == 0 {
+                &dy0[..]
+            } else {
+                &head[p + n * (i - 1)..p + n * i]
+            };
+            self.stage_correction(lin, f, i, dyi, out, &mut work[..mn]);
+        }
+    }
+
+    /// [`Self::step_norm`] of −J⁻¹F without keeping its stages: the node
+    /// corrections into `head` (p + n·N numbers), each interval's stages
+    /// in turn into a buffer of one interval. The sum runs in the order
+    /// of [`Self::step_norm`], so the norm is the same to the last bit.
+    pub(super) fn correction_norm(&self, lin: &Linearization, f: &[f64], head: &mut [f64]) -> f64 {
+        let (n, m, p) = (self.n, self.tab.m, self.p);
+        let mn = m * n;
+        let mut work = vec![0.0; 2 * mn];
+        self.node_correction(lin, f, head, &mut work);
+        let dy0 = self.clamp_correction(head);
+        let clamp: f64 = dy0
+            .iter()
+            .enumerate()
+            .map(|(r, d)| (d * self.w[r]).powi(2))
+            .sum();
+        let mut rest = 0.0;
+        for (q, d) in head[p..].iter().enumerate() {
+            rest += (d * self.w[q % n]).powi(2);
+        }
+        let (g, work) = work.split_at_mut(mn);
+        for i in 0..self.intervals() {
+            let dyi = if i == 0 {
+                &dy0[..]
+            } else {
+                &head[p + n * (i - 1)..p + n * i]
+            };
+            self.stage_correction(lin, f, i, dyi, g, work);
+            for (r, d) in g.iter().enumerate() {
+                rest += (d * self.w[r % n]).powi(2);
+            }
+        }
+        (clamp + rest).sqrt()
+    }
+
+    /// The node part [δu | δy_1 … δy_N] of −J⁻¹F into `head`: per interval
+    /// v = W⁻¹(−F_stages), the combined node row's right-hand side
+    /// −F_node + Σ_j d_j (F_stage_j − v_j), then the banded solve; `work`
+    /// holds 2·m·n numbers.
+    fn node_correction(&self, lin: &Linearization, f: &[f64], head: &mut [f64], work: &mut [f64]) {
+        let (n, m, p, k) = (self.n, self.tab.m, self.p, self.intervals());
+        let mn = m * n;
+        let d = &self.tab.d;
+        let (v, work) = work.split_at_mut(mn);
         for i in 0..k {
             let base = i * (m + 1) * n;
-            let v = &mut stages[i * mn..(i + 1) * mn];
             v.iter_mut()
                 .enumerate()
                 .for_each(|(r, a)| *a = -f[base + r] / self.w[r % n]);
-            dense_solve(
-                &lin.lu[i * mn * mn..(i + 1) * mn * mn],
-                mn,
-                &lin.piv[i * mn..(i + 1) * mn],
-                v,
-            );
+            let (lu, piv) = self.stage_factors(lin, i);
+            self.split
+                .solve(&self.tab, self.span(i).1, lu, piv, v, work);
             for r in 0..n {
                 let mut acc = -f[base + mn + r] / self.w[r];
                 for (j, dj) in d.iter().enumerate() {
                     acc += dj * (f[base + j * n + r] / self.w[r] + v[j * n + r]);
                 }
-                head[n * i + r] = acc * self.w[r];
+                head[n * i + self.band_order[r]] = acc * self.w[r];
             }
         }
         for q in 0..p {
             head[n * k + q] = -f[k * (m + 1) * n + q];
         }
         lin.band.solve(head);
-        let mut dy0 = vec![0.0; n];
-        for (r, d) in dy0.iter_mut().enumerate() {
-            *d = (0..p).map(|c| self.sens[(r, c)] * head[c]).sum();
+        self.unpermute_nodes(&mut head[p..]);
+    }
+
+    /// δy_0 = S δu.
+    fn clamp_correction(&self, head: &[f64]) -> Vec<f64> {
+        (0..self.n)
+            .map(|r| (0..self.p).map(|c| self.sens[(r, c)] * head[c]).sum())
+            .collect()
+    }
+
+    /// Interval i's stage correction δY = W⁻¹(−F_stages + E δy_i) into
+    /// `out` (m·n numbers); `work` holds m·n.
+    fn stage_correction(
+        &self,
+        lin: &Linearization,
+        f: &[f64],
+        i: usize,
+        dyi: &[f64],
+        out: &mut [f64],
+        work: &mut [f64],
+    ) {
+        let (n, m) = (self.n, self.tab.m);
+        let base = i * (m + 1) * n;
+        for (r, a) in out.iter_mut().enumerate() {
+            *a = -f[base + r] / self.w[r % n] + dyi[r % n];
         }
-        let mut g = vec![0.0; mn];
-        for i in 0..k {
-            let dyi = if i == 0 {
-                &dy0[..]
-            } else {
-                &head[p + n * (i - 1)..p + n * i]
-            };
-            for gj in g.chunks_exact_mut(n) {
-                gj.copy_from_slice(dyi);
-            }
-            dense_solve(
-                &lin.lu[i * mn * mn..(i + 1) * mn * mn],
-                mn,
-                &lin.piv[i * mn..(i + 1) * mn],
-                &mut g,
-            );
-            let v = &mut stages[i * mn..(i + 1) * mn];
-            v.iter_mut().zip(&g).for_each(|(a, b)| *a += b);
+        let (lu, piv) = self.stage_factors(lin, i);
+        self.split
+            .solve(&self.tab, self.span(i).1, lu, piv, out, work);
+    }
+
+    /// The node states of the band's solution back in state order.
+    fn unpermute_nodes(&self, nodes: &mut [f64]) {
+        let order = &self.band_order;
+        if order.iter().enumerate().all(|(k, &slot)| k == slot) {
+            return;
+        }
+        let mut node = vec![0.0; self.n];
+        for block in nodes.chunks_exact_mut(self.n) {
+            node.iter_mut()
+                .zip(order)
+                .for_each(|(v, &slot)| *v = block[slot]);
+            block.copy_from_slice(&node);
         }
     }
 
-    /// A weighted Euclidean norm of a correction (δy_0 = S δu, nodes and
-    /// stages, each component divided by its scale).
     /// The typical magnitude of each unknown: the free initial values in
     /// the scale of the state component they set, node states in the
     /// state scales.
@@ -517,6 +577,8 @@ impl<'a> Grid<'a> {
             .collect()
     }
 
+    /// A weighted Euclidean norm of a correction (δy_0 = S δu, nodes and
+    /// stages, each component divided by its scale).
     pub(super) fn step_norm(&self, dx: &[f64]) -> f64 {
         let (n, p) = (self.n, self.p);
         let head: f64 = (0..n)

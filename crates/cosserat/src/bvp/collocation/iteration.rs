@@ -19,10 +19,10 @@ use crate::numerics::newton::{self, NewtonError, System, Trial};
 /// second solve with these factors, and the node rows are combined with
 /// the stage rows so that they hold no Jacobian ([`super::Tableau::d`]).
 pub(super) struct Linearization {
-    /// LU factors of the stage matrices W (mn × mn each, row-major).
+    /// The stage matrices W factored by [`super::stage_lu::StageSplit`].
     pub(super) lu: Vec<f64>,
     /// Their row interchanges.
-    pub(super) piv: Vec<usize>,
+    pub(super) piv: Vec<u8>,
     pub(super) band: BandLu,
     /// Whether the last `linearize` succeeded.
     pub(super) valid: bool,
@@ -54,6 +54,8 @@ struct Collocation<'g, 'a> {
     n: usize,
     lin: Linearization,
     ws: Scratch,
+    /// The node part of a simplified correction ([`Grid::correction_norm`]).
+    head: Vec<f64>,
 }
 
 /// A residual that is not finite (its max-norm), which makes a point
@@ -93,6 +95,14 @@ impl System for Collocation<'_, '_> {
     fn correction_norm(&self, delta: &[f64]) -> f64 {
         self.grid.step_norm(delta)
     }
+
+    /// The damping's simplified correction measured interval by interval:
+    /// one vector of the unknowns' size fewer.
+    fn correction_norm_for(&mut self, f: &[f64], _work: &mut Vec<f64>) -> Option<f64> {
+        self.head
+            .resize(self.grid.p + self.grid.n * self.grid.intervals(), 0.0);
+        Some(self.grid.correction_norm(&self.lin, f, &mut self.head))
+    }
 }
 
 /// Damped Newton ([`crate::numerics::newton`]) with Deuflhard's natural
@@ -111,7 +121,8 @@ pub(super) fn damped_newton(
         grid,
         n: x.len(),
         lin: grid.new_linearization(),
-        ws: Scratch::new(grid.n, grid.tab.m),
+        ws: Scratch::new(grid),
+        head: Vec::new(),
     };
     let fail = |reason: String, history: Vec<f64>| CollocationError::NoConvergence {
         intervals,
@@ -121,7 +132,8 @@ pub(super) fn damped_newton(
     match newton::solve(&mut system, &mut x, &opts.damped()) {
         Ok(report) => {
             let Collocation { lin, mut ws, .. } = system;
-            let mut out = polish(grid, x, report.residual, report.history, lin, &mut ws);
+            let buffers = (report.residual, report.correction);
+            let mut out = polish(grid, x, buffers, report.history, lin, &mut ws);
             out.damped_steps = report.damped_steps;
             out.contraction = report.contraction;
             Ok(out)
@@ -174,29 +186,34 @@ pub(super) const POLISH_STEPS: usize = 2;
 /// if it reduces the residual by a factor 10 (so they stop at round-off).
 /// They cost O(N) each and leave a solution that satisfies the discrete
 /// equations to round-off, so that what remains (e.g. the director drift)
-/// is discretization error rather than Newton's stopping point.
+/// is discretization error rather than Newton's stopping point. `buffers`
+/// are F(x) and a vector of the unknowns' size to work in (Newton's last
+/// correction), so that polishing holds no more vectors than Newton.
 pub(super) fn polish(
     grid: &Grid,
     mut x: Vec<f64>,
-    mut f: Vec<f64>,
+    buffers: (Vec<f64>, Vec<f64>),
     mut history: Vec<f64>,
     mut lin: Linearization,
     ws: &mut Scratch,
 ) -> NewtonOutcome {
+    let (mut f, mut trial) = buffers;
+    let mut f_try = vec![0.0; x.len()];
     let iterations = history.len() - 1;
     for _ in 0..POLISH_STEPS {
         if !grid.linearize(&x, &mut lin, ws) {
             break;
         }
-        let mut step = vec![0.0; x.len()];
-        grid.newton_correction(&lin, &f, &mut step);
-        let trial: Vec<f64> = x.iter().zip(&step).map(|(a, b)| a + b).collect();
-        let f_try = grid.residual(&trial);
+        // The step, then x + step in place.
+        grid.newton_correction(&lin, &f, &mut trial);
+        trial.iter_mut().zip(&x).for_each(|(b, a)| *b += a);
+        grid.residual_into(&trial, &mut f_try);
         let norm = max_norm(&f_try);
         if norm.is_nan() || norm > 0.1 * history.last().unwrap() {
             break;
         }
-        (x, f) = (trial, f_try);
+        std::mem::swap(&mut x, &mut trial);
+        std::mem::swap(&mut f, &mut f_try);
         history.push(norm);
     }
     NewtonOutcome {

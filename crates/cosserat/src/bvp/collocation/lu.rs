@@ -6,29 +6,66 @@
 //! with row partial pivoting, stable where the forward recursion of
 //! compactification is not (AMR §7.2.2).
 
+/// A row interchange of a dense LU: `usize`, or `u8` where the factors are
+/// kept for every mesh interval (a stage matrix has at most m·n = 45 rows,
+/// so an eighth of the storage).
+pub(in crate::bvp) trait Pivot: Copy {
+    /// The row it names.
+    fn row(self) -> usize;
+    /// The interchange with row `i`.
+    fn of(i: usize) -> Self;
+}
+
+impl Pivot for usize {
+    fn row(self) -> usize {
+        self
+    }
+
+    fn of(i: usize) -> Self {
+        i
+    }
+}
+
+impl Pivot for u8 {
+    fn row(self) -> usize {
+        usize::from(self)
+    }
+
+    fn of(i: usize) -> Self {
+        u8::try_from(i).expect("a dense LU of at most 256 rows")
+    }
+}
+
 /// In-place LU with row partial pivoting (as nalgebra's `LU`) of the d × d
 /// row-major matrix `a`, interchanges in `piv`; false at a zero or
-/// non-finite pivot. The stage sizes m·n of the planar (n = 4) and spatial
-/// (n = 12) models are compiled for their size.
-pub(in crate::bvp) fn dense_lu(a: &mut [f64], d: usize, piv: &mut [usize]) -> bool {
+/// non-finite pivot. The stage sizes of the planar (n = 4, 2 components
+/// coupled) and spatial (n = 12, 9 coupled) models are compiled for their
+/// size.
+pub(in crate::bvp) fn dense_lu<P: Pivot>(a: &mut [f64], d: usize, piv: &mut [P]) -> bool {
     match d {
-        4 => lu_sized::<4>(a, piv),
-        8 => lu_sized::<8>(a, piv),
-        12 => lu_sized::<12>(a, piv),
-        24 => lu_sized::<24>(a, piv),
-        36 => lu_sized::<36>(a, piv),
+        4 => lu_sized::<4, P>(a, piv),
+        6 => lu_sized::<6, P>(a, piv),
+        8 => lu_sized::<8, P>(a, piv),
+        12 => lu_sized::<12, P>(a, piv),
+        18 => lu_sized::<18, P>(a, piv),
+        24 => lu_sized::<24, P>(a, piv),
+        27 => lu_sized::<27, P>(a, piv),
+        36 => lu_sized::<36, P>(a, piv),
         _ => lu_any(a, d, piv),
     }
 }
 
 /// Solves A x = b in place with the factors of [`dense_lu`].
-pub(in crate::bvp) fn dense_solve(a: &[f64], d: usize, piv: &[usize], b: &mut [f64]) {
+pub(in crate::bvp) fn dense_solve<P: Pivot>(a: &[f64], d: usize, piv: &[P], b: &mut [f64]) {
     match d {
-        4 => solve_sized::<4>(a, piv, b),
-        8 => solve_sized::<8>(a, piv, b),
-        12 => solve_sized::<12>(a, piv, b),
-        24 => solve_sized::<24>(a, piv, b),
-        36 => solve_sized::<36>(a, piv, b),
+        4 => solve_sized::<4, P>(a, piv, b),
+        6 => solve_sized::<6, P>(a, piv, b),
+        8 => solve_sized::<8, P>(a, piv, b),
+        12 => solve_sized::<12, P>(a, piv, b),
+        18 => solve_sized::<18, P>(a, piv, b),
+        24 => solve_sized::<24, P>(a, piv, b),
+        27 => solve_sized::<27, P>(a, piv, b),
+        36 => solve_sized::<36, P>(a, piv, b),
         _ => solve_any(a, d, piv, b),
     }
 }
@@ -39,22 +76,24 @@ pub(in crate::bvp) fn dense_solve(a: &[f64], d: usize, piv: &[usize], b: &mut [f
 /// vectorizes, where a column at a time is a chain of ordered dot-product
 /// sums (measured: [`dense_solve`] per column was 41 % of a collocation
 /// continuation run, three times the factorization).
-pub(in crate::bvp) fn dense_solve_rows(
+pub(in crate::bvp) fn dense_solve_rows<P: Pivot>(
     a: &[f64],
     d: usize,
-    piv: &[usize],
+    piv: &[P],
     b: &mut [f64],
     cols: usize,
 ) {
     match d {
-        24 => rows_sized::<24>(a, piv, b, cols),
-        36 => rows_sized::<36>(a, piv, b, cols),
+        6 => rows_sized::<6, P>(a, piv, b, cols),
+        24 => rows_sized::<24, P>(a, piv, b, cols),
+        27 => rows_sized::<27, P>(a, piv, b, cols),
+        36 => rows_sized::<36, P>(a, piv, b, cols),
         _ => rows_any(a, d, piv, b, cols),
     }
 }
 
 /// [`dense_solve_rows`] for a dimension known at compile time.
-fn rows_sized<const D: usize>(a: &[f64], piv: &[usize], b: &mut [f64], cols: usize) {
+fn rows_sized<const D: usize, P: Pivot>(a: &[f64], piv: &[P], b: &mut [f64], cols: usize) {
     rows_any(&a[..D * D], D, &piv[..D], &mut b[..D * cols], cols);
 }
 
@@ -62,8 +101,8 @@ fn rows_sized<const D: usize>(a: &[f64], piv: &[usize], b: &mut [f64], cols: usi
 // Forced so rows_sized::<D> sees a constant D (as `lu_any`).
 #[allow(clippy::inline_always)]
 #[inline(always)]
-fn rows_any(a: &[f64], d: usize, piv: &[usize], b: &mut [f64], cols: usize) {
-    for (k, &p) in piv.iter().enumerate() {
+fn rows_any<P: Pivot>(a: &[f64], d: usize, piv: &[P], b: &mut [f64], cols: usize) {
+    for (k, p) in piv.iter().map(|p| p.row()).enumerate() {
         if p != k {
             for c in 0..cols {
                 b.swap(k * cols + c, p * cols + c);
@@ -97,13 +136,13 @@ fn rows_any(a: &[f64], d: usize, piv: &[usize], b: &mut [f64], cols: usize) {
 }
 
 /// [`dense_lu`] for a dimension known at compile time (unrolled loops).
-fn lu_sized<const D: usize>(a: &mut [f64], piv: &mut [usize]) -> bool {
+fn lu_sized<const D: usize, P: Pivot>(a: &mut [f64], piv: &mut [P]) -> bool {
     // Inlined with a constant dimension, so the loops unroll.
     lu_any(&mut a[..D * D], D, &mut piv[..D])
 }
 
 /// [`dense_solve`] for a dimension known at compile time.
-fn solve_sized<const D: usize>(a: &[f64], piv: &[usize], b: &mut [f64]) {
+fn solve_sized<const D: usize, P: Pivot>(a: &[f64], piv: &[P], b: &mut [f64]) {
     solve_any(&a[..D * D], D, &piv[..D], &mut b[..D]);
 }
 
@@ -111,7 +150,7 @@ fn solve_sized<const D: usize>(a: &[f64], piv: &[usize], b: &mut [f64]) {
 // Forced so lu_sized::<D> unrolls: #[inline] ran 12-16% slower in `cargo bench --bench newton_step`.
 #[allow(clippy::inline_always)]
 #[inline(always)]
-fn lu_any(a: &mut [f64], d: usize, piv: &mut [usize]) -> bool {
+fn lu_any<P: Pivot>(a: &mut [f64], d: usize, piv: &mut [P]) -> bool {
     for k in 0..d {
         let (mut p, mut best) = (k, a[k * d + k].abs());
         for i in k + 1..d {
@@ -120,7 +159,7 @@ fn lu_any(a: &mut [f64], d: usize, piv: &mut [usize]) -> bool {
                 (p, best) = (i, v);
             }
         }
-        piv[k] = p;
+        piv[k] = P::of(p);
         if best == 0.0 || !best.is_finite() {
             return false;
         }
@@ -153,9 +192,9 @@ fn lu_any(a: &mut [f64], d: usize, piv: &mut [usize]) -> bool {
 // Forced so solve_sized::<D> unrolls for a constant D (measured: see `lu_any`).
 #[allow(clippy::inline_always)]
 #[inline(always)]
-fn solve_any(a: &[f64], d: usize, piv: &[usize], b: &mut [f64]) {
-    for (k, &p) in piv.iter().enumerate() {
-        b.swap(k, p);
+fn solve_any<P: Pivot>(a: &[f64], d: usize, piv: &[P], b: &mut [f64]) {
+    for (k, p) in piv.iter().enumerate() {
+        b.swap(k, p.row());
     }
     for k in 0..d {
         let x = b[k];
@@ -216,7 +255,15 @@ impl BandLu {
         self.data.fill(0.0);
     }
 
+    /// Aᵢⱼ += v; panics outside the band of the matrix (kl below, ku
+    /// above: a caller's error in the bandwidths).
     pub(super) fn add(&mut self, i: usize, j: usize, v: f64) {
+        assert!(
+            i <= j + self.kl && j <= i + self.ku,
+            "({i}, {j}) outside the band (kl {}, ku {})",
+            self.kl,
+            self.ku
+        );
         let k = self.idx(i, j);
         self.data[k] += v;
     }
@@ -348,7 +395,7 @@ mod tests {
                 .lu()
                 .solve(&DVector::from_column_slice(&b))
                 .unwrap();
-            let (mut f, mut piv, mut x) = (a.clone(), vec![0; d], b.clone());
+            let (mut f, mut piv, mut x) = (a.clone(), vec![0usize; d], b.clone());
             assert!(dense_lu(&mut f, d, &mut piv));
             dense_solve(&f, d, &piv, &mut x);
             let err = x
@@ -377,7 +424,7 @@ mod tests {
                 .lu()
                 .solve(&DMatrix::from_row_slice(d, cols, &b))
                 .unwrap();
-            let (mut f, mut piv, mut x) = (a.clone(), vec![0; d], b.clone());
+            let (mut f, mut piv, mut x) = (a.clone(), vec![0usize; d], b.clone());
             assert!(dense_lu(&mut f, d, &mut piv));
             dense_solve_rows(&f, d, &piv, &mut x, cols);
             let err = DMatrix::from_row_slice(d, cols, &x) - exact;

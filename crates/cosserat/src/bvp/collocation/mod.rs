@@ -28,7 +28,9 @@
 //!
 //! Submodules: `tableau` (the Gauss–Legendre tableau), `mesh` (the mesh and
 //! its refinement), `grid` (the equations on one mesh and the condensed
-//! Newton step), `lu` (the dense and banded factorizations), `iteration`
+//! Newton step), `stage_lu` (an interval's stage matrix factored without
+//! the position, which f does not depend on), `lu` (the dense and banded
+//! factorizations), `iteration`
 //! (damped Newton) and `error_estimate` (step doubling); this module holds
 //! the options, the solution and the adaptation loop.
 
@@ -37,6 +39,7 @@ mod grid;
 mod iteration;
 pub(super) mod lu;
 mod mesh;
+mod stage_lu;
 mod tableau;
 
 use super::newton::NewtonOptions;
@@ -133,7 +136,7 @@ impl CollocationSolution {
         let tab = Tableau::gauss(self.stage_count).expect("stored stage count is valid");
         let grid = Grid::new(eq, tab, self.mesh.clone());
         let (n, m) = (grid.n, grid.tab.m);
-        let mut ws = Scratch::new(n, m);
+        let mut ws = Scratch::new(&grid);
         let last = self.mesh.len() - 1;
         points
             .iter()
