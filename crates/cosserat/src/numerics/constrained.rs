@@ -277,15 +277,13 @@ fn constrained_lanczos(
     let guessed = estimate
         .map(|e| e.shift(diagonal_ratio(k, g)))
         .and_then(|s| Bordered::new(k, g, c, s).filter(none_below).map(|b| (s, b)));
-    let (sigma, bordered) = match guessed {
-        Some(found) => found,
-        None => {
-            let sigma = shift_below_constrained(k, g, c, count);
-            let bordered = Bordered::new(k, g, c, sigma).ok_or_else(|| {
-                EigenError::NotDefinite(format!("K − σG is singular at σ = {sigma}"))
-            })?;
-            (sigma, bordered)
-        }
+    let (sigma, bordered) = if let Some(found) = guessed {
+        found
+    } else {
+        let sigma = shift_below_constrained(k, g, c, count);
+        let bordered = Bordered::new(k, g, c, sigma)
+            .ok_or_else(|| EigenError::NotDefinite(format!("K − σG is singular at σ = {sigma}")))?;
+        (sigma, bordered)
     };
     let lower_bound = if none_below(&bordered) {
         sigma
