@@ -612,7 +612,7 @@ impl FiniteElements {
         });
     }
 
-    /// `visit(q, weight, points)` at each quadrature point q, points[k]
+    /// `visit(q, weight, points)` at each quadrature point q, `points[k]`
     /// being (ω, ω') of `vectors[k]` there: one pass over the points for
     /// several vectors (the factored Rayleigh quotients of a block's
     /// eigenvectors read each point's coefficients once; at 10⁵ elements
