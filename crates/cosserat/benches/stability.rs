@@ -1,23 +1,32 @@
 //! Speed of the stability analysis.
 //!
-//! Run: `cargo bench --bench stability`. Prints the time for the lowest four
-//! eigenvalues of the in-plane block of K (assembly + Sturm shift + Lanczos)
-//! on meshes of 10² to 10⁴ elements with the fitted log-log slope, and the
-//! time of a fixed-shape critical load (the generalized eigenproblem
-//! K0 + λK1) at 100 elements.
+//! Run: `cargo bench -p cosserat --bench stability`. Times what "the
+//! lowest 4 eigenvalues of each block on N elements" costs from a solved
+//! equilibrium: [`analyze`] of `problems/cantilever_tip_load.toml` (order
+//! 2, both blocks of the planar rod) on one mesh of N = 10², 10³, 10⁴, 10⁵
+//! elements — sampling the equilibrium at the quadrature points, the
+//! coefficients, K and G, the shift (from a mesh 64 times coarser where N
+//! ≥ 2048), shift-invert Lanczos, the factored Rayleigh quotients and the
+//! Morse index. Per mesh: the median and minimum wall time and the
+//! minimum CPU time of this thread (from /proc/thread-self/schedstat,
+//! steadier than wall time on a shared machine; NaN where that file does
+//! not exist) per analysis, over 5 batches of runs of at least 0.2 s of
+//! CPU each; then the log–log slope of the CPU time against N fitted over
+//! the four meshes and between neighbours. Last, the time of a
+//! fixed-shape critical load (the generalized eigenproblem K0 + λK1) at
+//! 100 elements.
 
 #[path = "../tests/support/mod.rs"]
 mod support;
 
+use std::path::Path;
 use std::time::Instant;
 
-use cosserat::bvp::{solve, SolverOptions};
-use cosserat::model::{ModelChoice, Profile};
-use cosserat::stability::eigen::lowest_eigenpairs;
-use cosserat::stability::{
-    coefficients, critical_load, Block, FiniteElements, FixedShape, StabilityOptions,
-};
-use support::rods::{cantilever, tip_force, uniform};
+use cosserat::bvp::solve;
+use cosserat::input::Problem;
+use cosserat::model::Profile;
+use cosserat::stability::{analyze, critical_load, FixedShape, StabilityOptions};
+use support::rods::{tip_force, uniform};
 
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
@@ -36,45 +45,79 @@ fn time(repeats: usize, mut f: impl FnMut()) -> f64 {
     )
 }
 
-fn main() {
-    let rod = cantilever(3.0);
-    let opts = SolverOptions::default();
-    let eq = solve(&rod, &ModelChoice::for_rod(&rod), &opts).unwrap();
-    println!("lowest 4 eigenvalues of the in-plane block (order 2), cantilever k = 3");
-    println!(
-        "{:>8} {:>8} {:>14} {:>14}",
-        "elements", "size", "K, G [ms]", "eigen [ms]"
-    );
-    let mut points = vec![];
-    for elements in [100, 300, 1000, 3000, 10000] {
-        let fe = FiniteElements::new(1.0, elements, 2);
-        let samples = eq.resample(&rod, &opts, &fe.quadrature_points()).unwrap();
-        let c = coefficients(&rod, &samples);
-        let repeats = if elements > 3000 { 3 } else { 9 };
-        let assemble = time(repeats, || {
-            std::hint::black_box((fe.stiffness(&c, Block::InPlane), fe.mass(Block::InPlane)));
-        });
-        let (k, g) = (fe.stiffness(&c, Block::InPlane), fe.mass(Block::InPlane));
-        let eigen = time(repeats, || {
-            std::hint::black_box(lowest_eigenpairs(&k, &g, 4).unwrap());
-        });
-        println!(
-            "{:>8} {:>8} {:>14.3} {:>14.3}",
-            elements,
-            k.size(),
-            assemble * 1e3,
-            eigen * 1e3
-        );
-        points.push(((elements as f64).ln(), (eigen + assemble).ln()));
-    }
+/// This thread's CPU time (s): the first field of
+/// /proc/thread-self/schedstat, nanoseconds on a core.
+fn cpu_time() -> f64 {
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()
+        .and_then(|s| s.split_whitespace().next()?.parse::<f64>().ok())
+        .map_or(f64::NAN, |ns| ns * 1e-9)
+}
+
+/// The least-squares slope of y against x.
+fn slope(points: &[(f64, f64)]) -> f64 {
     let n = points.len() as f64;
     let (mx, my) = (
         points.iter().map(|p| p.0).sum::<f64>() / n,
         points.iter().map(|p| p.1).sum::<f64>() / n,
     );
-    let slope = points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>()
-        / points.iter().map(|p| (p.0 - mx).powi(2)).sum::<f64>();
-    println!("log-log slope of time against elements: {slope:.2}");
+    points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum::<f64>()
+        / points.iter().map(|p| (p.0 - mx).powi(2)).sum::<f64>()
+}
+
+fn main() {
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../problems/cantilever_tip_load.toml");
+    let problem = Problem::from_path(&path, &[]).expect("the shipped cantilever");
+    let eq = solve(&problem.rod, &problem.model, &problem.options).expect("its equilibrium");
+    println!("analyze: the lowest 4 eigenvalues of both blocks, problems/cantilever_tip_load.toml (order 2)");
+    println!(
+        "{:>8} {:>10} {:>10} {:>10} {:>6}  {:>18} {:>18}",
+        "elements", "wall med", "wall min", "cpu min", "runs", "in-plane λ1", "out-of-plane λ1"
+    );
+    let mut points = vec![];
+    for elements in [100, 1_000, 10_000, 100_000] {
+        let opts = problem.stability.with_elements(elements).expect("elements");
+        let run = || analyze(&problem.rod, &eq, &problem.options, &opts).expect("analyzed");
+        let first = run();
+        let (t, c) = (Instant::now(), cpu_time());
+        run();
+        let once = (cpu_time() - c)
+            .max(t.elapsed().as_secs_f64() * 0.5)
+            .max(1e-6);
+        let runs = ((0.2 / once).ceil() as usize).max(1);
+        let (mut walls, mut cpu) = (Vec::new(), f64::INFINITY);
+        for _ in 0..5 {
+            let c = cpu_time();
+            for _ in 0..runs {
+                let t = Instant::now();
+                std::hint::black_box(run());
+                walls.push(t.elapsed().as_secs_f64());
+            }
+            cpu = cpu.min((cpu_time() - c) / runs as f64);
+        }
+        let lowest = |b: usize| first.blocks[b].eigenvalues[0];
+        println!(
+            "{:>8} {:>8.3}ms {:>8.3}ms {:>8.3}ms {:>6}  {:>18.12} {:>18.12}",
+            elements,
+            median(walls.clone()) * 1e3,
+            walls.iter().copied().fold(f64::INFINITY, f64::min) * 1e3,
+            cpu * 1e3,
+            5 * runs,
+            lowest(0),
+            lowest(1)
+        );
+        points.push(((elements as f64).ln(), cpu.ln()));
+    }
+    println!(
+        "log-log slope of CPU time against elements: {:.3} (fit over 10²–10⁵); between neighbours {}",
+        slope(&points),
+        points
+            .windows(2)
+            .map(|w| format!("{:.3}", slope(w)))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
 
     let straight = uniform(1.0, [1.0, 1.0, 1.0], tip_force(1.0, 0.0, 0.0));
     let shape = FixedShape {

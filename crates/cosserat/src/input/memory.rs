@@ -25,14 +25,15 @@
 //!
 //! Finite elements of E elements of order p with k eigenvalues: n_fe = 3 E p
 //! unknowns over the blocks; 4 banded matrices (K, G, the LDLᵀ factor, a
-//! shifted copy) of n_fe × (3(p + 1)) numbers; the Lanczos basis, n_fe
-//! (3k + 40) (Sturm counts store no factor, and the basis's G-image is not
-//! kept); and the shape at E (p + 1) quadrature points (a sample and the
-//! form coefficients, S + 216): 8 (4 · 3(p+1) + 3k + 40) n_fe +
-//! E (p + 1)(S + 216). Measured (issue 18, `/usr/bin/time -v`): the
-//! cantilever's verdict from 10⁵ elements (meshes 10⁵ and 2·10⁵) peaks at
-//! 601 MB resident, 3.0 KB per element of the finest mesh, where the
-//! formula gives 5.5 KB: an upper bound, as it must be.
+//! shifted copy) of n_fe × (3(p + 1)) numbers; the Lanczos basis and its
+//! G-image (kept so that a step needs one product by G), 2 n_fe (3k + 40)
+//! (Sturm counts store no factor); and the shape at E (p + 1) quadrature
+//! points (a sample and the form coefficients, S + 216):
+//! 8 (4 · 3(p+1) + 2(3k + 40)) n_fe + E (p + 1)(S + 216). Measured (issue
+//! 18, `/usr/bin/time -v`): the cantilever's verdict from 10⁵ elements
+//! (meshes 10⁵ and 2·10⁵) peaks at 690 MB resident, 3.5 KB per element of
+//! the finest mesh, where the formula gives 8.1 KB: an upper bound, as it
+//! must be.
 //!
 //! The total is the sum of the items (an upper bound: the phases of one
 //! run are not all alive at once). The budget is [`DEFAULT_BUDGET`] (4 GiB)
@@ -96,7 +97,7 @@ const SAMPLE: f64 = std::mem::size_of::<RodSample>() as f64;
 fn finite_elements(elements: f64, order: f64, eigenvalues: f64) -> f64 {
     let n = 3.0 * elements * order;
     let band = 3.0 * (order + 1.0);
-    let lanczos = 3.0 * eigenvalues + 40.0;
+    let lanczos = 2.0 * (3.0 * eigenvalues + 40.0);
     8.0 * (4.0 * band + lanczos) * n + elements * (order + 1.0) * (SAMPLE + 216.0)
 }
 

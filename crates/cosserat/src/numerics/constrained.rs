@@ -32,9 +32,9 @@
 use nalgebra::{DMatrix, DVector};
 
 use super::eigen::{
-    count_below, dense_pencil, diagonal_ratio, lowest_eigenpairs_near, shift_below,
-    shift_invert_lanczos, verify_with, EigenError, Eigenpairs, Inertia, UndecidedInertia,
-    DENSE_LIMIT,
+    count_below, dense_pencil, diagonal_ratio, lowest_eigenpairs_estimated, lowest_eigenpairs_near,
+    shift_below, shift_invert_lanczos, verify_with, BoundedPairs, EigenError, Eigenpairs, Inertia,
+    ShiftEstimate, UndecidedInertia, DENSE_LIMIT,
 };
 use crate::numerics::banded::{BandedLdlt, SymmetricBanded};
 
@@ -150,7 +150,7 @@ struct Bordered {
 
 impl Bordered {
     fn new(k: &SymmetricBanded, g: &SymmetricBanded, c: &Constraints, sigma: f64) -> Option<Self> {
-        let a = k.combine(1.0, g, -sigma).ldlt().ok()?;
+        let a = k.shifted_ldlt(-sigma, g).ok()?;
         let (rows, corner) = c.bordering();
         let (m, n) = (rows.nrows(), k.size());
         let mut z = DMatrix::zeros(n, m);
@@ -183,11 +183,11 @@ impl Bordered {
     }
 
     /// y = (A⁻¹ − Z S⁻¹ Zᵀ) b.
-    fn solve(&self, s_inv: &DMatrix<f64>, b: &mut [f64]) {
+    fn solve(&self, s_inv: &DMatrix<f64>, b: &[f64], y: &mut [f64]) {
         let zt_b = self.z.transpose() * DVector::from_column_slice(b);
-        self.a.solve_in_place(b);
+        self.a.solve(b, y);
         let corr = &self.z * (s_inv * zt_b);
-        b.iter_mut().zip(corr.iter()).for_each(|(y, c)| *y -= c);
+        y.iter_mut().zip(corr.iter()).for_each(|(y, c)| *y -= c);
     }
 }
 
@@ -237,24 +237,68 @@ pub fn lowest_eigenpairs_constrained(
     if c.is_empty() {
         return lowest_eigenpairs_near(k, g, count, previous);
     }
+    constrained_lanczos(k, g, c, count, None).map(|b| b.pairs)
+}
+
+/// [`lowest_eigenpairs_constrained`] with the shift placed by `estimate`
+/// where the constrained count certifies it (no eigenvalue below: see
+/// [`ShiftEstimate`]), else by the Sturm bisection, and that shift
+/// returned as a lower bound of the constrained spectrum.
+pub fn lowest_eigenpairs_constrained_estimated(
+    k: &SymmetricBanded,
+    g: &SymmetricBanded,
+    c: &Constraints,
+    count: usize,
+    estimate: Option<ShiftEstimate>,
+) -> Result<BoundedPairs, EigenError> {
+    if c.is_empty() {
+        return lowest_eigenpairs_estimated(k, g, count, estimate);
+    }
+    constrained_lanczos(k, g, c, count, estimate)
+}
+
+/// The constrained pencil's lowest pairs by the bordered shift-invert
+/// Lanczos (the dense pencil on null C for small problems).
+fn constrained_lanczos(
+    k: &SymmetricBanded,
+    g: &SymmetricBanded,
+    c: &Constraints,
+    count: usize,
+    estimate: Option<ShiftEstimate>,
+) -> Result<BoundedPairs, EigenError> {
     let count = count.min(k.size().saturating_sub(c.count()));
     if k.size() <= DENSE_LIMIT {
-        return dense_constrained(k, g, c, count);
+        return Ok(BoundedPairs {
+            pairs: dense_constrained(k, g, c, count)?,
+            lower_bound: f64::NEG_INFINITY,
+        });
     }
-    let sigma = shift_below_constrained(k, g, c, count);
-    let bordered = Bordered::new(k, g, c, sigma)
-        .ok_or_else(|| EigenError::NotDefinite(format!("K − σG is singular at σ = {sigma}")))?;
+    let none_below = |b: &Bordered| b.count_below() == Inertia::Below(0);
+    let guessed = estimate
+        .map(|e| e.shift(diagonal_ratio(k, g)))
+        .and_then(|s| Bordered::new(k, g, c, s).filter(none_below).map(|b| (s, b)));
+    let (sigma, bordered) = if let Some(found) = guessed {
+        found
+    } else {
+        let sigma = shift_below_constrained(k, g, c, count);
+        let bordered = Bordered::new(k, g, c, sigma)
+            .ok_or_else(|| EigenError::NotDefinite(format!("K − σG is singular at σ = {sigma}")))?;
+        (sigma, bordered)
+    };
+    let lower_bound = if none_below(&bordered) {
+        sigma
+    } else {
+        f64::NEG_INFINITY
+    };
     let s_inv = bordered
         .s
         .clone()
         .try_inverse()
         .ok_or_else(|| EigenError::NotDefinite("the constraints are degenerate".into()))?;
-    let apply = |x: &[f64], y: &mut [f64]| {
-        g.matvec(x, y);
-        bordered.solve(&s_inv, y);
-    };
+    // The bordered solve of G x, which the Lanczos recurrence holds.
+    let apply = |_: &[f64], gx: &[f64], y: &mut [f64]| bordered.solve(&s_inv, gx, y);
     let below = |s: f64| count_below_constrained(k, g, c, s);
-    shift_invert_lanczos(
+    let pairs = shift_invert_lanczos(
         k.size(),
         count,
         sigma,
@@ -262,7 +306,8 @@ pub fn lowest_eigenpairs_constrained(
         g,
         |ritz| verify(k, g, c, ritz),
         below,
-    )
+    )?;
+    Ok(BoundedPairs { pairs, lower_bound })
 }
 
 /// A shift below the constrained spectrum: [`shift_below`] on the
@@ -304,8 +349,9 @@ fn verify(
         g,
         pairs,
         |r, v| {
-            let r = r + &c.springs * (c.springs.transpose() * DVector::from_column_slice(v));
-            &r - c.rows.transpose() * (&c.rows * &r)
+            *r += &c.springs * (c.springs.transpose() * DVector::from_column_slice(v));
+            let off = c.rows.transpose() * (&c.rows * &*r);
+            *r -= off;
         },
         |v| c.apply(v).norm() <= 1e-8 * DVector::from_column_slice(v).norm(),
     )

@@ -179,15 +179,88 @@ pub fn lowest_eigenpairs_near(
     count: usize,
     previous: Option<(f64, f64)>,
 ) -> Result<Eigenpairs, EigenError> {
-    let count = count.min(k.size());
-    if k.size() <= DENSE_LIMIT {
-        return dense_pencil(&k.to_dense(), &g.to_dense(), count);
-    }
     let guess =
         previous.map(|(l1, l2)| l1 - (0.5 * (l2 - l1).abs()).max(1e-3 * l1.abs()).max(1e-6));
+    lowest_from_guess(k, g, count, guess).map(|b| b.pairs)
+}
+
+/// Estimates of the lowest eigenvalue λ_1 of a pencil and of λ_{k+1}, the
+/// first past the k wanted ones, taken from a related pencil — the same
+/// form on a coarser mesh (conforming elements give λ_i(coarse) ≥
+/// λ_i(fine), and with Gauss quadrature nearly so) — to place the shift
+/// of shift-invert Lanczos without a Sturm bisection (~10 inertia counts,
+/// each as dear as the factorization). Only a guess: the LDLᵀ factors of
+/// K − σG that Lanczos needs anyway certify that no eigenvalue lies below
+/// σ (no negative pivot); where they do not, the bisection places the
+/// shift as it does without estimates.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShiftEstimate {
+    lowest: f64,
+    next: f64,
+}
+
+impl ShiftEstimate {
+    /// From estimates of λ_1 and λ_{k+1}; None unless both are finite and
+    /// λ_1 ≤ λ_{k+1}.
+    pub fn new(lowest: f64, next: f64) -> Option<Self> {
+        (lowest.is_finite() && next.is_finite() && lowest <= next)
+            .then_some(ShiftEstimate { lowest, next })
+    }
+
+    /// σ = λ_1 − max(5 % of |λ_1|, 1e-3 (λ_{k+1} − λ_1), 1e-14·scale):
+    /// where [`shift_below`]'s bisection lands (0–10 % below λ_1, and
+    /// never closer to it than a fraction of the distance to λ_{k+1}: a
+    /// double zero needs that room), with room for the estimate's error.
+    pub(super) fn shift(self, scale: f64) -> f64 {
+        let margin = (0.05 * self.lowest.abs())
+            .max(1e-3 * (self.next - self.lowest))
+            .max(1e-14 * scale);
+        self.lowest - margin
+    }
+}
+
+/// Eigenpairs with a certified lower bound of the pencil's spectrum.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BoundedPairs {
+    /// The lowest eigenpairs.
+    pub pairs: Eigenpairs,
+    /// No eigenvalue of the pencil lies below it: the shift of the
+    /// Lanczos, at which K − σG had LDLᵀ factors without a negative or
+    /// zero pivot (or the constrained count was 0); −∞ where no
+    /// factorization certified one (the dense solver of small problems).
+    pub lower_bound: f64,
+}
+
+/// [`lowest_eigenpairs`] with the shift placed by `estimate` where its
+/// factors certify it ([`ShiftEstimate`]), and the shift returned as a
+/// lower bound of the spectrum.
+pub fn lowest_eigenpairs_estimated(
+    k: &SymmetricBanded,
+    g: &SymmetricBanded,
+    count: usize,
+    estimate: Option<ShiftEstimate>,
+) -> Result<BoundedPairs, EigenError> {
+    let guess = estimate.map(|e| e.shift(diagonal_ratio(k, g)));
+    lowest_from_guess(k, g, count, guess)
+}
+
+/// The lowest pairs with the shift `guess` where K − σG is positive
+/// definite there, else from the Sturm bisection.
+fn lowest_from_guess(
+    k: &SymmetricBanded,
+    g: &SymmetricBanded,
+    count: usize,
+    guess: Option<f64>,
+) -> Result<BoundedPairs, EigenError> {
+    let count = count.min(k.size());
+    if k.size() <= DENSE_LIMIT {
+        return Ok(BoundedPairs {
+            pairs: dense_pencil(&k.to_dense(), &g.to_dense(), count)?,
+            lower_bound: f64::NEG_INFINITY,
+        });
+    }
     let positive = |sigma: f64| {
-        k.combine(1.0, g, -sigma)
-            .ldlt()
+        k.shifted_ldlt(-sigma, g)
             .ok()
             .filter(|f| f.negative_pivots() == 0)
     };
@@ -211,12 +284,10 @@ pub fn lowest_eigenpairs_near(
         })?;
         (sigma, f)
     };
-    let apply = |x: &[f64], y: &mut [f64]| {
-        g.matvec(x, y);
-        shifted.solve_in_place(y);
-    };
+    // (K − σG)⁻¹ G x from G x, which the Lanczos recurrence holds.
+    let apply = |_: &[f64], gx: &[f64], y: &mut [f64]| shifted.solve(gx, y);
     let below = |s: f64| count_below(k, g, s);
-    shift_invert_lanczos(
+    let pairs = shift_invert_lanczos(
         k.size(),
         count,
         sigma,
@@ -224,7 +295,11 @@ pub fn lowest_eigenpairs_near(
         g,
         |ritz| verify(k, g, ritz),
         below,
-    )
+    )?;
+    Ok(BoundedPairs {
+        pairs,
+        lower_bound: sigma,
+    })
 }
 
 /// Shift-invert Lanczos with the operator `apply` = (K − σG)⁻¹G (or its
@@ -246,7 +321,7 @@ pub(super) fn shift_invert_lanczos(
     n: usize,
     count: usize,
     sigma: f64,
-    mut apply: impl FnMut(&[f64], &mut [f64]),
+    mut apply: impl FnMut(&[f64], &[f64], &mut [f64]),
     g: &SymmetricBanded,
     verify: impl Fn(Eigenpairs) -> Result<Eigenpairs, EigenError>,
     below: impl Fn(f64) -> Inertia,
@@ -308,7 +383,7 @@ fn converged_lanczos(
     n: usize,
     count: usize,
     sigma: f64,
-    apply: &mut impl FnMut(&[f64], &mut [f64]),
+    apply: &mut impl FnMut(&[f64], &[f64], &mut [f64]),
     g: &SymmetricBanded,
     verify: &impl Fn(Eigenpairs) -> Result<Eigenpairs, EigenError>,
     locked: &[Vec<f64>],
@@ -432,29 +507,27 @@ fn verify(
     g: &SymmetricBanded,
     pairs: Eigenpairs,
 ) -> Result<Eigenpairs, EigenError> {
-    verify_with(k, g, pairs, |r, _| r, |_| true)
+    verify_with(k, g, pairs, |_, _| {}, |_| true)
 }
 
-/// [`verify`] with the residual first passed through `project` (given the
-/// vector too: springs add UUᵀv, and the result is taken off the normals of
-/// constraints) and each vector required to be `admissible`.
+/// [`verify`] with the residual first passed through `project` (in place,
+/// given the vector too: springs add UUᵀv, and the result is taken off the
+/// normals of constraints) and each vector required to be `admissible`.
 pub(super) fn verify_with(
     k: &SymmetricBanded,
     g: &SymmetricBanded,
     pairs: Eigenpairs,
-    project: impl Fn(DVector<f64>, &[f64]) -> DVector<f64>,
+    project: impl Fn(&mut DVector<f64>, &[f64]),
     admissible: impl Fn(&[f64]) -> bool,
 ) -> Result<Eigenpairs, EigenError> {
     let n = k.size();
     let (norm_k, norm_g) = (row_sum_norm(k), row_sum_norm(g));
-    let (mut kv, mut gv) = (vec![0.0; n], vec![0.0; n]);
+    let (mut r, mut gv) = (DVector::zeros(n), vec![0.0; n]);
     for (lambda, v) in pairs.values.iter().zip(&pairs.vectors) {
-        k.matvec(v, &mut kv);
+        k.matvec(v, r.as_mut_slice());
         g.matvec(v, &mut gv);
-        let r = project(
-            DVector::from_iterator(n, kv.iter().zip(&gv).map(|(a, b)| a - lambda * b)),
-            v,
-        );
+        r.iter_mut().zip(&gv).for_each(|(a, b)| *a -= lambda * b);
+        project(&mut r, v);
         let v_norm = v.iter().map(|a| a * a).sum::<f64>().sqrt();
         let backward =
             r.norm() / ((norm_k + lambda.abs() * norm_g) * v_norm).max(f64::MIN_POSITIVE);
@@ -498,70 +571,59 @@ pub(super) fn dot(x: &[f64], y: &[f64]) -> f64 {
 /// full reorthogonalization, on the metric-orthogonal complement of
 /// `locked` (invariant vectors already found: deflation); Ritz values θ
 /// are mapped by `to_lambda` and the `count` best (by `order` on θ) are
-/// returned, sorted by λ.
+/// returned, sorted by λ. `apply(x, Mx, y)` sets y to the operator times x
+/// given x and its metric product (a shift-invert operator (K − σG)⁻¹G
+/// needs only G x, which the recurrence holds).
+///
+/// Each basis vector q_j is kept with M q_j, so that the
+/// reorthogonalization's inner products q_iᵀM w are (M q_i)ᵀw: one
+/// product by M per step (for the next M q) instead of one more per
+/// Gram–Schmidt pass, at the memory of a second basis.
 pub(super) fn lanczos(
     n: usize,
     count: usize,
     steps: usize,
-    mut apply: impl FnMut(&[f64], &mut [f64]),
+    mut apply: impl FnMut(&[f64], &[f64], &mut [f64]),
     (metric, locked): (&SymmetricBanded, &[Vec<f64>]),
     to_lambda: impl Fn(f64) -> f64,
     order: impl Fn(f64, f64) -> std::cmp::Ordering,
 ) -> Eigenpairs {
     let steps = n.saturating_sub(locked.len()).min(steps).max(1);
-    let m_locked: Vec<Vec<f64>> = locked
-        .iter()
-        .map(|l| {
-            let mut ml = vec![0.0; n];
-            metric.matvec(l, &mut ml);
-            ml
-        })
-        .collect();
-    let deflate = |w: &mut [f64]| {
-        for (l, ml) in locked.iter().zip(&m_locked) {
-            let c = dot(ml, w);
-            w.iter_mut().zip(l).for_each(|(a, b)| *a -= c * b);
-        }
+    let deflation = Deflation::new(metric, locked);
+    let mut basis = Basis {
+        q: Vec::with_capacity(steps),
+        mq: Vec::with_capacity(steps),
     };
-    // The basis q_j alone: inner products with it are taken against M w.
-    let mut q: Vec<Vec<f64>> = Vec::new();
-    let (mut alpha, mut beta) = (Vec::new(), Vec::new());
+    let (mut alpha, mut beta) = (Vec::with_capacity(steps), Vec::with_capacity(steps));
     // A deterministic start vector with components along every mode.
-    let mut v: Vec<f64> = (0..n)
+    let mut w: Vec<f64> = (0..n)
         .map(|i| 1.0 + 0.5 * ((i as f64) * 0.618).sin())
         .collect();
-    deflate(&mut v);
-    let mut mv = vec![0.0; n];
-    metric.matvec(&v, &mut mv);
-    let norm = dot(&v, &mv).sqrt();
-    for x in &mut v {
-        *x /= norm;
-    }
-    for x in &mut mv {
-        *x /= norm;
-    }
-    let mut w = vec![0.0; n];
     let mut mw = vec![0.0; n];
+    deflation.apply(&mut w);
+    metric.matvec(&w, &mut mw);
+    let mut b = metric_norm(&w, &mw);
     let mut coefficients = Vec::new();
     loop {
-        let j = q.len();
-        q.push(v.clone());
-        apply(&q[j], &mut w);
-        alpha.push(dot(&mv, &w));
-        // Classical Gram–Schmidt twice ("twice is enough": Giraud et al.,
-        // Numer. Math. 101, 2005), as accurate as the modified process
-        // and reading each basis vector twice per pass instead of four
-        // times (the basis is the memory traffic of a long run).
-        for _ in 0..2 {
-            deflate(&mut w);
-            metric.matvec(&w, &mut mw);
-            project_out(&q, &mw, &mut w, &mut coefficients);
+        let j = basis.q.len();
+        basis.q.push(w.iter().map(|x| x / b).collect());
+        basis.mq.push(mw.iter().map(|x| x / b).collect());
+        let (v, mv) = (&basis.q[j], &basis.mq[j]);
+        apply(v, mv, &mut w);
+        let a = dot(mv, &w);
+        alpha.push(a);
+        // The three-term recurrence, w − α_j q_j − β_{j−1} q_{j−1}; its
+        // loss of orthogonality is then removed against the whole basis.
+        match beta.last() {
+            Some(&bp) => {
+                let previous = &basis.q[j - 1];
+                w.iter_mut()
+                    .zip(v.iter().zip(previous))
+                    .for_each(|(x, (qj, qp))| *x -= a * qj + bp * qp);
+            }
+            None => w.iter_mut().zip(v).for_each(|(x, qj)| *x -= a * qj),
         }
-        metric.matvec(&w, &mut mw);
-        // wᵀMw ≥ 0 for the positive definite metric M; a negative value is
-        // round-off of a w already M-orthogonal to the basis (b ≈ 0, the
-        // space exhausted), not data, so it is read as 0.
-        let b = dot(&w, &mw).max(0.0).sqrt();
+        b = basis.reorthogonalize(metric, &deflation, &mut w, &mut mw, &mut coefficients);
         let exhausted = b <= 1e-14 * alpha[j].abs().max(f64::MIN_POSITIVE);
         let done = j + 1 >= steps
             || exhausted
@@ -572,24 +634,16 @@ pub(super) fn lanczos(
             break;
         }
         beta.push(b);
-        v = w.iter().map(|x| x / b).collect();
-        mv = mw.iter().map(|x| x / b).collect();
     }
     let eig = tridiagonal(&alpha, &beta).symmetric_eigen();
-    let m = alpha.len();
-    let mut idx: Vec<usize> = (0..m).collect();
+    let mut idx: Vec<usize> = (0..alpha.len()).collect();
     idx.sort_by(|&a, &b| order(eig.eigenvalues[a], eig.eigenvalues[b]));
+    idx.truncate(count);
+    let vectors = ritz_vectors(&basis.q, &idx, &eig.eigenvectors);
     let mut pairs: Vec<(f64, Vec<f64>)> = idx
-        .into_iter()
-        .take(count)
-        .map(|i| {
-            let s = eig.eigenvectors.column(i);
-            let mut x = vec![0.0; n];
-            for (qj, sj) in q.iter().zip(s.iter()) {
-                x.iter_mut().zip(qj).for_each(|(a, b)| *a += sj * b);
-            }
-            (to_lambda(eig.eigenvalues[i]), x)
-        })
+        .iter()
+        .map(|&i| to_lambda(eig.eigenvalues[i]))
+        .zip(vectors)
         .collect();
     pairs.sort_by(|a, b| a.0.total_cmp(&b.0));
     Eigenpairs {
@@ -598,18 +652,128 @@ pub(super) fn lanczos(
     }
 }
 
-/// w ← w − Σ_i c_i q_i with c_i = q_iᵀ(M w) given `mw` = M w: one
-/// classical Gram–Schmidt pass in the metric M, over blocks of the vectors
-/// so that the block of `mw` or `w` stays in cache while every q_i passes.
-fn project_out(q: &[Vec<f64>], mw: &[f64], w: &mut [f64], c: &mut Vec<f64>) {
+/// The locked vectors (with their metric products) a Lanczos basis is
+/// kept orthogonal to.
+struct Deflation<'a> {
+    locked: &'a [Vec<f64>],
+    m_locked: Vec<Vec<f64>>,
+}
+
+impl<'a> Deflation<'a> {
+    fn new(metric: &SymmetricBanded, locked: &'a [Vec<f64>]) -> Self {
+        let m_locked = locked
+            .iter()
+            .map(|l| {
+                let mut ml = vec![0.0; l.len()];
+                metric.matvec(l, &mut ml);
+                ml
+            })
+            .collect();
+        Deflation { locked, m_locked }
+    }
+
+    /// w ← w − Σ (l_iᵀ M w) l_i over the locked vectors; the sum of the
+    /// squared coefficients (what it took off ‖w‖²_M).
+    fn apply(&self, w: &mut [f64]) -> f64 {
+        let mut removed = 0.0;
+        for (l, ml) in self.locked.iter().zip(&self.m_locked) {
+            let c = dot(ml, w);
+            w.iter_mut().zip(l).for_each(|(a, b)| *a -= c * b);
+            removed += c * c;
+        }
+        removed
+    }
+}
+
+/// The Lanczos vectors q_j and their metric products M q_j.
+struct Basis {
+    q: Vec<Vec<f64>>,
+    mq: Vec<Vec<f64>>,
+}
+
+/// A reorthogonalization pass is repeated when it leaves less than this
+/// fraction of the vector's metric norm (Daniel, Gragg, Kaufman & Stewart,
+/// Math. Comp. 30, 1976; ARPACK's 0.717): a pass that removes little
+/// leaves w orthogonal to working precision, one that cancels most of w
+/// leaves its rounding errors as large as what remains.
+const REPEAT_BELOW: f64 = std::f64::consts::FRAC_1_SQRT_2;
+
+impl Basis {
+    /// w made M-orthogonal to the locked vectors and to the basis by
+    /// classical Gram–Schmidt in the metric, a second pass only where the
+    /// first cancelled most of w ([`REPEAT_BELOW`]; "twice is enough":
+    /// Giraud et al., Numer. Math. 101, 2005). Leaves M w in `mw` and
+    /// returns ‖w‖_M. After the three-term recurrence the components left
+    /// along the basis are round-off, so one pass is the rule: a product
+    /// by M and a read of each basis, where two passes always cost twice
+    /// that. The norm before a pass is ‖w‖²_M after it plus the squares of
+    /// what it removed (the basis is M-orthonormal).
+    fn reorthogonalize(
+        &self,
+        metric: &SymmetricBanded,
+        deflation: &Deflation,
+        w: &mut [f64],
+        mw: &mut [f64],
+        coefficients: &mut Vec<f64>,
+    ) -> f64 {
+        let mut after = 0.0;
+        for _ in 0..2 {
+            let mut removed = deflation.apply(w);
+            removed += project_out(&self.q, &self.mq, w, coefficients);
+            metric.matvec(w, mw);
+            after = metric_norm(w, mw);
+            if after * after
+                > removed * REPEAT_BELOW * REPEAT_BELOW / (1.0 - REPEAT_BELOW * REPEAT_BELOW)
+            {
+                return after;
+            }
+        }
+        after
+    }
+}
+
+/// ‖w‖_M from w and M w: wᵀMw ≥ 0 for the positive definite metric M; a
+/// negative value is round-off of a w already M-orthogonal to the basis
+/// (the space exhausted), not data, so it is read as 0.
+fn metric_norm(w: &[f64], mw: &[f64]) -> f64 {
+    dot(w, mw).max(0.0).sqrt()
+}
+
+/// The Ritz vectors x_i = Σ_j S[j, i] q_j for the columns `columns` of S,
+/// over blocks of rows so that each basis vector is read once while the
+/// blocks of every x_i stay in cache.
+fn ritz_vectors(q: &[Vec<f64>], columns: &[usize], s: &DMatrix<f64>) -> Vec<Vec<f64>> {
+    const BLOCK: usize = 2048;
+    let n = q.first().map_or(0, Vec::len);
+    let mut x = vec![vec![0.0; n]; columns.len()];
+    for start in (0..n).step_by(BLOCK) {
+        let end = (start + BLOCK).min(n);
+        for (j, qj) in q.iter().enumerate() {
+            for (xi, &col) in x.iter_mut().zip(columns) {
+                let sji = s[(j, col)];
+                xi[start..end]
+                    .iter_mut()
+                    .zip(&qj[start..end])
+                    .for_each(|(a, b)| *a += sji * b);
+            }
+        }
+    }
+    x
+}
+
+/// w ← w − Σ_i c_i q_i with c_i = (M q_i)ᵀw given `mq`: one classical
+/// Gram–Schmidt pass in the metric M, over blocks of the vectors so that
+/// the block of `w` stays in cache while every q_i passes; Σ c_i² (what
+/// it took off ‖w‖²_M).
+fn project_out(q: &[Vec<f64>], mq: &[Vec<f64>], w: &mut [f64], c: &mut Vec<f64>) -> f64 {
     const BLOCK: usize = 1024;
     c.clear();
     c.resize(q.len(), 0.0);
     for start in (0..w.len()).step_by(BLOCK) {
         let end = (start + BLOCK).min(w.len());
-        let block = &mw[start..end];
-        for (ci, qi) in c.iter_mut().zip(q) {
-            *ci += dot(&qi[start..end], block);
+        let block = &w[start..end];
+        for (ci, mqi) in c.iter_mut().zip(mq) {
+            *ci += dot(&mqi[start..end], block);
         }
     }
     for start in (0..w.len()).step_by(BLOCK) {
@@ -622,6 +786,7 @@ fn project_out(q: &[Vec<f64>], mw: &[f64], w: &mut [f64], c: &mut Vec<f64>) {
                 .for_each(|(a, b)| *a -= ci * b);
         }
     }
+    c.iter().map(|ci| ci * ci).sum()
 }
 
 fn tridiagonal(alpha: &[f64], beta: &[f64]) -> DMatrix<f64> {
@@ -706,7 +871,7 @@ pub fn smallest_positive_load_factor(
         if f.negative_pivots() > 0 {
             return Err(EigenError::NotDefinite("K0 has negative pivots".into()));
         }
-        let apply = |x: &[f64], y: &mut [f64]| {
+        let apply = |x: &[f64], _: &[f64], y: &mut [f64]| {
             k1.matvec(x, y);
             f.solve_in_place(y);
         };
@@ -844,9 +1009,9 @@ mod tests {
         assert_eq!(missing_below(&gapped, 0.0, below).unwrap().0, 1);
         assert_eq!(missing_below(&pairs, 0.0, below).unwrap().0, 0);
         let sigma = 0.5 * exact[0];
-        let shifted = k.combine(1.0, &g, -sigma).ldlt().unwrap();
-        let apply = |x: &[f64], y: &mut [f64]| {
-            g.matvec(x, y);
+        let shifted = k.shifted_ldlt(-sigma, &g).unwrap();
+        let apply = |_: &[f64], gx: &[f64], y: &mut [f64]| {
+            y.copy_from_slice(gx);
             shifted.solve_in_place(y);
         };
         let locked = [pairs.vectors[0].clone()];

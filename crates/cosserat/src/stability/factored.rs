@@ -23,39 +23,51 @@ use crate::numerics::eigen::Eigenpairs;
 /// vᵀKv from the factors: Σ_q w_q q(ω_q, ω'_q) for the block unknowns `v`
 /// and the coefficients at the quadrature points.
 pub fn form(fe: &FiniteElements, coeffs: &[FormCoefficients], block: Block, v: &[f64]) -> f64 {
-    fe.interpolate(block, v)
-        .iter()
-        .zip(fe.quadrature_weights())
-        .zip(coeffs)
-        .map(|(((w, dw), weight), c)| weight * c.evaluate(w, dw))
-        .sum()
+    let comps = block.components();
+    let mut sum = 0.0;
+    fe.for_each_point_of(block, &[v], |q, weight, points| {
+        let (w, dw) = &points[0];
+        sum += weight * coeffs[q].evaluate_on(comps, w, dw);
+    });
+    sum
 }
 
 /// The Rayleigh quotient vᵀKv / vᵀGv from the factors: an eigenvalue of
-/// (K, G) to second order in the error of its vector `v` (one
-/// interpolation for both sums).
+/// (K, G) to second order in the error of its vector `v`.
 pub fn rayleigh_quotient(
     fe: &FiniteElements,
     coeffs: &[FormCoefficients],
     block: Block,
     v: &[f64],
 ) -> f64 {
-    let (mut stiffness, mut metric) = (0.0, 0.0);
-    let points = fe.interpolate(block, v);
-    for (((w, dw), weight), c) in points.iter().zip(fe.quadrature_weights()).zip(coeffs) {
-        stiffness += weight * c.evaluate(w, dw);
-        metric += weight * w.norm_squared();
-    }
-    stiffness / metric
+    rayleigh_quotients(fe, coeffs, block, &[v])[0]
+}
+
+/// [`rayleigh_quotient`] of several vectors in one pass over the
+/// quadrature points (each point's coefficients read once for all).
+fn rayleigh_quotients(
+    fe: &FiniteElements,
+    coeffs: &[FormCoefficients],
+    block: Block,
+    vectors: &[&[f64]],
+) -> Vec<f64> {
+    let comps = block.components();
+    let mut sums = vec![(0.0, 0.0); vectors.len()];
+    fe.for_each_point_of(block, vectors, |q, weight, points| {
+        let c = &coeffs[q];
+        for ((stiffness, metric), (w, dw)) in sums.iter_mut().zip(points) {
+            *stiffness += weight * c.evaluate_on(comps, w, dw);
+            *metric += weight * w.norm_squared();
+        }
+    });
+    sums.into_iter().map(|(k, g)| k / g).collect()
 }
 
 /// vᵀGv from the factors: Σ_q w_q |ω_q|².
 fn metric(fe: &FiniteElements, block: Block, v: &[f64]) -> f64 {
-    fe.interpolate(block, v)
-        .iter()
-        .zip(fe.quadrature_weights())
-        .map(|((w, _), weight)| weight * w.norm_squared())
-        .sum()
+    let mut sum = 0.0;
+    fe.for_each_point(block, v, |weight, w, _| sum += weight * w.norm_squared());
+    sum
 }
 
 /// The load factor λ = −vᵀK0v / vᵀK1v of the pencil K0 + λK1 at its null
@@ -84,16 +96,18 @@ pub fn refined(
     support: &Constraints,
     pairs: Eigenpairs,
 ) -> Eigenpairs {
-    let mut all: Vec<(f64, Vec<f64>)> = pairs
-        .vectors
+    let vectors: Vec<&[f64]> = pairs.vectors.iter().map(Vec::as_slice).collect();
+    let quotients = rayleigh_quotients(fe, coeffs, block, &vectors);
+    let mut all: Vec<(f64, Vec<f64>)> = quotients
         .into_iter()
-        .map(|v| {
+        .zip(pairs.vectors)
+        .map(|(quotient, v)| {
             let springs = if support.is_empty() {
                 0.0
             } else {
                 support.spring_form(&v) / metric(fe, block, &v)
             };
-            (rayleigh_quotient(fe, coeffs, block, &v) + springs, v)
+            (quotient + springs, v)
         })
         .collect();
     all.sort_by(|a, b| a.0.total_cmp(&b.0));

@@ -24,8 +24,8 @@ use nalgebra::{Matrix3, Vector3};
 use crate::bvp::{Equilibrium, SolveError, SolverOptions};
 use crate::equations::RodSample;
 use crate::model::{shear_strain, Freedom, ModelLevel, Rod, StrainEnergy};
-use constrained::{count_below_constrained, lowest_eigenpairs_constrained, Constraints};
-use eigen::{EigenError, Inertia, UndecidedInertia};
+use constrained::{count_below_constrained, lowest_eigenpairs_constrained_estimated, Constraints};
+use eigen::{EigenError, Inertia, ShiftEstimate, UndecidedInertia};
 
 /// How the second variation is discretized and how much of its spectrum is
 /// computed: `elements` Lagrange elements of order `order` (1 to 3;
@@ -222,15 +222,34 @@ pub fn block_spectrum(
     count: usize,
     constraints: &Constraints,
 ) -> Result<BlockSpectrum, StabilityError> {
+    block_spectrum_estimated(fe, coeffs, block, count, constraints, None)
+}
+
+/// [`block_spectrum`] with the Lanczos shift placed by `estimate` (the
+/// block's eigenvalues on a coarser mesh: [`ShiftEstimate`]). The Morse
+/// index is the Sturm count of K at 0, unless the shift that certified
+/// the eigenvalues is at or above 0: K − σG positive definite with σ ≥ 0
+/// makes K positive definite, and the index 0, with no further count.
+pub fn block_spectrum_estimated(
+    fe: &FiniteElements,
+    coeffs: &[FormCoefficients],
+    block: Block,
+    count: usize,
+    constraints: &Constraints,
+    estimate: Option<ShiftEstimate>,
+) -> Result<BlockSpectrum, StabilityError> {
     let k = fe.stiffness(coeffs, block);
     let g = fe.mass(block);
-    let pairs = factored::refined(
-        fe,
-        coeffs,
-        block,
-        constraints,
-        lowest_eigenpairs_constrained(&k, &g, constraints, count, None)?,
-    );
+    let bounded = lowest_eigenpairs_constrained_estimated(&k, &g, constraints, count, estimate)?;
+    let morse_index = if bounded.lower_bound >= 0.0 {
+        0
+    } else {
+        match count_below_constrained(&k, &g, constraints, 0.0) {
+            Inertia::Below(n) => n,
+            Inertia::Undecided(why) => return Err(StabilityError::Undecided(block.name(), why)),
+        }
+    };
+    let pairs = factored::refined(fe, coeffs, block, constraints, bounded.pairs);
     Ok(BlockSpectrum {
         block,
         eigenvalues: pairs.values,
@@ -239,10 +258,7 @@ pub fn block_spectrum(
             .iter()
             .map(|v| fe.nodal_rotations(block, v))
             .collect(),
-        morse_index: match count_below_constrained(&k, &g, constraints, 0.0) {
-            Inertia::Below(n) => n,
-            Inertia::Undecided(why) => return Err(StabilityError::Undecided(block.name(), why)),
-        },
+        morse_index,
     })
 }
 
@@ -319,6 +335,16 @@ fn tip_motion(rod: &Rod, p: &RodSample) -> Result<TipMotion, StabilityError> {
 }
 
 /// The stability of an equilibrium of `rod` (from [`crate::bvp::solve`]).
+///
+/// On [`COARSE_ESTIMATE_FROM`] elements or more, the lowest eigenvalues
+/// of each block are first computed on a mesh [`COARSE_RATIO`] times
+/// coarser (one more than asked, so that λ_{k+1} is estimated too) to
+/// place the shift of each block's Lanczos ([`ShiftEstimate`]): the
+/// factors of the shifted K certify it, and a coarse mesh that fails
+/// (an error, or eigenvalues the fine mesh contradicts) leaves the Sturm
+/// bisection to place it, so the result is that of the mesh asked for
+/// either way. The coarse solve costs ~1/[`COARSE_RATIO`] of the fine
+/// one; the bisection it replaces cost ~10 factorizations per block.
 pub fn analyze(
     rod: &Rod,
     eq: &Equilibrium,
@@ -326,6 +352,11 @@ pub fn analyze(
     opts: &StabilityOptions,
 ) -> Result<Stability, StabilityError> {
     check_conservative(rod)?;
+    let estimates = if opts.elements >= COARSE_ESTIMATE_FROM {
+        coarse_estimates(rod, eq, solver, opts)
+    } else {
+        Vec::new()
+    };
     let fe = FiniteElements::new(rod.length(), opts.elements, opts.order)
         .with_breaks(&rod.breaks())
         .with_hinged_base(rod.clamp().hinge);
@@ -340,9 +371,11 @@ pub fn analyze(
     };
     let blocks = blocks
         .into_iter()
-        .map(|b| {
+        .enumerate()
+        .map(|(i, b)| {
             let c = support_constraints(rod, &fe, b, &samples, &tip)?;
-            block_spectrum(&fe, &coeffs, b, opts.eigenvalues, &c)
+            let estimate = estimates.get(i).copied().flatten();
+            block_spectrum_estimated(&fe, &coeffs, b, opts.eigenvalues, &c, estimate)
         })
         .collect::<Result<Vec<_>, _>>()?;
     let morse_index = blocks.iter().map(|b| b.morse_index).sum();
@@ -352,6 +385,42 @@ pub fn analyze(
         stable: morse_index == 0,
         nodes: fe.nodes(),
     })
+}
+
+/// The fewest elements on which [`analyze`] estimates the shifts from a
+/// coarser mesh.
+pub const COARSE_ESTIMATE_FROM: usize = 2048;
+
+/// How much coarser that mesh is.
+pub const COARSE_RATIO: usize = 64;
+
+/// Per block, λ_1 and λ_{k+1} on the mesh [`COARSE_RATIO`] times coarser
+/// (k = `opts`' eigenvalues); an empty list where that analysis fails
+/// (the fine one then places its shifts by bisection).
+fn coarse_estimates(
+    rod: &Rod,
+    eq: &Equilibrium,
+    solver: &SolverOptions,
+    opts: &StabilityOptions,
+) -> Vec<Option<ShiftEstimate>> {
+    let count = opts.eigenvalues;
+    let Ok(coarse) = opts
+        .with_elements(opts.elements / COARSE_RATIO)
+        .and_then(|o| o.with_eigenvalues(count + 1))
+    else {
+        return Vec::new();
+    };
+    let Ok(st) = analyze(rod, eq, solver, &coarse) else {
+        return Vec::new();
+    };
+    st.blocks
+        .iter()
+        .map(|b| {
+            let values = &b.eigenvalues;
+            let next = values.get(count).or(values.last())?;
+            ShiftEstimate::new(*values.first()?, *next)
+        })
+        .collect()
 }
 
 /// A stability verdict that states its own certainty.
