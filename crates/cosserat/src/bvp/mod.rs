@@ -722,13 +722,8 @@ const RAMP_ITERATIONS: usize = 8;
 /// (Deuflhard's continuation step control).
 const RAMP_CONTRACTION: f64 = 0.25;
 /// Newton's and the integrator's tolerance at the ramp's intermediate
-/// steps ([`warm_start_options`]): a starting point for the next step
-/// needs only to lie in its Newton region, which the next step's own
-/// contraction test checks. 1e-3 rather than 1e-6 takes 26 % fewer
-/// right-hand side evaluations for the cantilever at k = 3, 45 % at
-/// k = 10, 55 % at k = 30, with the same ramp steps and the same final
-/// Newton residuals to two digits (`examples/equilibrium_profile.rs`).
-const RAMP_TOLERANCE: f64 = 1e-3;
+/// steps ([`warm_start_options`]).
+const RAMP_TOLERANCE: f64 = 1e-6;
 
 /// Natural-parameter continuation in a load factor λ from 0 to 1, each step
 /// started from the secant through the last two equilibria ([`secant`];
@@ -811,11 +806,7 @@ fn ramp(
 /// or the asked ones where tighter), the last step at λ = 1 to the asked
 /// tolerances, from which Newton converges in the same few steps. Each
 /// step still has to pass the ramp's test (undamped, Θ ≤ 1/4), so the
-/// branch is followed as before. A step that meets the loose tolerance
-/// after one correction has no measured Θ; its residual after that
-/// correction is then below the tolerance, so the next correction is
-/// that small too against the first: consistent with Θ ≤ 1/4 unless the
-/// start was itself within the tolerance. Collocation keeps its settings (its mesh
+/// branch is followed as before. Collocation keeps its settings (its mesh
 /// adapts at every step).
 fn warm_start_options(step_opts: &SolverOptions) -> SolverOptions {
     if matches!(step_opts.method, Method::Collocation { .. }) {
