@@ -281,11 +281,7 @@ impl Dop853 {
                 let start = s;
                 s = if lands { target } else { s + step };
                 let inside = stops[next_stop..].partition_point(|&t| t <= s);
-                let extended = match serve {
-                    Stops::Landed => false,
-                    Stops::Interpolated => inside > 0,
-                    Stops::Recorded => true,
-                };
+                let extended = serve.extends(inside);
                 if extended {
                     // The extension needs y and f at the step's start.
                     self.interpolant(n).start(y);
@@ -443,6 +439,18 @@ pub enum Stops {
     /// readable at any later point without integrating again (three more
     /// evaluations on a step that holds no stop).
     Recorded,
+}
+
+impl Stops {
+    /// Whether an accepted step holding `inside` stops builds its
+    /// continuous extension.
+    fn extends(self, inside: usize) -> bool {
+        match self {
+            Stops::Landed => false,
+            Stops::Interpolated => inside > 0,
+            Stops::Recorded => true,
+        }
+    }
 }
 
 /// y += a x.

@@ -131,7 +131,7 @@ impl Interpolant {
 /// The continuous extensions of consecutive accepted steps (one
 /// integration, or several appended in increasing s): the solution at any
 /// point of the steps' span from seven coefficient vectors and the step's
-/// start state, as [`Interpolant::at`] reads them, without integrating
+/// start state, as the step's own extension reads them, without integrating
 /// again. Flat storage: per step its start, its size and 8 n numbers.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct DenseRecord {
