@@ -220,7 +220,9 @@ impl Equilibrium {
         }
         if let Some((tol, record)) = &self.recorded {
             if *tol == opts.integration {
-                if let Some(samples) = read_record(eq.as_ref(), record, points) {
+                if let Some(samples) =
+                    read_record(eq.as_ref(), record, points, |s, y| eq.sample(s, y))
+                {
                     return Ok(samples);
                 }
             }
@@ -231,26 +233,65 @@ impl Equilibrium {
             .map_err(SolveError::Sampling)?;
         Ok(samples)
     }
+
+    /// The largest |κ| at `points`, read from the recorded extension
+    /// without building whole samples where the record serves (else from
+    /// [`Self::resample`]).
+    pub fn max_curvature(
+        &self,
+        rod: &Rod,
+        opts: &SolverOptions,
+        points: &[f64],
+    ) -> Result<f64, SolveError> {
+        // NaN-propagating: a non-finite curvature must reach the caller.
+        let largest = |k: Vec<f64>| {
+            k.into_iter().fold(0.0, |a: f64, b| {
+                if a.is_nan() || b.is_nan() {
+                    f64::NAN
+                } else {
+                    a.max(b)
+                }
+            })
+        };
+        if let (Discretization::Shooting, Some((tol, record))) =
+            (&self.discretization, &self.recorded)
+        {
+            if *tol == opts.integration {
+                let eq = equations(rod, self.model.level);
+                let norms = read_record(eq.as_ref(), record, points, |s, y| {
+                    eq.curvature(s, y).norm()
+                });
+                if let Some(norms) = norms {
+                    return Ok(largest(norms));
+                }
+            }
+        }
+        let samples = self.resample(rod, opts, points)?;
+        Ok(largest(
+            samples.iter().map(|s| s.curvature.norm()).collect(),
+        ))
+    }
 }
 
-/// The samples of `eq` at `points` from a recorded continuous extension,
-/// each state projected as the integrator projects its stops; None when a
-/// point lies outside the record.
-fn read_record(
+/// `read(s, y)` of each state of `eq` at `points` from a recorded
+/// continuous extension, each state projected as the integrator projects
+/// its stops; None when a point lies outside the record.
+fn read_record<T>(
     eq: &dyn RodEquations,
     record: &DenseRecord,
     points: &[f64],
-) -> Option<Vec<RodSample>> {
+    read: impl Fn(f64, &[f64]) -> T,
+) -> Option<Vec<T>> {
     let mut y = vec![0.0; eq.dim()];
-    points
-        .iter()
-        .map(|&s| {
-            record.state_at(s, &mut y).then(|| {
-                eq.project(&mut y);
-                eq.sample(s, &y)
-            })
-        })
-        .collect()
+    let mut out = Vec::with_capacity(points.len());
+    for &s in points {
+        if !record.state_at(s, &mut y) {
+            return None;
+        }
+        eq.project(&mut y);
+        out.push(read(s, &y));
+    }
+    Some(out)
 }
 
 /// Why no equilibrium was returned.

@@ -96,6 +96,11 @@ pub trait RodEquations: Send + Sync {
     fn unknowns_of(&self, y0: &[f64]) -> Vec<f64>;
     /// The state in user quantities.
     fn sample(&self, s: f64, y: &[f64]) -> RodSample;
+    /// The curvature κ of [`Self::sample`] alone: for scans along the
+    /// rod that read nothing else (the stability's mesh resolution).
+    fn curvature(&self, s: f64, y: &[f64]) -> Vector3<f64> {
+        self.sample(s, y).curvature
+    }
     /// A state of the unloaded, straight rod at s: used where no better guess
     /// is available (multiple-shooting nodes after a blow-up).
     fn straight_state(&self, s: f64) -> Vec<f64>;

@@ -431,6 +431,10 @@ impl RodEquations for PlanarEquations {
         }
     }
 
+    fn curvature(&self, _s: f64, y: &[f64]) -> Vector3<f64> {
+        Self::kappa(y[3])
+    }
+
     fn straight_state(&self, s: f64) -> Vec<f64> {
         let mut y = vec![0.0; self.dim()];
         y[1] = s;

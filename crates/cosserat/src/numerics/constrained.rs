@@ -277,19 +277,38 @@ fn constrained_lanczos(
     let guessed = estimate
         .map(|e| e.shift(diagonal_ratio(k, g)))
         .and_then(|s| Bordered::new(k, g, c, s).filter(none_below).map(|b| (s, b)));
-    let (sigma, bordered) = if let Some(found) = guessed {
-        found
-    } else {
-        let sigma = shift_below_constrained(k, g, c, count);
-        let bordered = Bordered::new(k, g, c, sigma)
-            .ok_or_else(|| EigenError::NotDefinite(format!("K − σG is singular at σ = {sigma}")))?;
-        (sigma, bordered)
-    };
+    // A guessed shift whose Lanczos run fails falls back to the bisection:
+    // the pairs pass the same checks either way.
+    if let Some((sigma, bordered)) = guessed {
+        if let Ok(pairs) = bordered_lanczos(k, g, c, count, sigma, &bordered) {
+            return Ok(BoundedPairs {
+                pairs,
+                lower_bound: sigma,
+            });
+        }
+    }
+    let sigma = shift_below_constrained(k, g, c, count);
+    let bordered = Bordered::new(k, g, c, sigma)
+        .ok_or_else(|| EigenError::NotDefinite(format!("K − σG is singular at σ = {sigma}")))?;
     let lower_bound = if none_below(&bordered) {
         sigma
     } else {
         f64::NEG_INFINITY
     };
+    let pairs = bordered_lanczos(k, g, c, count, sigma, &bordered)?;
+    Ok(BoundedPairs { pairs, lower_bound })
+}
+
+/// The lowest `count` constrained pairs by shift-invert Lanczos from σ,
+/// with `bordered` the factors of the bordered K − σG.
+fn bordered_lanczos(
+    k: &SymmetricBanded,
+    g: &SymmetricBanded,
+    c: &Constraints,
+    count: usize,
+    sigma: f64,
+    bordered: &Bordered,
+) -> Result<Eigenpairs, EigenError> {
     let s_inv = bordered
         .s
         .clone()
@@ -298,7 +317,7 @@ fn constrained_lanczos(
     // The bordered solve of G x, which the Lanczos recurrence holds.
     let apply = |_: &[f64], gx: &[f64], y: &mut [f64]| bordered.solve(&s_inv, gx, y);
     let below = |s: f64| count_below_constrained(k, g, c, s);
-    let pairs = shift_invert_lanczos(
+    shift_invert_lanczos(
         k.size(),
         count,
         sigma,
@@ -306,8 +325,7 @@ fn constrained_lanczos(
         g,
         |ritz| verify(k, g, c, ritz),
         below,
-    )?;
-    Ok(BoundedPairs { pairs, lower_bound })
+    )
 }
 
 /// A shift below the constrained spectrum: [`shift_below`] on the
