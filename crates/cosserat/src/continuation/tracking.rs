@@ -7,7 +7,8 @@
 //!
 //! Each point's eigenpairs start from the previous point's vectors
 //! ([`crate::numerics::subspace`]: a few shift-invert sweeps with
-//! Rayleigh–Ritz, certified by one Sturm count); the full solve runs only at
+//! Rayleigh–Ritz, certified by one Sturm count, which also gives the Morse
+//! index where the spectrum keeps clear of zero); the full solve runs only at
 //! the first point of a branch, on a constrained pencil, and where the warm
 //! start cannot vouch for its pairs.
 
@@ -262,7 +263,7 @@ impl Tracker {
                     // One tracked eigenvalue: it is both of the lowest two.
                     (b[0], *b.get(1).unwrap_or(&b[0]))
                 });
-            let pairs = self.pairs(bi, k, g, constraints, near)?;
+            let (pairs, certified_morse) = self.pairs(bi, k, g, constraints, near)?;
             let count = self.opts.eigenvalues();
             // Every block fills its `eigenvalues` columns of the diagram; a
             // mesh with fewer unknowns than that cannot (the eigensolver
@@ -291,8 +292,11 @@ impl Tracker {
                     .chain(guard.iter().cloned())
                     .collect::<Vec<_>>(),
             );
-            block_morse.push(
-                count_below_constrained(k, g, constraints, 0.0)
+            // The warm pairs' certificate gives the count below 0 where
+            // the spectrum keeps clear of it; else Sylvester's inertia of K.
+            let morse = match certified_morse {
+                Some(morse) => morse,
+                None => count_below_constrained(k, g, constraints, 0.0)
                     .below()
                     .ok_or_else(|| {
                         PointError::Eigen(format!(
@@ -300,7 +304,8 @@ impl Tracker {
                             self.blocks[bi].name()
                         ))
                     })?,
-            );
+            };
+            block_morse.push(morse);
         }
         Ok(Spectrum {
             tip: shape_samples
@@ -368,7 +373,10 @@ impl Tracker {
     /// warm-started from the previous point's vectors when there are such
     /// and the pencil is unconstrained, else — or when the warm start
     /// cannot vouch for its pairs — the full solve, its shift placed by
-    /// `near` (the previous lowest two eigenvalues).
+    /// `near` (the previous lowest two eigenvalues). With them the Morse
+    /// index of the block where the warm start's certificate reads it
+    /// ([`crate::numerics::subspace::WarmPairs::count_below`] at 0), None
+    /// where it must be counted.
     fn pairs(
         &self,
         bi: usize,
@@ -376,7 +384,7 @@ impl Tracker {
         g: &SymmetricBanded,
         constraints: &Constraints,
         near: Option<(f64, f64)>,
-    ) -> Result<Eigenpairs, PointError> {
+    ) -> Result<(Eigenpairs, Option<usize>), PointError> {
         let count = self.opts.eigenvalues();
         let warm = self
             .previous
@@ -385,11 +393,15 @@ impl Tracker {
             .filter(|_| constraints.is_empty())
             .and_then(|start| lowest_eigenpairs_from(k, g, count, start));
         match warm {
-            Some(pairs) => Ok(pairs),
+            Some(warm) => {
+                let morse = warm.count_below(0.0);
+                Ok((warm.pairs, morse))
+            }
             // With the guard vectors when they converge too; else the
             // tracked ones alone (the next point then solves in full again).
             None => lowest_eigenpairs_constrained(k, g, constraints, count + GUARD, near)
                 .or_else(|_| lowest_eigenpairs_constrained(k, g, constraints, count, near))
+                .map(|pairs| (pairs, None))
                 .map_err(|e| PointError::Eigen(e.to_string())),
         }
     }
