@@ -38,9 +38,10 @@ use super::eigen::{count_below, diagonal_ratio, dot, row_sum_norm, Eigenpairs, I
 /// [`super::eigen`]; the sweeps stop at the first that meets it. The
 /// eigenvalues, Rayleigh quotients, err by its square: on the Euler
 /// column's branches (16 elements of order 2) pairs stopped at a backward
-/// error of 2–5e-9 differ from the same pairs swept on to 1e-13 by at most
-/// 2e-12 (λ ≈ 2.5) and 4e-15 (λ ≈ 3e-7), far inside the eigenvalues' mesh
-/// error. (The sweeps used to aim at 1e-13 and stop early only when a
+/// error of 2–5e-9 differ from the same pairs swept on to 1e-13 by 2e-12
+/// (λ ≈ 2.5) and 4e-15 (λ ≈ 3e-7), and the diagram's stored eigenvalues
+/// (|λ| ≤ 30) moved by at most 4.4e-11 when this rule replaced the one
+/// below — far inside the eigenvalues' mesh error. (The sweeps used to aim at 1e-13 and stop early only when a
 /// sweep gained less than a factor 10: where the shifted iteration
 /// converges by a factor just under 10 a sweep, as on the buckled column,
 /// that took 8–9 sweeps instead of 3–4 for no eigenvalue an event or a
