@@ -77,6 +77,11 @@ pub struct Tracker {
     /// not on the shape, so along a branch that keeps the length it is
     /// assembled once (the same sums, so bit for bit the same matrices).
     masses: RefCell<Option<(FiniteElements, Vec<SymmetricBanded>)>>,
+    /// The block and eigenvectors (tracked and guard) of the last trial
+    /// point of an event's location ([`Tracker::trial_nearest_zero`]),
+    /// which start the next trial's eigenpairs; cleared when a location
+    /// begins ([`Tracker::begin_trials`]).
+    trials: RefCell<Option<(Block, Vec<Vec<f64>>)>>,
 }
 
 impl Tracker {
@@ -94,6 +99,7 @@ impl Tracker {
             previous: None,
             previous_values: None,
             masses: RefCell::new(None),
+            trials: RefCell::new(None),
         }
     }
 
@@ -121,6 +127,7 @@ impl Tracker {
             previous: None,
             previous_values: None,
             masses: RefCell::new(None),
+            trials: RefCell::new(None),
             ..self.clone()
         })
     }
@@ -353,6 +360,62 @@ impl Tracker {
 }
 
 impl Tracker {
+    /// Forget the trial vectors: an event's location begins, and its first
+    /// trial solves in full, so that the location depends only on its
+    /// bracket (the same in a resumed run).
+    pub fn begin_trials(&self) {
+        *self.trials.borrow_mut() = None;
+    }
+
+    /// The eigenvalue of `block` nearest zero at (x, p), among the
+    /// `eigenvalues` lowest, at a trial point of an event's location: the
+    /// eigenpairs warm-started from the last trial's vectors
+    /// ([`lowest_eigenpairs_from`], certified by a Sturm count) where there
+    /// are such and the pencil is unconstrained, else the full solve; the
+    /// vectors are kept for the next trial. The located point's own
+    /// eigenvalue and null mode come from [`Tracker::nearest_zero`]'s full
+    /// solve. The warm pairs meet the backward error
+    /// [`crate::numerics::subspace::ACCEPT`], which moves an eigenvalue near
+    /// zero by round-off (4e-15 at 3e-7 on the Euler column) and so its
+    /// root in p by far less than the event tolerance.
+    pub fn trial_nearest_zero(
+        &self,
+        family: &Family,
+        x: &[f64],
+        p: f64,
+        block: Block,
+    ) -> Result<f64, PointError> {
+        let (_, mats, _, _) = self.matrices(family, x, p)?;
+        let bi = self
+            .blocks
+            .iter()
+            .position(|&b| b == block)
+            .expect("a tracked block");
+        let (k, g, constraints) = &mats[bi];
+        let count = self.opts.eigenvalues();
+        let start = self
+            .trials
+            .borrow_mut()
+            .take()
+            .filter(|(b, _)| *b == block && constraints.is_empty());
+        let warm = start.and_then(|(_, start)| lowest_eigenpairs_from(k, g, count, &start));
+        let pairs = match warm {
+            Some(warm) => warm.pairs,
+            None => lowest_eigenpairs_constrained(k, g, constraints, count + GUARD, None)
+                .or_else(|_| lowest_eigenpairs_constrained(k, g, constraints, count, None))
+                .map_err(|e| PointError::Eigen(e.to_string()))?,
+        };
+        let nearest = pairs.values[..count.min(pairs.values.len())]
+            .iter()
+            .copied()
+            .min_by(|a, b| a.abs().total_cmp(&b.abs()))
+            .ok_or_else(|| PointError::Eigen("no eigenvalue".into()))?;
+        if pairs.vectors.len() > count {
+            *self.trials.borrow_mut() = Some((block, pairs.vectors));
+        }
+        Ok(nearest)
+    }
+
     /// G of every block on the mesh `fe`, assembled only when the mesh
     /// differs from the last one's.
     fn masses_on(&self, fe: &FiniteElements) -> Vec<SymmetricBanded> {
