@@ -338,6 +338,38 @@ impl Run<'_> {
         sign: f64,
         ds: f64,
     ) -> Result<Option<Stepped>, PointError> {
+        self.step_after(None, from, sign, ds)
+    }
+
+    /// [`Run::step`], Newton started from the parabola through `before`
+    /// (the branch's point before `from`) where there is one
+    /// ([`engine::step_after`]): the same plane, so the same point to the
+    /// Newton tolerance. Should that corrector fail, the step from the
+    /// tangent predictor decides, so that a step fails only where it did
+    /// without the parabola.
+    pub(super) fn step_after(
+        &self,
+        before: Option<&Point>,
+        from: &Point,
+        sign: f64,
+        ds: f64,
+    ) -> Result<Option<Stepped>, PointError> {
+        if before.is_some() {
+            if let Ok(Some(stepped)) = self.step_from(before, from, sign, ds) {
+                return Ok(Some(stepped));
+            }
+        }
+        self.step_from(None, from, sign, ds)
+    }
+
+    /// The step of [`Run::step_after`] from one start.
+    fn step_from(
+        &self,
+        before: Option<&Point>,
+        from: &Point,
+        sign: f64,
+        ds: f64,
+    ) -> Result<Option<Stepped>, PointError> {
         let t: Vec<f64> = from.tangent.iter().map(|v| v * sign).collect();
         // A branch of symmetric copies keeps a null vector of F_x: step in
         // the slice through the last point (`slice.rs`).
@@ -363,8 +395,11 @@ impl Run<'_> {
             let stored: Vec<f64> = tangent.iter().map(|v| v * sign).collect();
             return Ok(Some((z[..n].to_vec(), z[n], stored, iterations)));
         }
-        let Some((x, p, tangent, iterations)) = engine::step(
+        let before: Option<Vec<f64>> =
+            before.map(|b| b.unknowns.iter().copied().chain([b.parameter]).collect());
+        let Some((x, p, tangent, iterations)) = engine::step_after(
             self.family,
+            before.as_deref(),
             &from.unknowns,
             from.parameter,
             &t,

@@ -437,7 +437,17 @@ impl<'a> Run<'a> {
             if let Some(reason) = self.stop_reason(&last, points.len()) {
                 return end(specials, reason, false);
             }
-            let (x, p, tangent, iterations) = match self.step(&last, sign, ds) {
+            // Newton from the parabola through the last two points only
+            // where the step control is saturated (the next step is the
+            // maximum whatever the corrector's iterations): elsewhere fewer
+            // iterations would lengthen the steps and move the points.
+            let before = points
+                .len()
+                .checked_sub(2)
+                .map(|i| &points[i])
+                .filter(|_| ds >= self.opts.max_step);
+            let stepped = self.step_after(before, &last, sign, ds);
+            let (x, p, tangent, iterations) = match stepped {
                 Ok(Some(stepped)) => stepped,
                 Ok(None) => {
                     let Some(shorter) = self.control().after_failure(ds) else {

@@ -214,15 +214,13 @@ impl Run<'_> {
             Test::Bordered { right, left, entry } => {
                 self.bordered_with(&x, p, right, left, fx)?[*entry]
             }
-            Test::Eigenvalue(block) => {
-                self.tracker
-                    .nearest_zero(self.family, &x, p, *block)
-                    .ok()?
-                    .0
-            }
-            Test::EigenvalueOn(block, tracker) => {
-                tracker.nearest_zero(self.family, &x, p, *block).ok()?.0
-            }
+            Test::Eigenvalue(block) => self
+                .tracker
+                .trial_nearest_zero(self.family, &x, p, *block)
+                .ok()?,
+            Test::EigenvalueOn(block, tracker) => tracker
+                .trial_nearest_zero(self.family, &x, p, *block)
+                .ok()?,
         };
         Some((value, x, p, tangent))
     }
@@ -951,6 +949,13 @@ impl Run<'_> {
         (lo, hi): (f64, f64),
         test: &Test,
     ) -> Option<Root> {
+        // Each location's trials start their eigenpairs from the last
+        // trial's, the first from a full solve.
+        match test {
+            Test::Eigenvalue(_) => self.tracker.begin_trials(),
+            Test::EigenvalueOn(_, tracker) => tracker.begin_trials(),
+            _ => {}
+        }
         let span = hi - lo;
         let start = lo + 1e-12 * span;
         let lower = self.test_at(a, sign, start, None, test)?;

@@ -7,7 +7,8 @@
 //!
 //! Each point's eigenpairs start from the previous point's vectors
 //! ([`crate::numerics::subspace`]: a few shift-invert sweeps with
-//! Rayleigh–Ritz, certified by one Sturm count); the full solve runs only at
+//! Rayleigh–Ritz, certified by one Sturm count, which also gives the Morse
+//! index where the spectrum keeps clear of zero); the full solve runs only at
 //! the first point of a branch, on a constrained pencil, and where the warm
 //! start cannot vouch for its pairs.
 
@@ -76,6 +77,11 @@ pub struct Tracker {
     /// not on the shape, so along a branch that keeps the length it is
     /// assembled once (the same sums, so bit for bit the same matrices).
     masses: RefCell<Option<(FiniteElements, Vec<SymmetricBanded>)>>,
+    /// The block and eigenvectors (tracked and guard) of the last trial
+    /// point of an event's location ([`Tracker::trial_nearest_zero`]),
+    /// which start the next trial's eigenpairs; cleared when a location
+    /// begins ([`Tracker::begin_trials`]).
+    trials: RefCell<Option<(Block, Vec<Vec<f64>>)>>,
 }
 
 impl Tracker {
@@ -93,6 +99,7 @@ impl Tracker {
             previous: None,
             previous_values: None,
             masses: RefCell::new(None),
+            trials: RefCell::new(None),
         }
     }
 
@@ -120,6 +127,7 @@ impl Tracker {
             previous: None,
             previous_values: None,
             masses: RefCell::new(None),
+            trials: RefCell::new(None),
             ..self.clone()
         })
     }
@@ -262,7 +270,7 @@ impl Tracker {
                     // One tracked eigenvalue: it is both of the lowest two.
                     (b[0], *b.get(1).unwrap_or(&b[0]))
                 });
-            let pairs = self.pairs(bi, k, g, constraints, near)?;
+            let (pairs, certified_morse) = self.pairs(bi, k, g, constraints, near)?;
             let count = self.opts.eigenvalues();
             // Every block fills its `eigenvalues` columns of the diagram; a
             // mesh with fewer unknowns than that cannot (the eigensolver
@@ -291,8 +299,11 @@ impl Tracker {
                     .chain(guard.iter().cloned())
                     .collect::<Vec<_>>(),
             );
-            block_morse.push(
-                count_below_constrained(k, g, constraints, 0.0)
+            // The warm pairs' certificate gives the count below 0 where
+            // the spectrum keeps clear of it; else Sylvester's inertia of K.
+            let morse = match certified_morse {
+                Some(morse) => morse,
+                None => count_below_constrained(k, g, constraints, 0.0)
                     .below()
                     .ok_or_else(|| {
                         PointError::Eigen(format!(
@@ -300,7 +311,8 @@ impl Tracker {
                             self.blocks[bi].name()
                         ))
                     })?,
-            );
+            };
+            block_morse.push(morse);
         }
         Ok(Spectrum {
             tip: shape_samples
@@ -348,6 +360,62 @@ impl Tracker {
 }
 
 impl Tracker {
+    /// Forget the trial vectors: an event's location begins, and its first
+    /// trial solves in full, so that the location depends only on its
+    /// bracket (the same in a resumed run).
+    pub fn begin_trials(&self) {
+        *self.trials.borrow_mut() = None;
+    }
+
+    /// The eigenvalue of `block` nearest zero at (x, p), among the
+    /// `eigenvalues` lowest, at a trial point of an event's location: the
+    /// eigenpairs warm-started from the last trial's vectors
+    /// ([`lowest_eigenpairs_from`], certified by a Sturm count) where there
+    /// are such and the pencil is unconstrained, else the full solve; the
+    /// vectors are kept for the next trial. The located point's own
+    /// eigenvalue and null mode come from [`Tracker::nearest_zero`]'s full
+    /// solve. The warm pairs meet the backward error
+    /// [`crate::numerics::subspace::ACCEPT`], which moves an eigenvalue near
+    /// zero by round-off (4e-15 at 3e-7 on the Euler column) and so its
+    /// root in p by far less than the event tolerance.
+    pub fn trial_nearest_zero(
+        &self,
+        family: &Family,
+        x: &[f64],
+        p: f64,
+        block: Block,
+    ) -> Result<f64, PointError> {
+        let (_, mats, _, _) = self.matrices(family, x, p)?;
+        let bi = self
+            .blocks
+            .iter()
+            .position(|&b| b == block)
+            .expect("a tracked block");
+        let (k, g, constraints) = &mats[bi];
+        let count = self.opts.eigenvalues();
+        let start = self
+            .trials
+            .borrow_mut()
+            .take()
+            .filter(|(b, _)| *b == block && constraints.is_empty());
+        let warm = start.and_then(|(_, start)| lowest_eigenpairs_from(k, g, count, &start));
+        let pairs = match warm {
+            Some(warm) => warm.pairs,
+            None => lowest_eigenpairs_constrained(k, g, constraints, count + GUARD, None)
+                .or_else(|_| lowest_eigenpairs_constrained(k, g, constraints, count, None))
+                .map_err(|e| PointError::Eigen(e.to_string()))?,
+        };
+        let nearest = pairs.values[..count.min(pairs.values.len())]
+            .iter()
+            .copied()
+            .min_by(|a, b| a.abs().total_cmp(&b.abs()))
+            .ok_or_else(|| PointError::Eigen("no eigenvalue".into()))?;
+        if pairs.vectors.len() > count {
+            *self.trials.borrow_mut() = Some((block, pairs.vectors));
+        }
+        Ok(nearest)
+    }
+
     /// G of every block on the mesh `fe`, assembled only when the mesh
     /// differs from the last one's.
     fn masses_on(&self, fe: &FiniteElements) -> Vec<SymmetricBanded> {
@@ -368,7 +436,10 @@ impl Tracker {
     /// warm-started from the previous point's vectors when there are such
     /// and the pencil is unconstrained, else — or when the warm start
     /// cannot vouch for its pairs — the full solve, its shift placed by
-    /// `near` (the previous lowest two eigenvalues).
+    /// `near` (the previous lowest two eigenvalues). With them the Morse
+    /// index of the block where the warm start's certificate reads it
+    /// ([`crate::numerics::subspace::WarmPairs::count_below`] at 0), None
+    /// where it must be counted.
     fn pairs(
         &self,
         bi: usize,
@@ -376,7 +447,7 @@ impl Tracker {
         g: &SymmetricBanded,
         constraints: &Constraints,
         near: Option<(f64, f64)>,
-    ) -> Result<Eigenpairs, PointError> {
+    ) -> Result<(Eigenpairs, Option<usize>), PointError> {
         let count = self.opts.eigenvalues();
         let warm = self
             .previous
@@ -385,11 +456,15 @@ impl Tracker {
             .filter(|_| constraints.is_empty())
             .and_then(|start| lowest_eigenpairs_from(k, g, count, start));
         match warm {
-            Some(pairs) => Ok(pairs),
+            Some(warm) => {
+                let morse = warm.count_below(0.0);
+                Ok((warm.pairs, morse))
+            }
             // With the guard vectors when they converge too; else the
             // tracked ones alone (the next point then solves in full again).
             None => lowest_eigenpairs_constrained(k, g, constraints, count + GUARD, near)
                 .or_else(|_| lowest_eigenpairs_constrained(k, g, constraints, count, near))
+                .map(|pairs| (pairs, None))
                 .map_err(|e| PointError::Eigen(e.to_string())),
         }
     }

@@ -20,7 +20,10 @@
 mod corrector;
 mod trace;
 
-pub use corrector::{correct, newton_at_fixed_p, step, tangent, tangent_from, Corrected, Stepped};
+pub use corrector::{
+    correct, correct_from, curved_start, newton_at_fixed_p, step, step_after, tangent,
+    tangent_from, Corrected, Stepped,
+};
 pub use trace::{
     trace, StepControl, Trace, TraceEnd, TraceOptions, TracePoint, TracedEvent, TracedFold,
 };
