@@ -47,7 +47,7 @@ impl<'a> ShootingSystem<'a> {
             eq,
             segments: segments.max(1),
             tol,
-            dop: Dop853::new(eq.dim()),
+            dop: Dop853::with_room(eq.dim(), sensitivity_dimension(eq, segments)),
             scales,
             gauss: None,
             jumps: eq.jumps(),
@@ -523,6 +523,16 @@ impl<'a> ShootingSystem<'a> {
             .fold(0.0, f64::max);
         Ok((samples, drift, record))
     }
+}
+
+/// The length of the integrated vector with the most sensitivity columns
+/// a system of `segments` segments integrates: the state, a column per
+/// free value (n per interior node's identity seed) and the parameter
+/// column of [`ShootingSystem::evaluate_staircase_forced`].
+fn sensitivity_dimension(eq: &dyn RodEquations, segments: usize) -> usize {
+    let (n, p) = (eq.dim(), eq.unknowns());
+    let columns = if segments > 1 { n.max(p) } else { p };
+    n * (columns + 2)
 }
 
 /// The pieces of [a, b] on which the right-hand side is smooth: a jump s_k

@@ -38,6 +38,15 @@ pub struct PlanarEquations {
     /// The clamp's d1(0), d3(0): the in-plane axes x, z that every
     /// right-hand side evaluation projects the internal force on.
     axes: (Vector3<f64>, Vector3<f64>),
+    /// H22 where it is one number: a trusted energy that is uniform (no
+    /// explicit s, so ∂sM = 0 and ∂sH = 0) and quadratic (H independent of
+    /// κ, so ∂H/∂κ = 0). The right-hand side then calls no energy method:
+    /// four dynamic calls per evaluation of the linearized equations.
+    constant_h22: Option<f64>,
+    /// (n_x, n_z) of the tip force and of the distributed force on the
+    /// axes, where no point force makes n(s) piecewise: n(s) = P + f (L − s)
+    /// in the plane without forming the 3-vector at every evaluation.
+    force_on_axes: Option<[f64; 4]>,
 }
 
 impl PlanarEquations {
@@ -46,7 +55,26 @@ impl PlanarEquations {
     pub fn new(rod: Rod) -> Self {
         let units = rod.residual_scales();
         let axes = (rod.clamp().director(0), rod.clamp().director(2));
-        PlanarEquations { rod, units, axes }
+        let e = rod.energy();
+        let constant_h22 = (e.derivatives_trusted() && e.is_uniform() && e.is_quadratic())
+            .then(|| e.stiffness(0.0, &Vector3::zeros())[(1, 1)]);
+        let loads = rod.loads();
+        let force_on_axes = loads.point_forces.is_empty().then(|| {
+            let (p, f) = (loads.tip_force, loads.distributed_force);
+            [
+                p.dot(&axes.0),
+                p.dot(&axes.1),
+                f.dot(&axes.0),
+                f.dot(&axes.1),
+            ]
+        });
+        PlanarEquations {
+            rod,
+            units,
+            axes,
+            constant_h22,
+            force_on_axes,
+        }
     }
 
     fn kappa(k2: f64) -> Vector3<f64> {
@@ -64,26 +92,34 @@ impl PlanarEquations {
     /// (n_x, n_z): the internal force in the clamp frame's plane, with the
     /// reaction of a held tip.
     fn force_in_plane(&self, s: f64, y: &[f64]) -> (f64, f64) {
-        let n = self.rod.loads().internal_force(s, self.rod.length());
-        let (rx, rz) = if y.len() > 4 {
-            (y[4], y[5])
+        let (nx, nz) = if let Some([px, pz, fx, fz]) = &self.force_on_axes {
+            let arm = self.rod.length() - s;
+            (px + fx * arm, pz + fz * arm)
         } else {
-            (0.0, 0.0)
+            let n = self.rod.loads().internal_force(s, self.rod.length());
+            (n.dot(&self.axes.0), n.dot(&self.axes.1))
         };
-        (n.dot(&self.axes.0) + rx, n.dot(&self.axes.1) + rz)
+        if y.len() > 4 {
+            (nx + y[4], nz + y[5])
+        } else {
+            (nx, nz)
+        }
     }
 
     /// κ2' at (s, y) with the pieces its linearization and p-derivative
     /// share; ∂κ2'/∂(R_x, R_z) = (−cos φ, sin φ)/H22.
     fn curvature_rate(&self, s: f64, y: &[f64]) -> Curving {
-        let (phi, k2) = (y[2], y[3]);
-        let e = &self.rod.energy();
-        let kappa = Self::kappa(k2);
         let (nx, nz) = self.force_in_plane(s, y);
-        let (sin, cos) = phi.sin_cos();
+        let (sin, cos) = y[2].sin_cos();
         let n1 = nx * cos - nz * sin;
-        let h22 = e.stiffness(s, &kappa)[(1, 1)];
-        let rate = (-n1 - e.moment_rate(s, &kappa)[1]) / h22;
+        let (rate, h22) = if let Some(h22) = self.constant_h22 {
+            (-n1 / h22, h22)
+        } else {
+            let e = &self.rod.energy();
+            let kappa = Self::kappa(y[3]);
+            let h22 = e.stiffness(s, &kappa)[(1, 1)];
+            ((-n1 - e.moment_rate(s, &kappa)[1]) / h22, h22)
+        };
         Curving {
             rate,
             sin,
@@ -96,9 +132,12 @@ impl PlanarEquations {
 
     /// (∂κ2'/∂φ, ∂κ2'/∂κ2) at (s, y) given its [`Curving`].
     fn curvature_rate_slopes(&self, s: f64, y: &[f64], c: &Curving) -> (f64, f64) {
+        let dn1 = -c.nx * c.sin - c.nz * c.cos;
+        if self.constant_h22.is_some() {
+            return (-dn1 / c.h22, 0.0);
+        }
         let e = &self.rod.energy();
         let kappa = Self::kappa(y[3]);
-        let dn1 = -c.nx * c.sin - c.nz * c.cos;
         let t22 = e.stiffness_derivative(s, &kappa, &Self::kappa(c.rate))[(1, 1)];
         let hs22 = e.stiffness_rate(s, &kappa)[(1, 1)];
         (-dn1 / c.h22, -(hs22 + t22) / c.h22)

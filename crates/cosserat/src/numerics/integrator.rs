@@ -157,10 +157,22 @@ pub struct Dop853 {
 impl Dop853 {
     /// Storage for systems of dimension `n`.
     pub fn new(n: usize) -> Self {
+        Dop853::with_room(n, n)
+    }
+
+    /// Storage for systems of dimension `n`, with room for dimensions up
+    /// to `room` without reallocating: shooting alternates between the
+    /// state alone and the state with its sensitivities.
+    pub fn with_room(n: usize, room: usize) -> Self {
+        let vector = || {
+            let mut v = Vec::with_capacity(n.max(room));
+            v.resize(n, 0.0);
+            v
+        };
         Dop853 {
-            k: vec![vec![0.0; n]; 12],
-            stage: vec![0.0; n],
-            next: vec![0.0; n],
+            k: std::array::from_fn::<_, 12, _>(|_| vector()).into(),
+            stage: vector(),
+            next: vector(),
             dense: None,
             record: DenseRecord::new(n),
         }
@@ -173,9 +185,16 @@ impl Dop853 {
         std::mem::replace(&mut self.record, DenseRecord::new(n))
     }
 
+    /// Stage storage for dimension n, reusing the vectors' capacity: a
+    /// shooting solve alternates between the state with its sensitivities
+    /// and the state alone, which reallocated all fourteen vectors at every
+    /// switch. A record of another dimension starts empty.
     fn resize(&mut self, n: usize) {
         if self.stage.len() != n {
-            *self = Dop853::new(n);
+            for v in self.k.iter_mut().chain([&mut self.stage, &mut self.next]) {
+                v.resize(n, 0.0);
+            }
+            self.record = DenseRecord::new(n);
         }
     }
 
