@@ -146,6 +146,18 @@ pub fn solve<S: NonlinearSystem>(
     x0: &[f64],
     opts: &NewtonOptions,
 ) -> Result<NewtonReport, NewtonFailure> {
+    newton_dense(system, x0, opts).map(|(report, _, _)| report)
+}
+
+/// Damped Newton with the dense LU of the system's Jacobian: the report,
+/// the last correction δ (the one that passed the stopping test) and the
+/// solver's state, whose LU is that of J at the root.
+#[allow(clippy::type_complexity)]
+fn newton_dense<'a, S: NonlinearSystem>(
+    system: &'a mut S,
+    x0: &[f64],
+    opts: &NewtonOptions,
+) -> Result<(NewtonReport, Vec<f64>, Dense<'a, S>), NewtonFailure> {
     let n = system.size();
     let mut dense = Dense {
         system,
@@ -155,14 +167,19 @@ pub fn solve<S: NonlinearSystem>(
     };
     let mut x = x0.to_vec();
     let report = numerics_newton::solve(&mut dense, &mut x, &opts.damped())?;
-    Ok(NewtonReport {
-        x,
-        iterations: report.iterations,
-        history: report.history,
-        damped_steps: report.damped_steps,
-        contraction: report.contraction,
-        jacobian: dense.jac,
-    })
+    let jacobian = std::mem::replace(&mut dense.jac, DMatrix::zeros(0, 0));
+    Ok((
+        NewtonReport {
+            x,
+            iterations: report.iterations,
+            history: report.history,
+            damped_steps: report.damped_steps,
+            contraction: report.contraction,
+            jacobian,
+        },
+        report.correction,
+        dense,
+    ))
 }
 
 /// The most polishing steps [`solve_polished`] takes after convergence.
@@ -196,24 +213,8 @@ pub fn solve_polished<S: NonlinearSystem>(
     opts: &NewtonOptions,
 ) -> Result<NewtonReport, NewtonFailure> {
     let n = system.size();
-    let mut dense = Dense {
-        system,
-        r: DVector::zeros(n),
-        jac: DMatrix::zeros(n, n),
-        lu: crate::numerics::dense::DenseLu::default(),
-    };
-    let mut x = x0.to_vec();
-    let report = numerics_newton::solve(&mut dense, &mut x, &opts.damped())?;
-    let mut polished = NewtonReport {
-        x,
-        iterations: report.iterations,
-        history: report.history,
-        damped_steps: report.damped_steps,
-        contraction: report.contraction,
-        jacobian: dense.jac,
-    };
+    let (mut polished, mut delta, mut dense) = newton_dense(system, x0, opts)?;
     let test = numerics_newton::Convergence::new(opts.tolerance, dense.system.unknown_scales());
-    let mut delta = report.correction;
     let (mut r, mut jac) = (DVector::zeros(n), DMatrix::zeros(n, n));
     let mut trial = vec![0.0; n];
     for _ in 0..POLISH_STEPS {

@@ -338,11 +338,7 @@ impl Tracker {
         block: Block,
     ) -> Result<(f64, Vec<Vector3<f64>>), PointError> {
         let (fe, mats, _, _) = self.matrices(family, x, p)?;
-        let bi = self
-            .blocks
-            .iter()
-            .position(|&b| b == block)
-            .expect("a tracked block");
+        let bi = self.block_index(block);
         let (k, g, constraints) = &mats[bi];
         // The full solve, never the warm start: the located point and its
         // null mode (sign included) must not depend on the path that led
@@ -360,6 +356,15 @@ impl Tracker {
 }
 
 impl Tracker {
+    /// The index of `block` among the tracked blocks (the order of the
+    /// matrices); a block not tracked is a caller's error.
+    fn block_index(&self, block: Block) -> usize {
+        self.blocks
+            .iter()
+            .position(|&b| b == block)
+            .expect("a tracked block")
+    }
+
     /// Forget the trial vectors: an event's location begins, and its first
     /// trial solves in full, so that the location depends only on its
     /// bracket (the same in a resumed run).
@@ -386,11 +391,7 @@ impl Tracker {
         block: Block,
     ) -> Result<f64, PointError> {
         let (_, mats, _, _) = self.matrices(family, x, p)?;
-        let bi = self
-            .blocks
-            .iter()
-            .position(|&b| b == block)
-            .expect("a tracked block");
+        let bi = self.block_index(block);
         let (k, g, constraints) = &mats[bi];
         let count = self.opts.eigenvalues();
         let start = self
