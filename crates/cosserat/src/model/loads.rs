@@ -39,7 +39,7 @@ pub struct DeadLoads {
     pub tip_couple: Vector3<f64>,
     /// Force per unit reference length, uniform along the rod (N/m).
     pub distributed_force: Vector3<f64>,
-    /// Forces at interior points, in the order the problem gives them
+    /// Forces and couples at interior points, in the order the problem gives them
     /// (`[[loads.point]]`); the same point may appear twice.
     pub point_loads: Vec<PointLoad>,
 }
