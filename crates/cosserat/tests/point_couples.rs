@@ -146,10 +146,11 @@ fn a_stiffening_energy_takes_the_curvature_of_cardanos_root() {
     }
 }
 
-/// The exact Jacobian of multiple shooting across a couple (a skew couple
-/// with a tip force, on the quartic energy: the jump's linearization maps
-/// the directors' and the curvature's sensitivities) against central
-/// differences of the residual, away from the solution.
+/// The exact Jacobian of shooting across a couple (a skew couple with a
+/// tip force, on the quartic energy: the jump's linearization maps the
+/// directors' and the curvature's sensitivities) against central
+/// differences of the residual, away from the solution: single and
+/// multiple shooting, and segments that are single Gauss steps.
 #[test]
 fn the_shooting_jacobian_across_a_couple_matches_central_differences() {
     let linear = LinearElastic::uniform([2.0, 1.0, 1.5], [0.0; 3]).unwrap();
@@ -164,10 +165,15 @@ fn the_shooting_jacobian_across_a_couple_matches_central_differences() {
         ..Default::default()
     };
     let rod = Rod::new(1.0, Arc::new(energy), Clamp::paper(), loads, None).unwrap();
-    for (level, segments) in [
-        (ModelLevel::Kirchhoff, 1),
-        (ModelLevel::Kirchhoff, 3),
-        (ModelLevel::Planar, 3),
+    // (level, segments, Gauss stages): DOP853 segments, or single Gauss
+    // steps split at the couple (the fixed-mesh collocation equations
+    // continuation runs).
+    for (level, segments, gauss) in [
+        (ModelLevel::Kirchhoff, 1, None),
+        (ModelLevel::Kirchhoff, 3, None),
+        (ModelLevel::Planar, 3, None),
+        (ModelLevel::Kirchhoff, 4, Some(3)),
+        (ModelLevel::Planar, 4, Some(2)),
     ] {
         let eq = equations(&rod, level);
         let tol = Tolerances {
@@ -175,7 +181,12 @@ fn the_shooting_jacobian_across_a_couple_matches_central_differences() {
             atol: 1e-13,
             ..Tolerances::default()
         };
-        let mut system = ShootingSystem::new(eq.as_ref(), segments, tol);
+        let mut system = match gauss {
+            None => ShootingSystem::new(eq.as_ref(), segments, tol),
+            Some(stages) => {
+                ShootingSystem::collocation(eq.as_ref(), segments, stages, tol).unwrap()
+            }
+        };
         let guess: Vec<f64> = eq.initial_guess().iter().map(|u| u + 0.3).collect();
         let x = system.initial_unknowns(&guess);
         let size = system.size();
@@ -194,15 +205,16 @@ fn the_shooting_jacobian_across_a_couple_matches_central_differences() {
             worst = worst.max((column - jac.column(c)).amax());
         }
         eprintln!(
-            "{level:?}, K = {segments}: |J − FD| = {worst:e}, |J| = {:e}",
+            "{level:?}, K = {segments}, Gauss {gauss:?}: |J − FD| = {worst:e}, |J| = {:e}",
             jac.amax()
         );
         // Central differences: O(h²) ≈ 1e-12 plus the integration's
-        // error over h; measured ≈ 1e-9 relative, where a jump without
-        // its linearization of the directors is off by 1e-1.
+        // error over h; measured ≤ 4e-10 relative, where a jump without
+        // its linearization (the directors' term, or the planar H⁻/H⁺) is
+        // off by 1e-1.
         assert!(
             worst <= 1e-7 * jac.amax(),
-            "{level:?}, K = {segments}: {worst:e} against |J| = {:e}",
+            "{level:?}, K = {segments}, Gauss {gauss:?}: {worst:e} against |J| = {:e}",
             jac.amax()
         );
     }

@@ -598,13 +598,18 @@ impl RodEquations for PlanarEquations {
     }
 }
 
-/// The moment at the clamp, m(0) = C + (r(L) − r(0)) × P + ∫ (r − r(0)) × f,
-/// on the straight rod r(s) = r(0) + s d3(0) (global components).
+/// The moment at the clamp, m(0) = C + Σ C_k + (r(L) − r(0)) × P +
+/// ∫ (r − r(0)) × f, on the straight rod r(s) = r(0) + s d3(0) (global
+/// components): every couple beyond s = 0 acts on the clamp undiminished.
+/// The point forces' arms are left out (a guess only; Newton and the ramp
+/// take it from there).
 pub(crate) fn straight_rod_clamp_moment(rod: &Rod) -> Vector3<f64> {
     let t = rod.clamp().director(2);
     let l = rod.length();
     let loads = &rod.loads();
+    let point_couples: Vector3<f64> = loads.point_loads.iter().map(|p| p.couple).sum();
     loads.tip_couple
+        + point_couples
         + (t * l).cross(&loads.tip_force)
         + (t * (0.5 * l * l)).cross(&loads.distributed_force)
 }
