@@ -641,10 +641,15 @@ fn served_pieces<'s>(
     for (i, &piece) in ps.iter().enumerate() {
         let upto = ps.get(i + 1).map_or(b, |next| next.from);
         let last = i + 1 == ps.len();
-        let count = rest
-            .iter()
-            .take_while(|&&s| s < upto || (last && closed && s <= upto))
-            .count();
+        // A piece that is not integrated (two jumps an ulp apart) serves
+        // nothing: its stops roll over to the next.
+        let count = if piece.to > piece.from {
+            rest.iter()
+                .take_while(|&&s| s < upto || (last && closed && s <= upto))
+                .count()
+        } else {
+            0
+        };
         let (mine, others) = rest.split_at(count);
         // A stop in the ulp between the piece's end and the jump is read
         // at the piece's end.
@@ -686,5 +691,51 @@ impl NonlinearSystem for ShootingSystem<'_> {
         self.evaluate_staircase(x, r, &mut a)?;
         a.write_dense(jac);
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_jump_ends_a_piece_an_ulp_below_and_is_applied_after_it() {
+        let half = 0.5_f64;
+        assert_eq!(
+            pieces(&[half], 0.0, 1.0),
+            vec![
+                Piece {
+                    from: 0.0,
+                    to: half.next_down(),
+                    jump: Some(half),
+                },
+                Piece {
+                    from: half,
+                    to: 1.0,
+                    jump: None,
+                },
+            ]
+        );
+        // A jump on the segment's end: applied there (node states are
+        // right limits); one on its start belongs to the segment before.
+        assert_eq!(
+            pieces(&[half], 0.0, half),
+            vec![Piece {
+                from: 0.0,
+                to: half.next_down(),
+                jump: Some(half),
+            }]
+        );
+        assert_eq!(pieces(&[half], half, 1.0).len(), 1);
+    }
+
+    #[test]
+    fn a_piece_that_is_not_integrated_serves_no_stop() {
+        let close = 0.5_f64.next_up();
+        let stops = [0.5, 0.75, 1.0];
+        let served = served_pieces(&[close], 0.5, 1.0, &stops, true);
+        assert_eq!(served.len(), 2);
+        assert!(served[0].0.to <= served[0].0.from && served[0].1.is_empty());
+        assert_eq!(served[1].1, &stops[..]);
     }
 }
