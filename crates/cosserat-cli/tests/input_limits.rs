@@ -224,7 +224,7 @@ fn a_hanging_arm_has_no_critical_load() {
                 tip_force: Vector3::new(1.0, 0.0, 0.0),
                 tip_couple: Vector3::zeros(),
                 distributed_force: Vector3::zeros(),
-                point_forces: Vec::new(),
+                point_loads: Vec::new(),
             },
             None,
         )

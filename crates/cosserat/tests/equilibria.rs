@@ -161,7 +161,7 @@ fn single_and_multiple_shooting_agree() {
                 tip_force: Vector3::new(0.6, 0.2, -0.1),
                 tip_couple: Vector3::new(0.0, 0.1, 0.2),
                 distributed_force: Vector3::new(0.3, 0.0, 0.0),
-                point_forces: Vec::new(),
+                point_loads: Vec::new(),
             },
             None,
         )

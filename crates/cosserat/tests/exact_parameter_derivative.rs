@@ -44,7 +44,7 @@ fn planar_rod() -> Rod {
             tip_force: Vector3::new(0.6, 0.0, -1.1),
             tip_couple: Vector3::new(0.0, 0.3, 0.0),
             distributed_force: Vector3::new(0.4, 0.0, -0.2),
-            point_forces: Vec::new(),
+            point_loads: Vec::new(),
         },
         None,
     )
@@ -61,7 +61,7 @@ fn spatial_rod() -> Rod {
             tip_force: Vector3::new(0.5, -0.4, -0.9),
             tip_couple: Vector3::new(0.1, 0.2, -0.15),
             distributed_force: Vector3::new(0.3, 0.2, -0.1),
-            point_forces: Vec::new(),
+            point_loads: Vec::new(),
         },
         None,
     )

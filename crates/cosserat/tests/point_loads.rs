@@ -10,7 +10,7 @@ use cosserat::continuation::{
     continuation, DerivativeMethod, Diagram, Location, SpecialKind, SpecialPoint,
 };
 use cosserat::input::{Problem, ProblemError};
-use cosserat::model::{DeadLoads, ModelChoice, ModelLevel, PointForce, Rod};
+use cosserat::model::{DeadLoads, ModelChoice, ModelLevel, PointLoad, Rod};
 use cosserat::references::CantileverTip;
 use cosserat::references::{arch_elastica_folds, strip_elastica_fold};
 use cosserat::stability::StabilityOptions;
@@ -22,10 +22,7 @@ use support::parameter_derivative::richardson_parameter_derivative;
 /// F e1 at s₀.
 fn loaded_at(s0: f64, force: f64) -> Rod {
     let loads = DeadLoads {
-        point_forces: vec![PointForce {
-            s: s0,
-            force: Vector3::new(force, 0.0, 0.0),
-        }],
+        point_loads: vec![PointLoad::force(s0, Vector3::new(force, 0.0, 0.0))],
         ..Default::default()
     };
     support::rods::uniform(1.0, [10.0, 1.0, 10.0], loads)
@@ -243,10 +240,7 @@ fn a_column_pressed_inside_buckles_as_the_column_up_to_the_force() {
     let b2 = 1.0;
     let critical = std::f64::consts::PI.powi(2) * b2 / (4.0 * s0 * s0);
     let loads = DeadLoads {
-        point_forces: vec![PointForce {
-            s: s0,
-            force: Vector3::new(0.0, 0.0, -critical),
-        }],
+        point_loads: vec![PointLoad::force(s0, Vector3::new(0.0, 0.0, -critical))],
         ..Default::default()
     };
     let rod = support::rods::uniform(1.0, [10.0, b2, 10.0], loads);
@@ -280,8 +274,8 @@ fn refused_field(text: &str, sets: &[&str]) -> String {
 }
 
 /// Hostile point loads and links are refused by the key they come from:
-/// a point outside (0, L) or not finite, a non-finite force, a couple (not
-/// carried yet); an unknown, repeated, self-linked or non-numeric linked
+/// a point outside (0, L) or not finite, a non-finite force or couple, a
+/// couple on collocation (which does not carry its jump); an unknown, repeated, self-linked or non-numeric linked
 /// key, a zero factor, and a file value that is not the link's at the
 /// start.
 #[test]
@@ -296,7 +290,14 @@ fn hostile_point_loads_and_links_are_refused_by_name() {
             "loads.point[0].force[1]",
         ),
         (
-            &["loads.point[0].couple=[0.0, 1.0, 0.0]"][..],
+            &["loads.point[0].couple=[0.0, nan, 0.0]"][..],
+            "loads.point[0].couple[1]",
+        ),
+        (
+            &[
+                "loads.point[0].couple=[0.0, 1.0, 0.0]",
+                "solver.method=\"collocation\"",
+            ][..],
             "loads.point[0].couple",
         ),
     ];

@@ -392,7 +392,7 @@ fn general_linearization_matches_differences() {
         tip_force: Vector3::new(0.5, -0.3, 0.8),
         tip_couple: Vector3::zeros(),
         distributed_force: Vector3::new(0.2, 0.4, -0.3),
-        point_forces: Vec::new(),
+        point_loads: Vec::new(),
     };
     let free = rod(energy.clone(), loads.clone());
     let support = TipSupport {

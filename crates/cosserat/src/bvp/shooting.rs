@@ -119,12 +119,25 @@ impl<'a> ShootingSystem<'a> {
         let span = pieces(&self.jumps, self.node(j), self.node(j + 1));
         if let Some(stepper) = &mut self.gauss {
             // A jump inside the interval splits the Gauss step there: the
-            // state and its sensitivities are continuous across a point
-            // force, so the pieces chain.
+            // pieces chain through the state's jump (the identity at a
+            // point force, the curvature's at a point couple).
             let mut y = (start.to_vec(), phi0.clone());
-            for (a, b) in span {
-                self.stats.accepted += 1;
-                y = stepper.step(self.eq, a, b - a, &y.0, &y.1, forcing)?;
+            for piece in span {
+                if piece.to > piece.from {
+                    self.stats.accepted += 1;
+                    y = stepper.step(
+                        self.eq,
+                        piece.from,
+                        piece.to - piece.from,
+                        &y.0,
+                        &y.1,
+                        forcing,
+                    )?;
+                }
+                if let Some(s) = piece.jump {
+                    let cols = y.1.ncols();
+                    self.eq.jump(s, &mut y.0, cols, y.1.as_mut_slice())?;
+                }
             }
             return Ok(y);
         }
@@ -148,13 +161,17 @@ impl<'a> ShootingSystem<'a> {
         // the steps grow until Φ, and so the Jacobian and the location of
         // its singularities, is wrong.
         let controlled = y.len();
-        // The state and Φ are continuous across a point force: the pieces
-        // between jumps chain with the same y.
-        for (a, b) in span {
+        // The pieces between jumps chain with the same y, carried across
+        // each jump with Φ (continuous at a point force).
+        for piece in span {
+            if piece.to <= piece.from {
+                jump_with_sensitivities(eq, piece.jump, &mut y, n, cols)?;
+                continue;
+            }
             let stats = self.dop.integrate(
                 &mut rhs,
-                a,
-                b,
+                piece.from,
+                piece.to,
                 &mut y,
                 controlled,
                 &self.tol,
@@ -171,6 +188,7 @@ impl<'a> ShootingSystem<'a> {
                 },
             )?;
             self.stats += stats;
+            jump_with_sensitivities(eq, piece.jump, &mut y, n, cols)?;
         }
         let phi = DMatrix::from_column_slice(n, cols, &y[n..]);
         y.truncate(n);
@@ -189,19 +207,24 @@ impl<'a> ShootingSystem<'a> {
         for j in 1..self.segments {
             if alive {
                 let eq = self.eq;
-                for (a, b) in pieces(&self.jumps, self.node(j - 1), self.node(j)) {
-                    let out = self.dop.integrate(
-                        |s, y: &[f64], d: &mut [f64]| eq.rhs(s, y, d),
-                        a,
-                        b,
-                        &mut y,
-                        n,
-                        &self.tol,
-                        &[],
-                        |_, _| {},
-                        |y| eq.project(y),
-                    );
-                    alive = alive && out.is_ok();
+                for piece in pieces(&self.jumps, self.node(j - 1), self.node(j)) {
+                    if piece.to > piece.from {
+                        let out = self.dop.integrate(
+                            |s, y: &[f64], d: &mut [f64]| eq.rhs(s, y, d),
+                            piece.from,
+                            piece.to,
+                            &mut y,
+                            n,
+                            &self.tol,
+                            &[],
+                            |_, _| {},
+                            |y| eq.project(y),
+                        );
+                        alive = alive && out.is_ok();
+                    }
+                    if let (Some(s), true) = (piece.jump, alive) {
+                        alive = eq.jump(s, &mut y, 0, &mut []).is_ok();
+                    }
                 }
             }
             if !alive {
@@ -240,18 +263,21 @@ impl<'a> ShootingSystem<'a> {
             let eq = self.eq;
             // The new nodes read from the continuous extension: a fine mesh
             // costs the steps the tolerance needs, not one per node.
-            for (pa, pb, stops) in served_pieces(&self.jumps, a, b, &stops, false) {
-                let stats = self.dop.integrate_serving(
-                    |s, y: &[f64], d: &mut [f64]| eq.rhs(s, y, d),
-                    (pa, pb, n),
-                    &mut y,
-                    &self.tol,
-                    stops,
-                    Stops::Interpolated,
-                    |_, y| out.extend_from_slice(&y[..n]),
-                    |y| eq.project(y),
-                )?;
-                self.stats += stats;
+            for (piece, stops) in served_pieces(&self.jumps, a, b, &stops, false) {
+                if piece.to > piece.from {
+                    let stats = self.dop.integrate_serving(
+                        |s, y: &[f64], d: &mut [f64]| eq.rhs(s, y, d),
+                        (piece.from, piece.to, n),
+                        &mut y,
+                        &self.tol,
+                        stops,
+                        Stops::Interpolated,
+                        |_, y| out.extend_from_slice(&y[..n]),
+                        |y| eq.project(y),
+                    )?;
+                    self.stats += stats;
+                }
+                jump_with_sensitivities(eq, piece.jump, &mut y, n, 0)?;
             }
         }
         debug_assert_eq!(out.len(), p + n * fine.len());
@@ -502,19 +528,22 @@ impl<'a> ShootingSystem<'a> {
                 .collect();
             let mut y = self.node_state(x, j);
             let eq = self.eq;
-            for (pa, pb, stops) in served_pieces(&self.jumps, a, b, &stops, last) {
-                let stats = self.dop.integrate_serving(
-                    |s, y: &[f64], d: &mut [f64]| eq.rhs(s, y, d),
-                    (pa, pb, n),
-                    &mut y,
-                    &self.tol,
-                    stops,
-                    serve,
-                    |s, y| samples.push(eq.sample(s, y)),
-                    |y| eq.project(y),
-                )?;
-                record.append(self.dop.take_record());
-                self.stats += stats;
+            for (piece, stops) in served_pieces(&self.jumps, a, b, &stops, last) {
+                if piece.to > piece.from {
+                    let stats = self.dop.integrate_serving(
+                        |s, y: &[f64], d: &mut [f64]| eq.rhs(s, y, d),
+                        (piece.from, piece.to, n),
+                        &mut y,
+                        &self.tol,
+                        stops,
+                        serve,
+                        |s, y| samples.push(eq.sample(s, y)),
+                        |y| eq.project(y),
+                    )?;
+                    record.append(self.dop.take_record());
+                    self.stats += stats;
+                }
+                jump_with_sensitivities(eq, piece.jump, &mut y, n, 0)?;
             }
         }
         let drift = samples
@@ -535,24 +564,63 @@ fn sensitivity_dimension(eq: &dyn RodEquations, segments: usize) -> usize {
     n * (columns + 2)
 }
 
+/// Carries `y` (the state, then `cols` sensitivity columns of it) across
+/// `jump` where there is one ([`RodEquations::jump`]).
+fn jump_with_sensitivities(
+    eq: &dyn RodEquations,
+    jump: Option<f64>,
+    y: &mut [f64],
+    n: usize,
+    cols: usize,
+) -> Result<(), IntegrationError> {
+    let Some(s) = jump else {
+        return Ok(());
+    };
+    let (state, phi) = y.split_at_mut(n);
+    eq.jump(s, state, cols, &mut phi[..n * cols])
+}
+
+/// One piece of an integration: [from, to] on which the right-hand side
+/// is smooth, and the jump s_k that follows it, if any.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Piece {
+    from: f64,
+    to: f64,
+    /// The point s_k just above `to` across which the state is carried by
+    /// [`RodEquations::jump`] before the next piece (or the next segment's
+    /// node, a right limit) starts there.
+    jump: Option<f64>,
+}
+
 /// The pieces of [a, b] on which the right-hand side is smooth: a jump s_k
 /// in (a, b] ends a piece at the float just below s_k (so that every
 /// evaluation on it, the step's last stage included, sees the left limit
-/// n(s_k⁻)) and, if s_k < b, starts the next at s_k (where the right-hand
-/// side is the right limit, [`crate::model::DeadLoads::internal_force`]).
-/// The ulp left out moves the state by O(ε |y'|). One piece without jumps.
-fn pieces(jumps: &[f64], a: f64, b: f64) -> Vec<(f64, f64)> {
+/// n(s_k⁻)), the state is carried across s_k ([`RodEquations::jump`]: a
+/// point couple's moment jump; the identity at a point force) and, if
+/// s_k < b, the next piece starts at s_k (where the right-hand side is the
+/// right limit, [`crate::model::DeadLoads::internal_force`]). A jump at b
+/// itself is applied at the end: node states are right limits, so the
+/// matching condition at a node on s_k compares right limits. The ulp left
+/// out moves the state by O(ε |y'|). One piece without jumps; a piece
+/// with `to ≤ from` (two jumps an ulp apart) is not integrated, its jump
+/// still applied.
+fn pieces(jumps: &[f64], a: f64, b: f64) -> Vec<Piece> {
     let mut out = Vec::with_capacity(1);
     let mut start = a;
     for &s in jumps.iter().filter(|&&s| s > a && s <= b) {
-        let end = s.next_down();
-        if end > start {
-            out.push((start, end));
-        }
+        out.push(Piece {
+            from: start,
+            to: s.next_down(),
+            jump: Some(s),
+        });
         start = s;
     }
     if start < b {
-        out.push((start, b));
+        out.push(Piece {
+            from: start,
+            to: b,
+            jump: None,
+        });
     }
     out
 }
@@ -566,21 +634,26 @@ fn served_pieces<'s>(
     b: f64,
     stops: &'s [f64],
     closed: bool,
-) -> Vec<(f64, f64, &'s [f64])> {
+) -> Vec<(Piece, &'s [f64])> {
     let ps = pieces(jumps, a, b);
     let mut out = Vec::with_capacity(ps.len());
     let mut rest = stops;
-    for (i, &(pa, pb)) in ps.iter().enumerate() {
-        let upto = ps.get(i + 1).map_or(b, |next| next.0);
+    for (i, &piece) in ps.iter().enumerate() {
+        let upto = ps.get(i + 1).map_or(b, |next| next.from);
         let last = i + 1 == ps.len();
-        let count = rest
-            .iter()
-            .take_while(|&&s| s < upto || (last && closed && s <= upto))
-            .count();
+        // A piece that is not integrated (two jumps an ulp apart) serves
+        // nothing: its stops roll over to the next.
+        let count = if piece.to > piece.from {
+            rest.iter()
+                .take_while(|&&s| s < upto || (last && closed && s <= upto))
+                .count()
+        } else {
+            0
+        };
         let (mine, others) = rest.split_at(count);
         // A stop in the ulp between the piece's end and the jump is read
         // at the piece's end.
-        out.push((pa, pb, mine));
+        out.push((piece, mine));
         rest = others;
     }
     out
@@ -618,5 +691,51 @@ impl NonlinearSystem for ShootingSystem<'_> {
         self.evaluate_staircase(x, r, &mut a)?;
         a.write_dense(jac);
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_jump_ends_a_piece_an_ulp_below_and_is_applied_after_it() {
+        let half = 0.5_f64;
+        assert_eq!(
+            pieces(&[half], 0.0, 1.0),
+            vec![
+                Piece {
+                    from: 0.0,
+                    to: half.next_down(),
+                    jump: Some(half),
+                },
+                Piece {
+                    from: half,
+                    to: 1.0,
+                    jump: None,
+                },
+            ]
+        );
+        // A jump on the segment's end: applied there (node states are
+        // right limits); one on its start belongs to the segment before.
+        assert_eq!(
+            pieces(&[half], 0.0, half),
+            vec![Piece {
+                from: 0.0,
+                to: half.next_down(),
+                jump: Some(half),
+            }]
+        );
+        assert_eq!(pieces(&[half], half, 1.0).len(), 1);
+    }
+
+    #[test]
+    fn a_piece_that_is_not_integrated_serves_no_stop() {
+        let close = 0.5_f64.next_up();
+        let stops = [0.5, 0.75, 1.0];
+        let served = served_pieces(&[close], 0.5, 1.0, &stops, true);
+        assert_eq!(served.len(), 2);
+        assert!(served[0].0.to <= served[0].0.from && served[0].1.is_empty());
+        assert_eq!(served[1].1, &stops[..]);
     }
 }

@@ -27,6 +27,7 @@ use nalgebra::{DMatrix, Matrix3, Vector3};
 
 use std::sync::{Arc, Mutex};
 
+use super::moment_jump::curvature_for_moment;
 use super::planar::straight_rod_clamp_moment;
 use super::strained::Strained;
 use super::tip::{condition_rates, conditions, rates_cover, TipRates, TipState};
@@ -34,6 +35,7 @@ use super::{RodEquations, RodSample};
 use crate::model::{
     ResidualScales, Rod, RodTangent, StoredEnergy, StrainEnergy, StrainError, TipSupport,
 };
+use crate::numerics::integrator::IntegrationError;
 use crate::numerics::newton::{self, Convergence, Damping, Options, System};
 
 /// The 9-ODE Kirchhoff equations (12 with the position), or the Cosserat
@@ -442,6 +444,59 @@ impl RodEquations for KirchhoffEquations {
 
     fn jumps(&self) -> Vec<f64> {
         self.rod.breaks()
+    }
+
+    fn state_jumps(&self) -> bool {
+        self.rod.loads().has_point_couples()
+    }
+
+    /// A point couple C drops the moment by C (global): M⁺ = M⁻ + J with
+    /// J_i = −C·d_i, the directors continuous; κ⁺ from ∇W(s, κ⁺) = M⁺ by
+    /// Newton, and dκ⁺ = H⁺⁻¹ (H⁻ dκ⁻ + dJ), dJ_i = −C·δd_i (δd3 =
+    /// δd1 × d2 + d1 × δd2). Not on the general Cosserat path, whose
+    /// moment also depends on the strain ν (refused by name).
+    fn jump(
+        &self,
+        s: f64,
+        y: &mut [f64],
+        cols: usize,
+        phi: &mut [f64],
+    ) -> Result<(), IntegrationError> {
+        let drop = self.rod.loads().moment_jump(s);
+        if drop == Vector3::zeros() {
+            return Ok(());
+        }
+        if self.strained {
+            return Err(IntegrationError::JumpWithoutValue {
+                s,
+                reason: "a point couple is not carried on the general W(s, κ, ν) path",
+            });
+        }
+        let n = self.dim();
+        let st = State::read(y);
+        let e = self.rod.energy();
+        let left = s.next_down();
+        let body = |v: &Vector3<f64>| Vector3::new(v.dot(&st.d1), v.dot(&st.d2), v.dot(&st.d3));
+        let target = e.moment(left, &st.kappa) + body(&drop);
+        let (kappa, h_after) = curvature_for_moment(e.as_ref(), s, &st.kappa, &target)
+            .map_err(|reason| IntegrationError::JumpWithoutValue { s, reason })?;
+        let h_before = e.stiffness(left, &st.kappa);
+        let lu = h_after.lu();
+        for c in 0..cols {
+            let v = &mut phi[n * c..n * (c + 1)];
+            let dd1 = Vector3::new(v[0], v[1], v[2]);
+            let dd2 = Vector3::new(v[3], v[4], v[5]);
+            let dd3 = dd1.cross(&st.d2) + st.d1.cross(&dd2);
+            let dk = Vector3::new(v[6], v[7], v[8]);
+            let dm = h_before * dk + Vector3::new(drop.dot(&dd1), drop.dot(&dd2), drop.dot(&dd3));
+            let dk_after = lu.solve(&dm).ok_or(IntegrationError::JumpWithoutValue {
+                s,
+                reason: "the energy's Hessian is singular after the jump",
+            })?;
+            v[6..9].copy_from_slice(dk_after.as_slice());
+        }
+        y[6..9].copy_from_slice(kappa.as_slice());
+        Ok(())
     }
 
     fn initial_state(&self, u: &[f64], y0: &mut [f64]) {

@@ -8,6 +8,7 @@
 //! Shooting and the other BVP methods see only this interface.
 
 mod kirchhoff;
+mod moment_jump;
 mod planar;
 mod strained;
 mod tip;
@@ -18,6 +19,7 @@ pub use planar::PlanarEquations;
 use nalgebra::{DMatrix, Vector3};
 
 use crate::model::RodTangent;
+use crate::numerics::integrator::IntegrationError;
 
 /// The rod's state at one arc length, in the quantities users read.
 #[derive(Debug, Clone, PartialEq)]
@@ -50,6 +52,28 @@ pub trait RodEquations: Send + Sync {
     /// right-hand side of one side at the other's s (the right-hand side
     /// at s = s_k is the right limit).
     fn jumps(&self) -> Vec<f64>;
+    /// Whether the state itself jumps at some point of [`Self::jumps`]
+    /// (a point couple makes the moment, and so the curvature, jump): the
+    /// solvers that do not call [`Self::jump`] refuse such equations.
+    fn state_jumps(&self) -> bool {
+        false
+    }
+    /// Carries the state across the interior point s (one of
+    /// [`Self::jumps`]): `y` holds the left limit y(s⁻) on entry and the
+    /// right limit y(s⁺) on return, and the `cols` tangent vectors in
+    /// `phi` (dim × cols, column-major) are mapped by the jump's
+    /// linearization ∂y⁺/∂y⁻. The identity where the state is continuous
+    /// (the default, and every point without a couple); an error with the
+    /// reason where the state after the jump has no value.
+    fn jump(
+        &self,
+        _s: f64,
+        _y: &mut [f64],
+        _cols: usize,
+        _phi: &mut [f64],
+    ) -> Result<(), IntegrationError> {
+        Ok(())
+    }
     /// y(0) for the free initial values u.
     fn initial_state(&self, u: &[f64], y0: &mut [f64]);
     /// ∂y(0)/∂u (dim × unknowns); y(0) is affine in u.

@@ -24,8 +24,10 @@
 
 use nalgebra::{DMatrix, Vector3};
 
+use super::moment_jump::bending_for_moment;
 use super::{RodEquations, RodSample};
 use crate::model::{Freedom, ResidualScales, Rod, RodTangent, TipSupport};
+use crate::numerics::integrator::IntegrationError;
 
 /// The 4-ODE planar equations of a rod.
 #[derive(Debug, Clone)]
@@ -59,7 +61,7 @@ impl PlanarEquations {
         let constant_h22 = (e.derivatives_trusted() && e.is_uniform() && e.is_quadratic())
             .then(|| e.stiffness(0.0, &Vector3::zeros())[(1, 1)]);
         let loads = rod.loads();
-        let force_on_axes = loads.point_forces.is_empty().then(|| {
+        let force_on_axes = loads.point_loads.is_empty().then(|| {
             let (p, f) = (loads.tip_force, loads.distributed_force);
             [
                 p.dot(&axes.0),
@@ -322,6 +324,47 @@ impl RodEquations for PlanarEquations {
         self.rod.breaks()
     }
 
+    fn state_jumps(&self) -> bool {
+        self.rod.loads().has_point_couples()
+    }
+
+    /// A point couple C along d2 drops M2 by C·d2 (d2 is constant in the
+    /// plane, so the jump does not depend on the state): κ2⁺ from
+    /// ∂W/∂κ2(s, κ2⁺) = M2⁻ − C·d2, and dκ2⁺ = (H22⁻/H22⁺) dκ2⁻.
+    fn jump(
+        &self,
+        s: f64,
+        y: &mut [f64],
+        cols: usize,
+        phi: &mut [f64],
+    ) -> Result<(), IntegrationError> {
+        let drop = self
+            .rod
+            .loads()
+            .moment_jump(s)
+            .dot(&self.rod.clamp().director(1));
+        if drop == 0.0 {
+            return Ok(());
+        }
+        let n = self.dim();
+        let (k2, ratio) = if let Some(h22) = self.constant_h22 {
+            (y[3] + drop / h22, 1.0)
+        } else {
+            let e = self.rod.energy();
+            let before = Self::kappa(y[3]);
+            let left = s.next_down();
+            let target = e.moment(left, &before)[1] + drop;
+            let (k2, h_after) = bending_for_moment(e.as_ref(), s, y[3], target)
+                .map_err(|reason| IntegrationError::JumpWithoutValue { s, reason })?;
+            (k2, e.stiffness(left, &before)[(1, 1)] / h_after)
+        };
+        y[3] = k2;
+        for c in 0..cols {
+            phi[n * c + 3] *= ratio;
+        }
+        Ok(())
+    }
+
     fn initial_state(&self, u: &[f64], y0: &mut [f64]) {
         y0[..3].fill(0.0);
         y0[3..].copy_from_slice(u);
@@ -555,13 +598,18 @@ impl RodEquations for PlanarEquations {
     }
 }
 
-/// The moment at the clamp, m(0) = C + (r(L) − r(0)) × P + ∫ (r − r(0)) × f,
-/// on the straight rod r(s) = r(0) + s d3(0) (global components).
+/// The moment at the clamp, m(0) = C + Σ C_k + (r(L) − r(0)) × P +
+/// ∫ (r − r(0)) × f, on the straight rod r(s) = r(0) + s d3(0) (global
+/// components): every couple beyond s = 0 acts on the clamp undiminished.
+/// The point forces' arms are left out (a guess only; Newton and the ramp
+/// take it from there).
 pub(crate) fn straight_rod_clamp_moment(rod: &Rod) -> Vector3<f64> {
     let t = rod.clamp().director(2);
     let l = rod.length();
     let loads = &rod.loads();
+    let point_couples: Vector3<f64> = loads.point_loads.iter().map(|p| p.couple).sum();
     loads.tip_couple
+        + point_couples
         + (t * l).cross(&loads.tip_force)
         + (t * (0.5 * l * l)).cross(&loads.distributed_force)
 }

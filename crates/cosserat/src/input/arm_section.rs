@@ -101,7 +101,7 @@ fn default_true() -> bool {
 fn downward(rod: &Rod) -> Result<(f64, f64), ProblemError> {
     let l = &rod.loads();
     let down = |v: &nalgebra::Vector3<f64>| v[1] == 0.0 && v[2] == 0.0 && v[0] >= 0.0;
-    if !l.point_forces.is_empty() {
+    if !l.point_loads.is_empty() {
         return Err(invalid(
             "loads.point",
             "the arm takes a tip force and its weight only, no [[loads.point]]",

@@ -74,10 +74,10 @@ pub enum ModelError {
         value: f64,
     },
     /// A point load (`index` k from 0, in the order given) is not at an
-    /// interior point 0 < s < L, or its force is not finite.
+    /// interior point 0 < s < L, or its force or couple is not finite.
     #[error(
-        "point load {index} must act at an interior point 0 < s < {length} with a finite force, \
-         got s = {s}, force {force:?}"
+        "point load {index} must act at an interior point 0 < s < {length} with a finite force \
+         and couple, got s = {s}, force {force:?}, couple {couple:?}"
     )]
     PointLoad {
         /// Which point load, from 0.
@@ -86,6 +86,8 @@ pub enum ModelError {
         s: f64,
         /// Its force.
         force: [f64; 3],
+        /// Its couple.
+        couple: [f64; 3],
         /// The rod length.
         length: f64,
     },

@@ -105,14 +105,20 @@ fn planar_obstruction(rod: &Rod) -> Option<String> {
     let normal = rod.clamp().director(1);
     let loads = &rod.loads();
     let scale = loads
-        .point_forces
+        .point_loads
         .iter()
-        .map(|p| p.force.norm() * p.s)
+        .map(|p| (p.force.norm() * p.s).max(p.couple.norm()))
         .fold(loads.moment_scale(rod.length()), f64::max)
         .max(f64::MIN_POSITIVE);
-    for (k, p) in loads.point_forces.iter().enumerate() {
+    for (k, p) in loads.point_loads.iter().enumerate() {
         if (p.force.dot(&normal) * p.s).abs() > PLANE_TOLERANCE * scale {
             return Some(format!("point force {k} has a component along d2(0)"));
+        }
+        // A couple along the plane's normal bends in the plane, as the tip
+        // couple does.
+        let c = p.couple - normal * p.couple.dot(&normal);
+        if c.norm() > PLANE_TOLERANCE * scale {
+            return Some(format!("point couple {k} is not along d2(0)"));
         }
     }
     if (loads.tip_force.dot(&normal) * rod.length()).abs() > PLANE_TOLERANCE * scale {

@@ -31,7 +31,7 @@ pub use formula::{
 };
 pub use frame::Frame;
 pub use level::{ModelChoice, ModelLevel};
-pub use loads::{DeadLoads, PointForce};
+pub use loads::{DeadLoads, PointLoad};
 pub use profile::{Extremes, Knots, Pieces, Profile, Sampler, SplineKnots};
 pub use profile_edits::{intrinsic_profiles, ProfileEdits, ProfileKind};
 pub use rod::{Clamp, ResidualScales, Rod};

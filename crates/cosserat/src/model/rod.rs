@@ -123,17 +123,19 @@ fn check_loads(loads: &DeadLoads) -> Result<(), ModelError> {
     finite("distributed force", &loads.distributed_force)
 }
 
-/// Point forces act at interior points 0 < s_k < L with finite forces: at
-/// an end the load is a tip load or a reaction, and n(s) would have no
-/// interior jump to integrate across.
-fn check_point_forces(loads: &DeadLoads, length: f64) -> Result<(), ModelError> {
-    for (index, p) in loads.point_forces.iter().enumerate() {
+/// Point loads act at interior points 0 < s_k < L with finite forces and
+/// couples: at an end the load is a tip load or a reaction, and n(s), m(s)
+/// would have no interior jump to integrate across.
+fn check_point_loads(loads: &DeadLoads, length: f64) -> Result<(), ModelError> {
+    for (index, p) in loads.point_loads.iter().enumerate() {
         let inside = p.s.is_finite() && p.s > 0.0 && p.s < length;
-        if !inside || !p.force.iter().all(|x| x.is_finite()) {
+        let finite = p.force.iter().chain(p.couple.iter()).all(|x| x.is_finite());
+        if !inside || !finite {
             return Err(ModelError::PointLoad {
                 index,
                 s: p.s,
                 force: [p.force.x, p.force.y, p.force.z],
+                couple: [p.couple.x, p.couple.y, p.couple.z],
                 length,
             });
         }
@@ -164,7 +166,7 @@ impl Rod {
     /// clamped by `clamp` at s = 0, under dead `loads`, free at s = L
     /// (`support` None) or held there. Refused with the named
     /// [`ModelError`] when the length is not positive and finite, a load or
-    /// a position is not finite, a point force is not at an interior point, or a support axis is not a unit vector
+    /// a position is not finite, a point load is not at an interior point, or a support axis is not a unit vector
     /// (frames are [`Frame`]s, checked when built). The energy is the
     /// caller's: its Hessian is checked along the rod when a solve starts.
     pub fn new(
@@ -177,7 +179,7 @@ impl Rod {
         check_length(length)?;
         check_clamp(&clamp)?;
         check_loads(&loads)?;
-        check_point_forces(&loads, length)?;
+        check_point_loads(&loads, length)?;
         check_support(support.as_ref())?;
         Ok(Rod {
             length,
@@ -216,7 +218,7 @@ impl Rod {
     /// The same rod with another length, checked as in [`Rod::new`].
     pub fn with_length(mut self, length: f64) -> Result<Rod, ModelError> {
         check_length(length)?;
-        check_point_forces(&self.loads, length)?;
+        check_point_loads(&self.loads, length)?;
         self.length = length;
         Ok(self)
     }
@@ -239,7 +241,7 @@ impl Rod {
     /// The same rod under other loads, checked as in [`Rod::new`].
     pub fn with_loads(mut self, loads: DeadLoads) -> Result<Rod, ModelError> {
         check_loads(&loads)?;
-        check_point_forces(&loads, self.length)?;
+        check_point_loads(&loads, self.length)?;
         self.loads = loads;
         Ok(self)
     }

@@ -65,8 +65,9 @@ impl RodTangent {
         finite("tip force rate", &rates.tip_force)?;
         finite("tip couple rate", &rates.tip_couple)?;
         finite("distributed force rate", &rates.distributed_force)?;
-        for p in &rates.point_forces {
+        for p in &rates.point_loads {
             finite("point force rate", &p.force)?;
+            finite("point couple rate", &p.couple)?;
         }
         self.loads = rates;
         Ok(self)
@@ -128,10 +129,11 @@ impl RodTangent {
         self.loads.tip_couple += l.tip_couple * factor;
         self.loads.distributed_force += l.distributed_force * factor;
         self.loads
-            .point_forces
-            .extend(l.point_forces.iter().map(|p| crate::model::PointForce {
+            .point_loads
+            .extend(l.point_loads.iter().map(|p| crate::model::PointLoad {
                 s: p.s,
                 force: p.force * factor,
+                couple: p.couple * factor,
             }));
         self.length += other.length * factor;
         self.stiffness += other.stiffness * factor;
@@ -183,10 +185,16 @@ impl RodTangent {
         // A point force stays at its s_k while a length rate moves every
         // point at fixed σ = s/L: the jump would move in σ, a term the
         // sensitivity equations do not carry.
-        let points_stay = self.length == 0.0 || rod.loads().point_forces.is_empty();
+        let points_stay = self.length == 0.0 || rod.loads().point_loads.is_empty();
+        // The curvature after a point couple solves ∇W(κ⁺) = M⁻ − C·d_i:
+        // its p-derivative (the couple's rate, the energy's) is not built
+        // into the jump's linearization, which maps the state's
+        // sensitivities only (a central difference then, said so).
+        let couples_stay = !rod.loads().has_point_couples() && !self.loads.has_point_couples();
         (!energy_moves || (e.is_quadratic() && diagonal))
             && (self.length == 0.0 || e.is_uniform())
             && points_stay
+            && couples_stay
     }
 
     /// dn/dp at a fixed σ = s/L of the internal force n = P + f (L − s) +
@@ -200,7 +208,7 @@ impl RodTangent {
         let mut rate = self.loads.tip_force
             + self.loads.distributed_force * (l - s)
             + f * (self.length * (1.0 - s / l));
-        for p in self.loads.point_forces.iter().filter(|p| p.s > s) {
+        for p in self.loads.point_loads.iter().filter(|p| p.s > s) {
             rate += p.force;
         }
         rate

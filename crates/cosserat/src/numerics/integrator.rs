@@ -80,6 +80,16 @@ pub enum IntegrationError {
         /// The step budget.
         steps: usize,
     },
+    /// The state's jump at an interior point had no value: the equation
+    /// that gives the state after the jump (the curvature that carries the
+    /// moment after a point couple) has no solution its Newton found.
+    #[error("the state has no value after its jump at s = {s:.6e} ({reason})")]
+    JumpWithoutValue {
+        /// The point of the jump.
+        s: f64,
+        /// Why, in words.
+        reason: &'static str,
+    },
 }
 
 // Butcher tableau of DOP853 (Hairer's dop853.f; stages 1..12, c12 = 1).

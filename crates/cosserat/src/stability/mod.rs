@@ -273,6 +273,14 @@ pub fn check_conservative(rod: &Rod) -> Result<(), StabilityError> {
         Some(Freedom::Axial(a)) => (couple - a * couple.dot(&a)).norm() <= 1e-12 * couple.norm(),
         _ => false,
     };
+    if rod.loads().has_point_couples() {
+        return Err(StabilityError::NonConservative(
+            "a dead point couple (loads.point[k].couple) has no potential for spatial \
+             rotations, so the second variation does not decide stability (as for a dead tip \
+             couple); remove the couple to ask for stability"
+                .into(),
+        ));
+    }
     if couple.norm() > 0.0 && !held {
         return Err(StabilityError::NonConservative(
             "a dead tip couple has no potential for spatial rotations, so the second \

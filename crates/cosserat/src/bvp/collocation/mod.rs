@@ -312,6 +312,16 @@ pub fn solve_collocation_from(
     guess: Option<&[f64]>,
 ) -> Result<CollocationSolution, CollocationError> {
     let tab = check_options(opts)?;
+    if eq.state_jumps() {
+        // The global collocation equations hold the state continuous at
+        // every node: a point couple's jump of the curvature is not built
+        // there (never a couple silently dropped).
+        return Err(CollocationError::Options(
+            "a point couple (loads.point[k].couple) makes the state jump, which collocation \
+             does not carry; use solver.method = \"shooting\" or \"multiple-shooting\""
+                .into(),
+        ));
+    }
     if let Some(u) = guess {
         if u.len() != eq.unknowns() {
             return Err(CollocationError::Options(format!(

@@ -20,7 +20,7 @@ use nalgebra::Vector3;
 
 use crate::continuation::{FamilyError, Lens, Lens2, Parameter, RodLens};
 use crate::input::strict;
-use crate::model::{DeadLoads, EnergyCatalog, PointForce, Rod, RodTangent};
+use crate::model::{DeadLoads, EnergyCatalog, PointLoad, Rod, RodTangent};
 
 /// The tables whose numbers make the rod.
 const ROD_TABLES: [&str; 5] = ["rod", "energy", "clamp", "support", "loads"];
@@ -234,12 +234,9 @@ impl Lens for KeyLens {
         }
         if let Some((k, j)) = point_force_component(&self.key) {
             let rod = self.rod_at(p).ok()?;
-            let s = rod.loads().point_forces.get(k)?.s;
+            let s = rod.loads().point_loads.get(k)?.s;
             let rate = DeadLoads {
-                point_forces: vec![PointForce {
-                    s,
-                    force: Vector3::ith(j, 1.0),
-                }],
+                point_loads: vec![PointLoad::force(s, Vector3::ith(j, 1.0))],
                 ..DeadLoads::default()
             };
             return RodTangent::zero().with_loads(rate).ok();

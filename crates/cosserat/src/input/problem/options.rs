@@ -238,7 +238,7 @@ fn check_measures(
             Measure::Turning | Measure::StoredEnergy | Measure::TotalPotentialEnergy
         )
     });
-    if let (Some(m), false) = (integral, rod.loads().point_forces.is_empty()) {
+    if let (Some(m), false) = (integral, rod.loads().point_loads.is_empty()) {
         // The measure's quadrature straddles the jump of n(s), and the
         // potential has no −F_k·r(s_k) term: refused, not approximate.
         return Err(invalid(

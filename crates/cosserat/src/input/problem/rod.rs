@@ -14,7 +14,7 @@ use super::checks::{finite, load_vector, magnitude, vector};
 use super::sections::{ClampSection, EnergySection, PointLoadSection, ProblemFile, ProfileSpec};
 use super::{invalid, ProblemError};
 use crate::model::{
-    Clamp, DeadLoads, EnergyCatalog, EnergySpec, ModelChoice, ModelError, ModelLevel, PointForce,
+    Clamp, DeadLoads, EnergyCatalog, EnergySpec, ModelChoice, ModelError, ModelLevel, PointLoad,
     Profile, Rod, Shearable, StoredEnergy,
 };
 
@@ -125,7 +125,7 @@ pub(super) fn build_rod(file: &ProblemFile, catalog: &EnergyCatalog) -> Result<R
         tip_force: load_vector("loads.tip_force", file.loads.tip_force)?,
         tip_couple: load_vector("loads.tip_couple", file.loads.tip_couple)?,
         distributed_force: load_vector("loads.distributed_force", file.loads.distributed_force)?,
-        point_forces: point_forces(&file.loads.point, length)?,
+        point_loads: point_loads(&file.loads.point, length)?,
     };
     // Every value was checked above with its key and message; a refusal
     // all the same is named by the key it comes from.
@@ -133,11 +133,11 @@ pub(super) fn build_rod(file: &ProblemFile, catalog: &EnergyCatalog) -> Result<R
         .map_err(|e| invalid(model_key(&e), e.to_string()))
 }
 
-/// The `[[loads.point]]` tables as point forces: each `s` finite and
-/// inside (0, L), each force a load vector; a non-zero couple is refused by
-/// name (a point couple makes the moment jump, a jump no solver carries
-/// yet — never a load silently dropped).
-fn point_forces(points: &[PointLoadSection], length: f64) -> Result<Vec<PointForce>, ProblemError> {
+/// The `[[loads.point]]` tables as point loads: each `s` finite and
+/// inside (0, L), each force and couple a load vector. Which solvers carry
+/// a couple's moment jump is checked with the solver options
+/// (`options.rs`), never a load silently dropped.
+fn point_loads(points: &[PointLoadSection], length: f64) -> Result<Vec<PointLoad>, ProblemError> {
     points
         .iter()
         .enumerate()
@@ -153,17 +153,10 @@ fn point_forces(points: &[PointLoadSection], length: f64) -> Result<Vec<PointFor
                     ),
                 ));
             }
-            let couple = load_vector(&format!("{key}.couple"), p.couple)?;
-            if couple != nalgebra::Vector3::zeros() {
-                return Err(invalid(
-                    format!("{key}.couple"),
-                    "point couples are not supported yet: a couple makes the bending moment \
-                     jump, which the solvers do not carry; leave it out (or zero)",
-                ));
-            }
-            Ok(PointForce {
+            Ok(PointLoad {
                 s,
                 force: load_vector(&format!("{key}.force"), p.force)?,
+                couple: load_vector(&format!("{key}.couple"), p.couple)?,
             })
         })
         .collect()
