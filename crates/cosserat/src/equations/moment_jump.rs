@@ -35,8 +35,7 @@ pub(super) fn curvature_for_moment(
     target: &Vector3<f64>,
 ) -> Result<(Vector3<f64>, Matrix3<f64>), &'static str> {
     let mut kappa = *start;
-    let mut first = None;
-    let mut previous = f64::INFINITY;
+    let mut stop = Stop::default();
     for _ in 0..MAX_STEPS {
         let h = energy.stiffness(s, &kappa);
         let residual = energy.moment(s, &kappa) - target;
@@ -44,19 +43,44 @@ pub(super) fn curvature_for_moment(
             return Err("the energy's Hessian is singular there");
         };
         kappa -= delta;
-        let size = delta.amax();
         if !kappa.iter().all(|x| x.is_finite()) {
             return Err("Newton for the curvature left the finite numbers");
         }
-        let reference = kappa.amax().max(*first.get_or_insert(size));
-        if size <= CONVERGED * reference
-            || (size > 0.5 * previous && size <= ROUND_OFF_FLOOR * reference)
-        {
+        if stop.reached(delta.amax(), kappa.amax()) {
             return Ok((kappa, energy.stiffness(s, &kappa)));
         }
-        previous = size;
     }
     Err("Newton for the curvature did not converge in 50 steps")
+}
+
+/// The stopping test both Newton iterations share: a correction at the
+/// round-off of the solve ([`CONVERGED`]) against the curvature or the
+/// first correction, or one that no longer halves below
+/// [`ROUND_OFF_FLOOR`].
+struct Stop {
+    first: Option<f64>,
+    previous: f64,
+}
+
+impl Default for Stop {
+    fn default() -> Self {
+        Stop {
+            first: None,
+            previous: f64::INFINITY,
+        }
+    }
+}
+
+impl Stop {
+    /// Whether the correction of max-norm `size`, giving a curvature of
+    /// max-norm `kappa`, ends the iteration.
+    fn reached(&mut self, size: f64, kappa: f64) -> bool {
+        let reference = kappa.max(*self.first.get_or_insert(size));
+        let done = size <= CONVERGED * reference
+            || (size > 0.5 * self.previous && size <= ROUND_OFF_FLOOR * reference);
+        self.previous = size;
+        done
+    }
 }
 
 /// κ2⁺ of a planar state, bending about e2 alone: ∂W/∂κ2(s, (0, κ2⁺, 0))
@@ -69,8 +93,7 @@ pub(super) fn bending_for_moment(
 ) -> Result<(f64, f64), &'static str> {
     let at = |k2: f64| Vector3::new(0.0, k2, 0.0);
     let mut k2 = start;
-    let mut first = None;
-    let mut previous = f64::INFINITY;
+    let mut stop = Stop::default();
     for _ in 0..MAX_STEPS {
         let h22 = energy.stiffness(s, &at(k2))[(1, 1)];
         if h22 <= 0.0 || !h22.is_finite() {
@@ -81,14 +104,9 @@ pub(super) fn bending_for_moment(
         if !k2.is_finite() {
             return Err("Newton for the curvature left the finite numbers");
         }
-        let size = delta.abs();
-        let reference = k2.abs().max(*first.get_or_insert(size));
-        if size <= CONVERGED * reference
-            || (size > 0.5 * previous && size <= ROUND_OFF_FLOOR * reference)
-        {
+        if stop.reached(delta.abs(), k2.abs()) {
             return Ok((k2, energy.stiffness(s, &at(k2))[(1, 1)]));
         }
-        previous = size;
     }
     Err("Newton for the curvature did not converge in 50 steps")
 }
