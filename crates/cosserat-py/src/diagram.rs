@@ -358,8 +358,11 @@ impl SpecialPoint {
         self.point.location.name()
     }
 
-    /// The estimated error of the parameter where it is not the BVP's own
-    /// (an "extrapolated" location), else None.
+    /// The estimated error of the parameter: the discretization's for an
+    /// "augmented" location (located again on a refined discretization),
+    /// the extrapolations' for an "extrapolated" one, the bracket's spread
+    /// for a "bracketed" one not closed; None where unknown (the diagram's
+    /// warnings say why).
     #[getter]
     fn parameter_error(&self) -> Option<f64> {
         self.point.parameter_error

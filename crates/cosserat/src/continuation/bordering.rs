@@ -27,11 +27,22 @@ use crate::numerics::staircase::{Border, StaircaseLu};
 /// (one LU each; an SVD costs seconds at a thousand unknowns): the borders
 /// need only complement the kernel and the range, and at a bracketed
 /// singular point F_x's smallest singular value is far below the next, so
-/// one step already isolates the null vectors.
+/// one step already isolates the null vectors. An F_x singular in floating
+/// point (a point located to round-off) is shifted by ε max|F_x| before
+/// it is factored, as inverse iteration's zero pivots are floored
+/// ([`crate::numerics::band_lu::BandLu::factor_for_inverse_iteration`]).
 pub(super) fn dense_null_vectors(fx: &DMatrix<f64>) -> Option<(DVector<f64>, DVector<f64>)> {
     let n = fx.nrows();
     let start = DVector::from_fn(n, |i, _| 1.0 + (0.618_033_988_75 * i as f64).fract());
-    let (lu, lu_t) = (fx.clone().lu(), fx.transpose().lu());
+    let factored = |m: DMatrix<f64>| {
+        let lu = m.clone().lu();
+        if lu.is_invertible() {
+            return lu;
+        }
+        let shift = f64::EPSILON * m.amax();
+        (m + DMatrix::identity(n, n) * shift).lu()
+    };
+    let (lu, lu_t) = (factored(fx.clone()), factored(fx.transpose()));
     let (mut right, mut left) = (start.clone(), start);
     for _ in 0..2 {
         right = lu.solve(&right)?.normalize();

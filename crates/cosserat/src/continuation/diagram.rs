@@ -118,11 +118,15 @@ pub struct SpecialPoint {
     pub multiplicity: usize,
     /// How it was located.
     pub location: Location,
-    /// The estimated discretization error of `point.parameter` where it
-    /// is not the BVP's own ([`Location::Extrapolated`]: the difference of
-    /// the extrapolations from two pairs of meshes); None where the point
-    /// solves the BVP's equations (its error is then the discretization's
-    /// of every point of the branch).
+    /// The estimated error of `point.parameter`: on the augmented system
+    /// ([`Location::Augmented`]) the discretization's — the same point
+    /// located on the family refined (twice the collocation intervals, or
+    /// integration tolerances up to 100× tighter), the difference scaled
+    /// by Richardson's G/(G − 1) (`continuation/discretization.rs`); for
+    /// [`Location::Extrapolated`] the difference of the extrapolations
+    /// from two pairs of element meshes; for [`Location::Bracketed`] the
+    /// bracket's spread where it could not be closed. None where it is
+    /// not known, and the diagram's warnings then say why.
     pub parameter_error: Option<f64>,
 }
 

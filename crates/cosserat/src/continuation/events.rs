@@ -586,7 +586,7 @@ impl Run<'_> {
                     (branch, index),
                     (wanted, Location::Augmented),
                 );
-                (point, None)
+                self.with_discretization_error(point, radius)
             }
             Err(why) => {
                 let note = format!(
@@ -632,7 +632,8 @@ impl Run<'_> {
                     (branch, index),
                     (bp, Location::Augmented),
                 );
-                return (point.into_iter().collect(), None);
+                let (point, note) = self.with_discretization_error(point, radius);
+                return (point.into_iter().collect(), note);
             }
         }
         let best = root.located;
@@ -671,7 +672,8 @@ impl Run<'_> {
             }
         };
         let point = self.special_point(a, b, sign, located, (branch, index), (wanted, location));
-        (point.into_iter().collect(), note)
+        let (point, error_note) = self.with_discretization_error(point, radius);
+        (point.into_iter().collect(), note.or(error_note))
     }
 
     /// The direction of the branch through a simple branch point (x, p):
@@ -768,7 +770,8 @@ impl Run<'_> {
                 (branch, index),
                 (wanted, Location::Augmented),
             );
-            return (point.into_iter().collect(), vec![]);
+            let (point, note) = self.with_discretization_error(point, radius);
+            return (point.into_iter().collect(), note.into_iter().collect());
         }
         (vec![], vec![])
     }

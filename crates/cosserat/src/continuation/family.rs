@@ -28,6 +28,19 @@ use crate::numerics::staircase::Staircase;
 /// branch ([`Family::method`]): its dense Newton costs O(K³).
 const START_SEGMENTS: usize = 32;
 
+/// The integrator's smallest tolerance (the problem files' floor for
+/// `solver.integration_tolerance`: below it DOP853's steps underflow in
+/// round-off).
+const TOLERANCE_FLOOR: f64 = 1e-14;
+
+/// How much tighter the refined shooting family's tolerances are at most
+/// ([`Family::refined`]).
+const MAX_GAIN: f64 = 100.0;
+
+/// The least refinement gain that still tells the error apart from the
+/// refined point's own ([`Family::refined`]).
+const MIN_GAIN: f64 = 10.0;
+
 /// A rod whose one number is the parameter: a [`Lens`] gives the rod at
 /// p, the family discretizes its equilibrium equations.
 #[derive(Debug, Clone)]
@@ -221,6 +234,39 @@ impl Family {
             last_fp: DerivativeCache::default(),
             ..self
         }
+    }
+
+    /// The same family on a finer discretization, and how many times
+    /// smaller its error is expected to be (the gain): collocation on
+    /// twice the intervals (the nodes' error falls by 2^{2m} at order 2m),
+    /// shooting with its integration tolerances divided by up to 100, down
+    /// to the integrator's floor 1e-14 (DOP853's global error follows its
+    /// tolerance). Located special points are located again on it, and
+    /// the difference, scaled by gain/(gain − 1), is their discretization
+    /// error (`events.rs`). Err says why there is none: a tolerance within
+    /// a factor 10 of the floor.
+    pub fn refined(&self) -> Result<(Family, f64), String> {
+        let mut fine = self.clone();
+        let gain = if let Some(m) = self.stages {
+            fine.segments = 2 * self.segments;
+            // The node states' weights carry 1/√K.
+            fine.weights = std::sync::OnceLock::new();
+            f64::from(1u32 << (2 * m))
+        } else {
+            let coarse = self.tolerances.rtol.min(self.tolerances.atol);
+            let gain = (coarse / TOLERANCE_FLOOR).min(MAX_GAIN);
+            if gain < MIN_GAIN {
+                return Err(format!(
+                    "the integration tolerance {coarse:.1e} is within a factor \
+                     {MIN_GAIN} of the integrator's floor {TOLERANCE_FLOOR:.0e}"
+                ));
+            }
+            fine.tolerances.rtol = self.tolerances.rtol / gain;
+            fine.tolerances.atol = self.tolerances.atol / gain;
+            gain
+        };
+        fine.last_fp = DerivativeCache::default();
+        Ok((fine, gain))
     }
 
     /// The discrete system at a rod's equations.

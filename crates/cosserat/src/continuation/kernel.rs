@@ -85,8 +85,13 @@ impl BandedJacobian {
         if !banded.reproduces(a) {
             return None;
         }
-        banded.lu.factor().ok()?;
-        banded.lu_t.factor().ok()?;
+        // An exactly singular F_x (a fold located to round-off) is where
+        // inverse iteration works best: a zero pivot is floored, not fatal.
+        banded.lu.factor_for_inverse_iteration(f64::EPSILON).ok()?;
+        banded
+            .lu_t
+            .factor_for_inverse_iteration(f64::EPSILON)
+            .ok()?;
         Some(banded)
     }
 

@@ -31,6 +31,7 @@ mod branch_point;
 mod codim2;
 mod corrector;
 mod diagram;
+mod discretization;
 mod driver;
 pub mod engine;
 mod events;

@@ -83,6 +83,20 @@ impl BandLu {
     /// P A = L U in place by partial pivoting; on a zero pivot the
     /// factors are unusable and the column is named.
     pub fn factor(&mut self) -> Result<(), SingularBand> {
+        self.factor_floored(None)
+    }
+
+    /// The factors of a matrix inverse iteration will be run on: a pivot
+    /// that is exactly zero (A singular in floating point — at a located
+    /// fold the ideal case for inverse iteration, not a failure) is
+    /// replaced by `floor` times the largest entry, as LAPACK's inverse
+    /// iteration (dstein) perturbs its pivots; the solves then grow the
+    /// null direction by ≈ 1/floor. Err only on a non-finite pivot.
+    pub fn factor_for_inverse_iteration(&mut self, floor: f64) -> Result<(), SingularBand> {
+        self.factor_floored(Some(floor))
+    }
+
+    fn factor_floored(&mut self, floor: Option<f64>) -> Result<(), SingularBand> {
         let (n, kl, kv) = (self.n, self.kl, self.kl + self.ku);
         let ld = self.lead();
         self.magnitude = self.data.iter().fold(0.0, |m: f64, v| m.max(v.abs()));
@@ -99,7 +113,11 @@ impl BandLu {
                 })
                 .unwrap_or(0);
             self.pivots[j] = j + jp;
-            let pivot = self.data[col + jp];
+            let mut pivot = self.data[col + jp];
+            if let (0.0, Some(floor)) = (pivot, floor) {
+                pivot = floor * self.magnitude;
+                self.data[col + jp] = pivot;
+            }
             if pivot == 0.0 || !pivot.is_finite() {
                 return Err(SingularBand { column: j });
             }
@@ -352,5 +370,27 @@ mod tests {
         lu.add(1, 1, 4.0);
         lu.add(2, 2, 1.0);
         assert_eq!(lu.factor(), Err(SingularBand { column: 1 }));
+    }
+
+    /// The same exactly singular matrix factored for inverse iteration:
+    /// the zero pivot is floored, and one solve from any start returns
+    /// the null vector (2, −1, 0)/√5 to round-off.
+    #[test]
+    fn inverse_iteration_on_an_exactly_singular_band() {
+        let mut lu = BandLu::zeros(3, 1, 1);
+        lu.add(0, 0, 1.0);
+        lu.add(0, 1, 2.0);
+        lu.add(1, 0, 2.0);
+        lu.add(1, 1, 4.0);
+        lu.add(2, 2, 1.0);
+        lu.factor_for_inverse_iteration(f64::EPSILON).unwrap();
+        let mut v = [0.3, 0.5, 0.7];
+        lu.solve(&mut v);
+        let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let null = [2.0 / 5f64.sqrt(), -1.0 / 5f64.sqrt(), 0.0];
+        let sign = v[0].signum();
+        for (got, want) in v.iter().zip(null) {
+            assert!((sign * got / norm - want).abs() < 1e-12, "{v:?}");
+        }
     }
 }
