@@ -61,7 +61,7 @@ fn entry(parent: &str, name: &str) -> (&'static str, &'static str) {
         ("special_points", "singularity") => ("1", "size of the singularity (test function, its bound)"),
         ("special_points", "multiplicity") => ("", "eigenvalues crossing zero together"),
         ("special_points", "location") => ("", "augmented (minimally augmented system), bracketed (regula falsi) or extrapolated (finite-element crossings on three meshes, Richardson)"),
-        ("special_points", "parameter_error") => ("as the continued key", "estimated error of the parameter: augmented, the discretization's (the point located again on twice the collocation intervals or integration tolerances up to 100× tighter, Richardson-scaled); extrapolated, the difference of two extrapolations; bracketed, the bracket's spread where it was not closed; NaN where unknown (a warning says why)"),
+        ("special_points", "parameter_error") => ("as the continued key", "estimated error of the parameter: augmented, the discretization's (the point located again on twice the collocation intervals or integration tolerances up to 100× tighter, Richardson-scaled; NaN with a warning where that failed); extrapolated, the difference of two extrapolations; bracketed, the bracket's spread where it was not closed, NaN (not estimated) where it closed to the event tolerance"),
         (_, "warnings") => ("", "events detected but not located, and other warnings"),
         // Curves of singular points.
         ("curve", "parameters") => ("as the two keys", "the two parameters along the curve"),
