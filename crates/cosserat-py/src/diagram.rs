@@ -361,8 +361,9 @@ impl SpecialPoint {
     /// The estimated error of the parameter: the discretization's for an
     /// "augmented" location (located again on a refined discretization),
     /// the extrapolations' for an "extrapolated" one, the bracket's spread
-    /// for a "bracketed" one not closed; None where unknown (the diagram's
-    /// warnings say why).
+    /// for a "bracketed" one not closed; None where not estimated (an
+    /// augmented point whose refined location failed, which the diagram's
+    /// warnings say, and a closed bracket).
     #[getter]
     fn parameter_error(&self) -> Option<f64> {
         self.point.parameter_error

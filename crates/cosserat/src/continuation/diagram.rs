@@ -126,7 +126,10 @@ pub struct SpecialPoint {
     /// [`Location::Extrapolated`] the difference of the extrapolations
     /// from two pairs of element meshes; for [`Location::Bracketed`] the
     /// bracket's spread where it could not be closed. None where it is
-    /// not known, and the diagram's warnings then say why.
+    /// not estimated: an augmented point whose refined location failed
+    /// (the diagram's warnings say why), and a bracket closed to the event
+    /// tolerance (a multiple branch point; its discretization error is not
+    /// estimated).
     pub parameter_error: Option<f64>,
 }
 
