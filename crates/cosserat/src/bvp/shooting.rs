@@ -27,7 +27,10 @@ pub struct ShootingSystem<'a> {
     eq: &'a dyn RodEquations,
     segments: usize,
     tol: Tolerances,
-    dop: Dop853,
+    /// The generic integrator, built on first use: a planar solve whose
+    /// segments all take the fixed-size path ([`PlanarKernel`]) never
+    /// needs its fourteen stage vectors until it samples.
+    dop: Option<Dop853>,
     scales: Vec<f64>,
     /// Segments as single Gauss–Legendre steps (the collocation equations
     /// of the segment mesh) instead of adaptive DOP853 integration.
@@ -53,7 +56,7 @@ impl<'a> ShootingSystem<'a> {
             eq,
             segments: segments.max(1),
             tol,
-            dop: Dop853::with_room(eq.dim(), sensitivity_dimension(eq, segments)),
+            dop: None,
             scales,
             gauss: None,
             jumps: eq.jumps(),
@@ -80,6 +83,16 @@ impl<'a> ShootingSystem<'a> {
             gauss: Some(GaussStepper::new(tab)),
             ..ShootingSystem::new(eq, intervals, tol)
         })
+    }
+
+    /// The generic integrator, with room for the longest integrated vector
+    /// ([`sensitivity_dimension`]).
+    fn dop<'d>(
+        dop: &'d mut Option<Dop853>,
+        eq: &dyn RodEquations,
+        segments: usize,
+    ) -> &'d mut Dop853 {
+        dop.get_or_insert_with(|| Dop853::with_room(eq.dim(), sensitivity_dimension(eq, segments)))
     }
 
     fn node(&self, j: usize) -> f64 {
@@ -181,7 +194,7 @@ impl<'a> ShootingSystem<'a> {
                 jump_with_sensitivities(eq, piece.jump, &mut y, n, cols)?;
                 continue;
             }
-            let stats = self.dop.integrate(
+            let stats = Self::dop(&mut self.dop, self.eq, self.segments).integrate(
                 &mut rhs,
                 piece.from,
                 piece.to,
@@ -249,7 +262,7 @@ impl<'a> ShootingSystem<'a> {
                 let eq = self.eq;
                 for piece in pieces(&self.jumps, self.node(j - 1), self.node(j)) {
                     if piece.to > piece.from {
-                        let out = self.dop.integrate(
+                        let out = Self::dop(&mut self.dop, eq, self.segments).integrate(
                             |s, y: &[f64], d: &mut [f64]| eq.rhs(s, y, d),
                             piece.from,
                             piece.to,
@@ -305,7 +318,7 @@ impl<'a> ShootingSystem<'a> {
             // costs the steps the tolerance needs, not one per node.
             for (piece, stops) in served_pieces(&self.jumps, a, b, &stops, false) {
                 if piece.to > piece.from {
-                    let stats = self.dop.integrate_serving(
+                    let stats = Self::dop(&mut self.dop, eq, self.segments).integrate_serving(
                         |s, y: &[f64], d: &mut [f64]| eq.rhs(s, y, d),
                         (piece.from, piece.to, n),
                         &mut y,
@@ -570,7 +583,7 @@ impl<'a> ShootingSystem<'a> {
             let eq = self.eq;
             for (piece, stops) in served_pieces(&self.jumps, a, b, &stops, last) {
                 if piece.to > piece.from {
-                    let stats = self.dop.integrate_serving(
+                    let stats = Self::dop(&mut self.dop, eq, self.segments).integrate_serving(
                         |s, y: &[f64], d: &mut [f64]| eq.rhs(s, y, d),
                         (piece.from, piece.to, n),
                         &mut y,
@@ -580,7 +593,7 @@ impl<'a> ShootingSystem<'a> {
                         |s, y| samples.push(eq.sample(s, y)),
                         |y| eq.project(y),
                     )?;
-                    record.append(self.dop.take_record());
+                    record.append(Self::dop(&mut self.dop, eq, self.segments).take_record());
                     self.stats += stats;
                 }
                 jump_with_sensitivities(eq, piece.jump, &mut y, n, 0)?;
