@@ -15,10 +15,10 @@ use nalgebra::{DMatrix, DVector};
 use super::collocation::Tableau;
 use super::gauss_step::GaussStepper;
 use super::newton::NonlinearSystem;
-use crate::equations::{RodEquations, RodSample};
+use crate::equations::{PlanarKernel, RodEquations, RodSample};
 use crate::model::RodTangent;
 use crate::numerics::integrator::{
-    DenseRecord, Dop853, IntegrationError, IntegrationStats, Stops, Tolerances,
+    DenseRecord, Dop853, FixedDop853, IntegrationError, IntegrationStats, Stops, Tolerances,
 };
 use crate::numerics::staircase::Staircase;
 
@@ -27,7 +27,10 @@ pub struct ShootingSystem<'a> {
     eq: &'a dyn RodEquations,
     segments: usize,
     tol: Tolerances,
-    dop: Dop853,
+    /// The generic integrator, built on first use: a planar solve whose
+    /// segments all take the fixed-size path ([`PlanarKernel`]) never
+    /// needs its fourteen stage vectors until it samples.
+    dop: Option<Dop853>,
     scales: Vec<f64>,
     /// Segments as single Gauss–Legendre steps (the collocation equations
     /// of the segment mesh) instead of adaptive DOP853 integration.
@@ -35,6 +38,12 @@ pub struct ShootingSystem<'a> {
     /// The interior points where the right-hand side jumps
     /// ([`RodEquations::jumps`]): every integration stops there.
     jumps: Vec<f64>,
+    /// The planar right-hand side as one value
+    /// ([`RodEquations::planar_kernel`]): a segment with one sensitivity
+    /// column and no jump inside is then integrated on fixed-size arrays
+    /// (`fixed`), the same steps and result as `dop`'s.
+    kernel: Option<PlanarKernel>,
+    fixed: FixedDop853<8>,
     /// Integration work so far.
     pub stats: IntegrationStats,
 }
@@ -47,10 +56,12 @@ impl<'a> ShootingSystem<'a> {
             eq,
             segments: segments.max(1),
             tol,
-            dop: Dop853::with_room(eq.dim(), sensitivity_dimension(eq, segments)),
+            dop: None,
             scales,
             gauss: None,
             jumps: eq.jumps(),
+            kernel: eq.planar_kernel(),
+            fixed: FixedDop853::default(),
             stats: IntegrationStats::default(),
         }
     }
@@ -72,6 +83,16 @@ impl<'a> ShootingSystem<'a> {
             gauss: Some(GaussStepper::new(tab)),
             ..ShootingSystem::new(eq, intervals, tol)
         })
+    }
+
+    /// The generic integrator, with room for the longest integrated vector
+    /// ([`sensitivity_dimension`]).
+    fn dop<'d>(
+        dop: &'d mut Option<Dop853>,
+        eq: &dyn RodEquations,
+        segments: usize,
+    ) -> &'d mut Dop853 {
+        dop.get_or_insert_with(|| Dop853::with_room(eq.dim(), sensitivity_dimension(eq, segments)))
     }
 
     fn node(&self, j: usize) -> f64 {
@@ -142,6 +163,11 @@ impl<'a> ShootingSystem<'a> {
             return Ok(y);
         }
         let cols = phi0.ncols();
+        if let (Some(kernel), None, 1, [piece]) = (self.kernel, forcing, cols, span.as_slice()) {
+            if piece.jump.is_none() {
+                return self.planar_segment(kernel, piece, start, phi0);
+            }
+        }
         let mut y = Vec::with_capacity(n * (cols + 1));
         y.extend_from_slice(start);
         y.extend_from_slice(phi0.as_slice());
@@ -168,7 +194,7 @@ impl<'a> ShootingSystem<'a> {
                 jump_with_sensitivities(eq, piece.jump, &mut y, n, cols)?;
                 continue;
             }
-            let stats = self.dop.integrate(
+            let stats = Self::dop(&mut self.dop, self.eq, self.segments).integrate(
                 &mut rhs,
                 piece.from,
                 piece.to,
@@ -195,6 +221,33 @@ impl<'a> ShootingSystem<'a> {
         Ok((y, phi))
     }
 
+    /// A segment of the planar kernel's equations with one sensitivity
+    /// column, on [`FixedDop853`]: the state and the column as one
+    /// 8-array, every component controlled, no projection (the planar
+    /// state has no invariant to restore) — the steps and the result of
+    /// the generic path of [`ShootingSystem::forced_segment`], bit for bit
+    /// (tested), with no heap storage and loops of known length.
+    fn planar_segment(
+        &mut self,
+        kernel: PlanarKernel,
+        piece: &Piece,
+        start: &[f64],
+        phi0: &DMatrix<f64>,
+    ) -> Result<(Vec<f64>, DMatrix<f64>), IntegrationError> {
+        let mut y = [0.0; 8];
+        y[..4].copy_from_slice(start);
+        y[4..].copy_from_slice(phi0.as_slice());
+        let stats = self.fixed.integrate(
+            |s, y, d| kernel.rates_with_column(s, y, d),
+            piece.from,
+            piece.to,
+            &mut y,
+            &self.tol,
+        )?;
+        self.stats += stats;
+        Ok((y[..4].to_vec(), DMatrix::from_column_slice(4, 1, &y[4..])))
+    }
+
     /// A starting vector of unknowns from free values u: the interior nodes
     /// are filled by integrating from u, and by the straight rod beyond a
     /// blow-up.
@@ -209,7 +262,7 @@ impl<'a> ShootingSystem<'a> {
                 let eq = self.eq;
                 for piece in pieces(&self.jumps, self.node(j - 1), self.node(j)) {
                     if piece.to > piece.from {
-                        let out = self.dop.integrate(
+                        let out = Self::dop(&mut self.dop, eq, self.segments).integrate(
                             |s, y: &[f64], d: &mut [f64]| eq.rhs(s, y, d),
                             piece.from,
                             piece.to,
@@ -265,7 +318,7 @@ impl<'a> ShootingSystem<'a> {
             // costs the steps the tolerance needs, not one per node.
             for (piece, stops) in served_pieces(&self.jumps, a, b, &stops, false) {
                 if piece.to > piece.from {
-                    let stats = self.dop.integrate_serving(
+                    let stats = Self::dop(&mut self.dop, eq, self.segments).integrate_serving(
                         |s, y: &[f64], d: &mut [f64]| eq.rhs(s, y, d),
                         (piece.from, piece.to, n),
                         &mut y,
@@ -530,7 +583,7 @@ impl<'a> ShootingSystem<'a> {
             let eq = self.eq;
             for (piece, stops) in served_pieces(&self.jumps, a, b, &stops, last) {
                 if piece.to > piece.from {
-                    let stats = self.dop.integrate_serving(
+                    let stats = Self::dop(&mut self.dop, eq, self.segments).integrate_serving(
                         |s, y: &[f64], d: &mut [f64]| eq.rhs(s, y, d),
                         (piece.from, piece.to, n),
                         &mut y,
@@ -540,7 +593,7 @@ impl<'a> ShootingSystem<'a> {
                         |s, y| samples.push(eq.sample(s, y)),
                         |y| eq.project(y),
                     )?;
-                    record.append(self.dop.take_record());
+                    record.append(Self::dop(&mut self.dop, eq, self.segments).take_record());
                     self.stats += stats;
                 }
                 jump_with_sensitivities(eq, piece.jump, &mut y, n, 0)?;
@@ -697,6 +750,46 @@ impl NonlinearSystem for ShootingSystem<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::equations::PlanarEquations;
+    use crate::model::{Clamp, DeadLoads, LinearElastic, Rod};
+    use nalgebra::Vector3;
+    use std::sync::Arc;
+
+    /// The planar kernel's fixed-size segments against the generic path
+    /// (the same system with the kernel taken away): the residual, the
+    /// Jacobian and the integration work agree bit for bit, single and
+    /// multiple shooting, loose and tight tolerances.
+    #[test]
+    fn the_planar_fast_path_is_the_generic_integration() {
+        let energy = LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3]).unwrap();
+        let loads = DeadLoads {
+            tip_force: Vector3::new(3.0, 0.0, 0.0),
+            distributed_force: Vector3::new(0.5, 0.0, -0.2),
+            ..Default::default()
+        };
+        let rod = Rod::new(1.0, Arc::new(energy), Clamp::paper(), loads, None).unwrap();
+        let eq = PlanarEquations::new(rod);
+        assert!(eq.planar_kernel().is_some());
+        for (segments, rtol) in [(1, 1e-4), (1, 1e-12), (3, 1e-8)] {
+            let tol = Tolerances {
+                rtol,
+                atol: rtol,
+                ..Tolerances::default()
+            };
+            let mut fast = ShootingSystem::new(&eq, segments, tol);
+            let mut slow = ShootingSystem::new(&eq, segments, tol);
+            slow.kernel = None;
+            let x = fast.initial_unknowns(&[1.3]);
+            let size = fast.size();
+            let run = |sys: &mut ShootingSystem| {
+                let (mut r, mut jac) = (DVector::zeros(size), DMatrix::zeros(size, size));
+                sys.evaluate(&x, &mut r, &mut jac).unwrap();
+                (r, jac, sys.stats)
+            };
+            let (a, b) = (run(&mut fast), run(&mut slow));
+            assert_eq!(a, b, "{segments} segments, rtol {rtol}");
+        }
+    }
 
     #[test]
     fn a_jump_ends_a_piece_an_ulp_below_and_is_applied_after_it() {

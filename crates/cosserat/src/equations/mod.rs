@@ -14,7 +14,7 @@ mod strained;
 mod tip;
 
 pub use kirchhoff::KirchhoffEquations;
-pub use planar::PlanarEquations;
+pub use planar::{PlanarEquations, PlanarKernel};
 
 use nalgebra::{DMatrix, Vector3};
 
@@ -100,6 +100,14 @@ pub trait RodEquations: Send + Sync {
     /// Restores invariants of y after an integration step (orthonormal
     /// directors); the identity where there are none.
     fn project(&self, y: &mut [f64]);
+    /// The right-hand side as a [`PlanarKernel`] where it is one (the
+    /// planar level with a constant H22, no point forces and a free tip):
+    /// then [`RodEquations::rhs_linearized`] is exactly
+    /// [`PlanarKernel::rates`], which shooting inlines on fixed-size
+    /// arrays. None by default.
+    fn planar_kernel(&self) -> Option<PlanarKernel> {
+        None
+    }
     /// A starting guess of the free values: the curvature at the clamp that
     /// balances the loads on the unloaded, straight rod.
     fn initial_guess(&self) -> Vec<f64>;

@@ -49,6 +49,82 @@ pub struct PlanarEquations {
     /// axes, where no point force makes n(s) piecewise: n(s) = P + f (L − s)
     /// in the plane without forming the 3-vector at every evaluation.
     force_on_axes: Option<[f64; 4]>,
+    /// The right-hand side as one small value where both of the above
+    /// hold and the tip is free (no reaction states): [`PlanarKernel`].
+    kernel: Option<PlanarKernel>,
+}
+
+/// The planar right-hand side of a rod whose H22 is one number (a trusted,
+/// uniform, quadratic energy) and whose internal force is
+/// n(s) = P + f (L − s) (no point forces), at a free tip: state
+/// (x, z, φ, κ2) and
+///
+///   x' = sin φ,  z' = cos φ,  φ' = κ2,  κ2' = −N1/H22,
+///   N1 = n_x cos φ − n_z sin φ,
+///
+/// with its linearization ∂κ2'/∂φ = (n_x sin φ + n_z cos φ)/H22,
+/// ∂κ2'/∂κ2 = 0. One copyable value with no energy calls: what
+/// [`PlanarEquations`] itself evaluates in this case, and what shooting's
+/// fixed-size fast path (`numerics::integrator::FixedDop853`) inlines.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlanarKernel {
+    length: f64,
+    /// 1/H22: a product instead of two divisions on every evaluation's
+    /// critical path (within an ulp of the quotients).
+    compliance: f64,
+    /// (n_x, n_z) of the tip force P and of the distributed force f on
+    /// the clamp's axes d1(0), d3(0).
+    force: [f64; 4],
+}
+
+impl PlanarKernel {
+    /// The state's rates dy (4 components) at (s, y), and the pieces the
+    /// linearization needs: (sin φ, cos φ, ∂κ2'/∂φ).
+    #[inline]
+    fn state_rates(&self, s: f64, y: &[f64], dy: &mut [f64]) -> (f64, f64, f64) {
+        let [px, pz, fx, fz] = self.force;
+        let arm = self.length - s;
+        let (nx, nz) = (px + fx * arm, pz + fz * arm);
+        let (sin, cos) = y[2].sin_cos();
+        let n1 = nx * cos - nz * sin;
+        let dn1 = -nx * sin - nz * cos;
+        dy[0] = sin;
+        dy[1] = cos;
+        dy[2] = y[3];
+        dy[3] = -n1 * self.compliance;
+        (sin, cos, -dn1 * self.compliance)
+    }
+
+    /// f(s, y) and ∂f/∂y applied to `cols` tangent vectors in `phi`
+    /// (4 × cols, column-major), as [`RodEquations::rhs_linearized`].
+    #[inline]
+    pub fn rates(
+        &self,
+        s: f64,
+        y: &[f64],
+        cols: usize,
+        phi: &[f64],
+        dy: &mut [f64],
+        dphi: &mut [f64],
+    ) {
+        let (sin, cos, d_phi) = self.state_rates(s, y, dy);
+        for (v, out) in phi.chunks_exact(4).zip(dphi.chunks_exact_mut(4)).take(cols) {
+            out[0] = cos * v[2];
+            out[1] = -sin * v[2];
+            out[2] = v[3];
+            out[3] = d_phi * v[2];
+        }
+    }
+
+    /// The state and one sensitivity column as one 8-vector
+    /// (x, z, φ, κ2, δx, δz, δφ, δκ2): [`PlanarKernel::rates`] with
+    /// `cols` = 1 on arrays, for the fixed-size integrator.
+    #[inline]
+    pub fn rates_with_column(&self, s: f64, y: &[f64; 8], d: &mut [f64; 8]) {
+        let (state, column) = y.split_at(4);
+        let (dy, dphi) = d.split_at_mut(4);
+        self.rates(s, state, 1, column, dy, dphi);
+    }
 }
 
 impl PlanarEquations {
@@ -70,12 +146,22 @@ impl PlanarEquations {
                 f.dot(&axes.1),
             ]
         });
+        let free_tip = !rod.support().as_ref().is_some_and(|s| s.holds_position());
+        let kernel = match (constant_h22, force_on_axes, free_tip) {
+            (Some(h22), Some(force), true) => Some(PlanarKernel {
+                length: rod.length(),
+                compliance: 1.0 / h22,
+                force,
+            }),
+            _ => None,
+        };
         PlanarEquations {
             rod,
             units,
             axes,
             constant_h22,
             force_on_axes,
+            kernel,
         }
     }
 
@@ -388,6 +474,10 @@ impl RodEquations for PlanarEquations {
     }
 
     fn rhs(&self, s: f64, y: &[f64], dy: &mut [f64]) {
+        if let Some(kernel) = &self.kernel {
+            kernel.state_rates(s, y, dy);
+            return;
+        }
         let c = self.curvature_rate(s, y);
         dy[0] = c.sin;
         dy[1] = c.cos;
@@ -405,6 +495,10 @@ impl RodEquations for PlanarEquations {
         dy: &mut [f64],
         dphi: &mut [f64],
     ) {
+        if let Some(kernel) = &self.kernel {
+            kernel.rates(s, y, cols, phi, dy, dphi);
+            return;
+        }
         let c = self.curvature_rate(s, y);
         let (d_phi, d_k2) = self.curvature_rate_slopes(s, y, &c);
         let (sin, cos, h22) = (c.sin, c.cos, c.h22);
@@ -457,6 +551,10 @@ impl RodEquations for PlanarEquations {
     }
 
     fn project(&self, _: &mut [f64]) {}
+
+    fn planar_kernel(&self) -> Option<PlanarKernel> {
+        self.kernel
+    }
 
     /// M2(0) balancing the loads on the straight rod: C·d2 plus the moment
     /// about d2 of P at the tip and f along the rod, then κ2 from M2 by
@@ -612,4 +710,55 @@ pub(crate) fn straight_rod_clamp_moment(rod: &Rod) -> Vector3<f64> {
         + point_couples
         + (t * l).cross(&loads.tip_force)
         + (t * (0.5 * l * l)).cross(&loads.distributed_force)
+}
+
+#[cfg(test)]
+mod tests {
+    use std::sync::Arc;
+
+    use nalgebra::Vector3;
+
+    use super::*;
+    use crate::model::{Clamp, DeadLoads, LinearElastic};
+
+    /// The kernel (constant H22, no energy calls) against the general path
+    /// of the same rod (H22, ∂sM and ∂H/∂κ asked of the energy at every
+    /// evaluation, n(s) formed as a 3-vector): f and ∂f/∂y · φ agree to
+    /// round-off at states across the turn.
+    #[test]
+    fn the_kernel_is_the_general_right_hand_side() {
+        let energy = LinearElastic::uniform([10.0, 2.5, 10.0], [0.0; 3]).unwrap();
+        let loads = DeadLoads {
+            tip_force: Vector3::new(3.0, 0.0, 1.0),
+            distributed_force: Vector3::new(0.5, 0.0, -0.2),
+            ..Default::default()
+        };
+        let rod = Rod::new(1.5, Arc::new(energy), Clamp::paper(), loads, None).unwrap();
+        let fast = PlanarEquations::new(rod);
+        assert!(fast.planar_kernel().is_some());
+        let general = PlanarEquations {
+            constant_h22: None,
+            force_on_axes: None,
+            kernel: None,
+            ..fast.clone()
+        };
+        let phi = [0.3, -0.7, 1.1, -2.0, 0.0, 0.5, -0.4, 0.9];
+        for (s, angle) in [(0.0, 0.0), (0.4, 1.2), (1.1, -2.9), (1.5, 4.0)] {
+            let y = [0.2, 0.9, angle, -1.7];
+            let mut out = [[0.0; 12]; 2];
+            for (eq, o) in [&fast, &general].into_iter().zip(&mut out) {
+                let (dy, dphi) = o.split_at_mut(4);
+                eq.rhs_linearized(s, &y, 2, &phi, dy, dphi);
+                let mut alone = [0.0; 4];
+                eq.rhs(s, &y, &mut alone);
+                assert_eq!(alone, dy[..4], "rhs and rhs_linearized at s = {s}");
+            }
+            for (a, b) in out[0].iter().zip(&out[1]) {
+                assert!(
+                    (a - b).abs() <= 1e-15 * b.abs().max(1.0),
+                    "s = {s}: {a} against {b}"
+                );
+            }
+        }
+    }
 }

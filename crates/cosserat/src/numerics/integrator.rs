@@ -14,8 +14,10 @@
 #![allow(clippy::excessive_precision)]
 
 mod dense;
+mod fixed;
 
 pub use dense::DenseRecord;
+pub use fixed::FixedDop853;
 
 /// Tolerances and limits of one integration.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -155,7 +157,7 @@ const ER: [f64; 12] = [
 /// Newton iterations allocate nothing.
 #[derive(Debug, Clone)]
 pub struct Dop853 {
-    k: Vec<Vec<f64>>,
+    k: [Vec<f64>; 12],
     stage: Vec<f64>,
     next: Vec<f64>,
     /// The continuous extension, built on the first interpolated stop.
@@ -180,7 +182,7 @@ impl Dop853 {
             v
         };
         Dop853 {
-            k: std::array::from_fn::<_, 12, _>(|_| vector()).into(),
+            k: std::array::from_fn(|_| vector()),
             stage: vector(),
             next: vector(),
             dense: None,
@@ -264,7 +266,6 @@ impl Dop853 {
         let (s0, s1, controlled) = span;
         let n = y.len();
         self.resize(n);
-        let mut stats = IntegrationStats::default();
         let mut s = s0;
         let mut next_stop = stops.partition_point(|&t| t < s0);
         while next_stop < stops.len() && stops[next_stop] <= s0 {
@@ -272,187 +273,301 @@ impl Dop853 {
             next_stop += 1;
         }
         f(s, y, &mut self.k[0]);
-        stats.evaluations += 1;
-        let mut h = self.initial_step(&mut f, s, s1, y, controlled, tol);
-        stats.evaluations += 1;
-        let mut rejected_last = false;
+        let h = initial_step(
+            &mut self.k,
+            &mut self.stage,
+            &mut |t, a: &Vec<f64>, b: &mut Vec<f64>| f(t, a, b),
+            s,
+            s1,
+            y,
+            controlled,
+            tol,
+        );
+        let mut control = StepControl::new(h);
         while s < s1 {
-            if stats.accepted + stats.rejected >= tol.max_steps {
-                return Err(IntegrationError::TooManySteps {
-                    s,
-                    steps: tol.max_steps,
-                });
-            }
             let target = match serve {
                 Stops::Landed => stops.get(next_stop).copied().unwrap_or(s1).min(s1),
                 Stops::Interpolated | Stops::Recorded => s1,
             };
-            let lands = s + h >= target - 1e-14 * target.abs().max(1.0);
-            let step = if lands { target - s } else { h };
-            if step.abs() <= 10.0 * f64::EPSILON * s.abs().max(1.0) && !lands {
-                return Err(IntegrationError::StepSizeUnderflow { s });
-            }
-            self.stages(&mut f, s, step, y);
-            stats.evaluations += 11;
-            let err = self.error_norm(step, y, controlled, tol);
-            if !err.is_finite() {
-                if step < 1e-3 * (s1 - s0) * f64::EPSILON.sqrt() {
-                    return Err(IntegrationError::NotFinite { s });
-                }
-                h = step * 0.1;
-                stats.rejected += 1;
-                rejected_last = true;
+            let (step, lands) = control.propose(s, target, tol)?;
+            stages(
+                &mut self.k,
+                &mut self.stage,
+                &mut self.next,
+                &mut |t, a: &Vec<f64>, b: &mut Vec<f64>| f(t, a, b),
+                s,
+                step,
+                y,
+            );
+            let err = error_norm(&self.k, &self.next, step, y, controlled, tol);
+            if !control.judge(err, step, lands, s, (s0, s1))? {
                 continue;
             }
-            let factor = (0.9 * err.powf(-1.0 / 8.0)).clamp(0.333, 6.0);
-            if err <= 1.0 {
-                stats.accepted += 1;
-                let start = s;
-                s = if lands { target } else { s + step };
-                let inside = stops[next_stop..].partition_point(|&t| t <= s);
-                let extended = serve.extends(inside);
-                if extended {
-                    // The extension needs y and f at the step's start.
-                    self.interpolant(n).start(y);
+            let start = s;
+            s = if lands { target } else { s + step };
+            let inside = stops[next_stop..].partition_point(|&t| t <= s);
+            let extended = serve.extends(inside);
+            if extended {
+                // The extension needs y and f at the step's start.
+                self.interpolant(n).start(y);
+            }
+            y.copy_from_slice(&self.next);
+            project(y);
+            if y.iter().any(|v| !v.is_finite()) {
+                return Err(IntegrationError::NotFinite { s });
+            }
+            if extended {
+                control.stats.evaluations += self.extend(&mut f, start, step, y);
+                let mut dense = self.dense.take().expect("built by interpolant");
+                if serve == Stops::Recorded {
+                    self.record.push(start, step, &dense);
                 }
-                y.copy_from_slice(&self.next);
-                project(y);
-                if y.iter().any(|v| !v.is_finite()) {
-                    return Err(IntegrationError::NotFinite { s });
-                }
-                if extended {
-                    stats.evaluations += self.extend(&mut f, start, step, y);
-                    let mut dense = self.dense.take().expect("built by interpolant");
-                    if serve == Stops::Recorded {
-                        self.record.push(start, step, &dense);
+                for &t in &stops[next_stop..next_stop + inside] {
+                    // The step's end is the state itself, as when landed.
+                    if t == s {
+                        observe(t, y);
+                    } else {
+                        observe(t, dense.at((t - start) / step, &mut project));
                     }
-                    for &t in &stops[next_stop..next_stop + inside] {
-                        // The step's end is the state itself, as when landed.
-                        if t == s {
-                            observe(t, y);
-                        } else {
-                            observe(t, dense.at((t - start) / step, &mut project));
-                        }
-                    }
-                    // f(s, y) is the extension's first extra stage.
-                    self.k[0].copy_from_slice(dense.end_slope());
-                    self.dense = Some(dense);
-                    next_stop += inside;
-                } else {
-                    f(s, y, &mut self.k[0]);
-                    stats.evaluations += 1;
                 }
-                if lands && next_stop < stops.len() && target == stops[next_stop] {
-                    observe(s, y);
-                    next_stop += 1;
-                }
-                let grow = if rejected_last {
-                    factor.min(1.0)
-                } else {
-                    factor
-                };
-                // A step shortened to land on a stop says nothing against h.
-                h = if lands && step < h {
-                    h.max(step * grow)
-                } else {
-                    step * grow
-                };
-                rejected_last = false;
+                // f(s, y) is the extension's first extra stage.
+                self.k[0].copy_from_slice(dense.end_slope());
+                self.dense = Some(dense);
+                next_stop += inside;
             } else {
-                stats.rejected += 1;
-                h = step * factor.min(1.0);
-                rejected_last = true;
+                f(s, y, &mut self.k[0]);
+                control.stats.evaluations += 1;
+            }
+            if lands && next_stop < stops.len() && target == stops[next_stop] {
+                observe(s, y);
+                next_stop += 1;
             }
         }
-        Ok(stats)
+        Ok(control.stats)
+    }
+}
+
+/// Stage storage of one step: a vector of the system's dimension (a
+/// `Vec` for [`Dop853`], an array for [`FixedDop853`], whose loops then
+/// have a length known at compile time).
+pub(crate) trait StageVector: AsRef<[f64]> + AsMut<[f64]> {}
+
+impl<K: AsRef<[f64]> + AsMut<[f64]>> StageVector for K {}
+
+/// Hairer's starting step (II.4, "automatic selection of the initial
+/// step size"), with k[0] = f(s, y) already evaluated; k[1] and `stage`
+/// are overwritten.
+#[allow(clippy::too_many_arguments)]
+fn initial_step<K: StageVector, F: FnMut(f64, &K, &mut K)>(
+    k: &mut [K; 12],
+    stage: &mut K,
+    f: &mut F,
+    s: f64,
+    s1: f64,
+    y: &[f64],
+    controlled: usize,
+    tol: &Tolerances,
+) -> f64 {
+    let scale = |v: f64| tol.atol + tol.rtol * v.abs();
+    let rms = |a: &dyn Fn(usize) -> f64| {
+        ((0..controlled).map(|i| a(i).powi(2)).sum::<f64>() / controlled.max(1) as f64).sqrt()
+    };
+    let d0 = rms(&|i| y[i] / scale(y[i]));
+    let d1 = rms(&|i| k[0].as_ref()[i] / scale(y[i]));
+    let span = s1 - s;
+    let h0 = if d0 < 1e-5 || d1 < 1e-5 {
+        1e-6 * span
+    } else {
+        (0.01 * d0 / d1).min(span)
+    };
+    for (i, st) in stage.as_mut().iter_mut().enumerate() {
+        *st = y[i] + h0 * k[0].as_ref()[i];
+    }
+    let (k0, rest) = k.split_at_mut(1);
+    f(s + h0, stage, &mut rest[0]);
+    let (k0, k1) = (k0[0].as_ref(), rest[0].as_ref());
+    let d2 = rms(&|i| (k1[i] - k0[i]) / scale(y[i])) / h0;
+    let h1 = if d1.max(d2) <= 1e-15 {
+        (h0 * 1e-3).max(1e-6 * span)
+    } else {
+        (0.01 / d1.max(d2)).powf(1.0 / 8.0)
+    };
+    // Hairer's 100 h0 bound, but not below 1e-6 of the span: with y
+    // nearly zero and above Hairer's threshold (a straight column whose
+    // clamp curvature is 1e-17), h0 = 0.01 d0/d1 is ~1e-19 and the first
+    // step would count as an underflow; h1 still bounds the step.
+    (100.0 * h0).max(1e-6 * span).min(h1).min(span)
+}
+
+/// The 12 stages of one step of size h from (s, y); the 8th-order result
+/// goes to `next`. Stage 1 (k[0]) is f(s, y) from the previous step.
+fn stages<K: StageVector, F: FnMut(f64, &K, &mut K)>(
+    k: &mut [K; 12],
+    stage: &mut K,
+    next: &mut K,
+    f: &mut F,
+    s: f64,
+    h: f64,
+    y: &[f64],
+) {
+    for j in 1..12 {
+        stage.as_mut().copy_from_slice(y);
+        for (l, &a) in A[j][..j].iter().enumerate() {
+            if a != 0.0 {
+                axpy(stage.as_mut(), h * a, k[l].as_ref());
+            }
+        }
+        let (_, rest) = k.split_at_mut(j);
+        f(s + C[j] * h, stage, &mut rest[0]);
+    }
+    next.as_mut().copy_from_slice(y);
+    for (l, &b) in B.iter().enumerate() {
+        if b != 0.0 {
+            axpy(next.as_mut(), h * b, k[l].as_ref());
+        }
+    }
+}
+
+/// Hairer's combined error norm of DOP853: the 5th-order estimate,
+/// corrected by the 3rd-order one so that it behaves like an 8th-order
+/// error (dop853.f, "error estimation").
+#[allow(clippy::needless_range_loop)] // i indexes y, next and 12 stages
+fn error_norm<K: StageVector>(
+    k: &[K; 12],
+    next: &K,
+    h: f64,
+    y: &[f64],
+    controlled: usize,
+    tol: &Tolerances,
+) -> f64 {
+    let k: [&[f64]; 12] = std::array::from_fn(|l| k[l].as_ref());
+    let next = next.as_ref();
+    let (mut err5, mut err3) = (0.0, 0.0);
+    for i in 0..controlled {
+        let sk = tol.atol + tol.rtol * y[i].abs().max(next[i].abs());
+        // B and ER vanish at stages 2 to 5: summing over the others
+        // alone is the same sum at two thirds of the cost.
+        let (mut bsum, mut e5) = (B[0] * k[0][i], ER[0] * k[0][i]);
+        for l in 5..12 {
+            bsum += B[l] * k[l][i];
+            e5 += ER[l] * k[l][i];
+        }
+        let e3 = bsum - BHH[0] * k[0][i] - BHH[1] * k[8][i] - BHH[2] * k[11][i];
+        err3 += (e3 / sk).powi(2);
+        err5 += (e5 / sk).powi(2);
+    }
+    let mut deno = err5 + 0.01 * err3;
+    if deno <= 0.0 {
+        deno = 1.0;
+    }
+    h.abs() * err5 * (1.0 / (controlled as f64 * deno)).sqrt()
+}
+
+/// Hairer's step size control, shared by [`Dop853`] and [`FixedDop853`]:
+/// the next step from the last error norm (factor 0.9 err^(−1/8) within
+/// [1/3, 6], not growing right after a rejection), the step budget, the
+/// underflow test, and the work count.
+struct StepControl {
+    h: f64,
+    rejected_last: bool,
+    stats: IntegrationStats,
+}
+
+impl StepControl {
+    /// After f(s0, y0) and the starting step's one evaluation.
+    fn new(h: f64) -> Self {
+        StepControl {
+            h,
+            rejected_last: false,
+            stats: IntegrationStats {
+                evaluations: 2,
+                ..IntegrationStats::default()
+            },
+        }
     }
 
-    /// Hairer's starting step (II.4, "automatic selection of the initial
-    /// step size"), with k[0] = f(s, y) already evaluated.
-    fn initial_step<F: FnMut(f64, &[f64], &mut [f64])>(
-        &mut self,
-        f: &mut F,
+    /// The next step from s towards `target` and whether it lands there
+    /// (a step within round-off of `target` is stretched onto it).
+    fn propose(
+        &self,
         s: f64,
-        s1: f64,
-        y: &[f64],
-        controlled: usize,
+        target: f64,
         tol: &Tolerances,
-    ) -> f64 {
-        let scale = |v: f64| tol.atol + tol.rtol * v.abs();
-        let rms = |a: &dyn Fn(usize) -> f64| {
-            ((0..controlled).map(|i| a(i).powi(2)).sum::<f64>() / controlled.max(1) as f64).sqrt()
-        };
-        let d0 = rms(&|i| y[i] / scale(y[i]));
-        let d1 = rms(&|i| self.k[0][i] / scale(y[i]));
-        let span = s1 - s;
-        let h0 = if d0 < 1e-5 || d1 < 1e-5 {
-            1e-6 * span
-        } else {
-            (0.01 * d0 / d1).min(span)
-        };
-        for (i, st) in self.stage.iter_mut().enumerate() {
-            *st = y[i] + h0 * self.k[0][i];
+    ) -> Result<(f64, bool), IntegrationError> {
+        if self.stats.accepted + self.stats.rejected >= tol.max_steps {
+            return Err(IntegrationError::TooManySteps {
+                s,
+                steps: tol.max_steps,
+            });
         }
-        let (k0, rest) = self.k.split_at_mut(1);
-        f(s + h0, &self.stage, &mut rest[0]);
-        let d2 = rms(&|i| (rest[0][i] - k0[0][i]) / scale(y[i])) / h0;
-        let h1 = if d1.max(d2) <= 1e-15 {
-            (h0 * 1e-3).max(1e-6 * span)
-        } else {
-            (0.01 / d1.max(d2)).powf(1.0 / 8.0)
-        };
-        // Hairer's 100 h0 bound, but not below 1e-6 of the span: with y
-        // nearly zero and above Hairer's threshold (a straight column whose
-        // clamp curvature is 1e-17), h0 = 0.01 d0/d1 is ~1e-19 and the first
-        // step would count as an underflow; h1 still bounds the step.
-        (100.0 * h0).max(1e-6 * span).min(h1).min(span)
+        let lands = s + self.h >= target - 1e-14 * target.abs().max(1.0);
+        let step = if lands { target - s } else { self.h };
+        if step.abs() <= 10.0 * f64::EPSILON * s.abs().max(1.0) && !lands {
+            return Err(IntegrationError::StepSizeUnderflow { s });
+        }
+        Ok((step, lands))
     }
 
-    /// The 12 stages of one step of size h from (s, y); the 8th-order result
-    /// goes to `next`. Stage 1 (k[0]) is f(s, y) from the previous step.
+    /// Counts the step's 11 evaluations, accepts it (true) or rejects it
+    /// (false), and sets the next step size; an error norm that is not
+    /// finite shrinks the step tenfold, down to a blow-up.
+    fn judge(
+        &mut self,
+        err: f64,
+        step: f64,
+        lands: bool,
+        s: f64,
+        (s0, s1): (f64, f64),
+    ) -> Result<bool, IntegrationError> {
+        self.stats.evaluations += 11;
+        if !err.is_finite() {
+            if step < 1e-3 * (s1 - s0) * f64::EPSILON.sqrt() {
+                return Err(IntegrationError::NotFinite { s });
+            }
+            self.h = step * 0.1;
+            self.stats.rejected += 1;
+            self.rejected_last = true;
+            return Ok(false);
+        }
+        let factor = (0.9 * err.powf(-1.0 / 8.0)).clamp(0.333, 6.0);
+        if err > 1.0 {
+            self.stats.rejected += 1;
+            self.h = step * factor.min(1.0);
+            self.rejected_last = true;
+            return Ok(false);
+        }
+        self.stats.accepted += 1;
+        let grow = if self.rejected_last {
+            factor.min(1.0)
+        } else {
+            factor
+        };
+        // A step shortened to land on a stop says nothing against h.
+        self.h = if lands && step < self.h {
+            self.h.max(step * grow)
+        } else {
+            step * grow
+        };
+        self.rejected_last = false;
+        Ok(true)
+    }
+}
+
+#[cfg(test)]
+impl Dop853 {
+    /// One step's stages from (s, y) with k[0] = f(s, y) set: [`stages`]
+    /// on this integrator's storage.
     fn stages<F: FnMut(f64, &[f64], &mut [f64])>(&mut self, f: &mut F, s: f64, h: f64, y: &[f64]) {
-        for j in 1..12 {
-            self.stage.copy_from_slice(y);
-            for (l, &a) in A[j][..j].iter().enumerate() {
-                if a != 0.0 {
-                    axpy(&mut self.stage, h * a, &self.k[l]);
-                }
-            }
-            let (_, rest) = self.k.split_at_mut(j);
-            f(s + C[j] * h, &self.stage, &mut rest[0]);
-        }
-        self.next.copy_from_slice(y);
-        for (l, &b) in B.iter().enumerate() {
-            if b != 0.0 {
-                axpy(&mut self.next, h * b, &self.k[l]);
-            }
-        }
-    }
-
-    /// Hairer's combined error norm of DOP853: the 5th-order estimate,
-    /// corrected by the 3rd-order one so that it behaves like an 8th-order
-    /// error (dop853.f, "error estimation").
-    #[allow(clippy::needless_range_loop)] // i indexes y, next and 12 stages
-    fn error_norm(&self, h: f64, y: &[f64], controlled: usize, tol: &Tolerances) -> f64 {
-        let (mut err5, mut err3) = (0.0, 0.0);
-        for i in 0..controlled {
-            let sk = tol.atol + tol.rtol * y[i].abs().max(self.next[i].abs());
-            // B and ER vanish at stages 2 to 5: summing over the others
-            // alone is the same sum at two thirds of the cost.
-            let (mut bsum, mut e5) = (B[0] * self.k[0][i], ER[0] * self.k[0][i]);
-            for l in 5..12 {
-                bsum += B[l] * self.k[l][i];
-                e5 += ER[l] * self.k[l][i];
-            }
-            let e3 = bsum - BHH[0] * self.k[0][i] - BHH[1] * self.k[8][i] - BHH[2] * self.k[11][i];
-            err3 += (e3 / sk).powi(2);
-            err5 += (e5 / sk).powi(2);
-        }
-        let mut deno = err5 + 0.01 * err3;
-        if deno <= 0.0 {
-            deno = 1.0;
-        }
-        h.abs() * err5 * (1.0 / (controlled as f64 * deno)).sqrt()
+        let mut f = |t, a: &Vec<f64>, b: &mut Vec<f64>| f(t, a, b);
+        stages(
+            &mut self.k,
+            &mut self.stage,
+            &mut self.next,
+            &mut f,
+            s,
+            h,
+            y,
+        );
     }
 }
 
