@@ -16,7 +16,7 @@
 //! | multiple shooting | `solver.segments` | 4 × 8 N², N = u + n (segments − 1) (dense Jacobian, its LU, Newton's copies) |
 //! | collocation | `solver.max_intervals` | 2 × 8 K (m²n² + 2mn² + 2mn + (m+1)n), K = max_intervals, m = stages (per interval: the condensed LU, its right-hand sides, the stage Jacobians; the old and the new mesh during adaptation) |
 //! | stability verdict | `stability.elements` | the finite elements below at the verdict's finest mesh, max(2E, min(32E, [`crate::stability::MAX_VERDICT_ELEMENTS`])) for E = elements (its first comparison, then [`crate::stability::REFINEMENTS`] doublings up to the cap), eigenvalues + 1 |
-//! | continuation system | `continuation.intervals` (collocation) or `solver.segments` | N the family's unknowns: 6 × 8 (N+1)² (dense F_x, the bordered matrix, its LU, the SVD at branch points) for single shooting and N ≤ 200; above, 8 × 40 n (N+1) (band F_x, its copy and transpose, the bordered embedding, their LUs; the augmented systems of folds and branch points reuse them) |
+//! | continuation system | `continuation.intervals` (collocation) or `solver.segments` | N the family's unknowns: 6 × 8 (N+1)² (dense F_x, the bordered matrix, its LU, the SVD at branch points) for single shooting and N ≤ 200; above, 8 × 40 n (N+1) (band F_x, its copy and transpose, the bordered embedding, their LUs; the augmented systems of folds and branch points reuse them); plus the same for the refined family (2N unknowns on collocation) on which located points are located again |
 //! | continuation points | `continuation.max_points` | points × branches × (8 (2N + 1 + 3k + 3 shape_points + measures) + S + 256), branches = (1 + both_directions)(1 + 6 k switch_depth) |
 //! | tracked spectrum | `continuation.elements` | the finite elements below at `continuation.elements`, plus the previous point's 3k eigenvectors |
 //! | arm's second variation | `arm.elements` | the finite elements below at 4 × arm.elements, 1 eigenvalue (a reported optimum is re-evaluated on finer meshes) |
@@ -170,8 +170,17 @@ fn add_continuation(e: &mut MemoryEstimate, problem: &Problem) {
             "solver.segments"
         };
         let n = equations(&problem.rod, problem.model.level).dim() as f64;
-        e.add(field, continuation_system(family, size, n), format!(
-            "continuation systems of {size} unknowns (dense up to {}, band beyond, the augmented systems of folds and branch points too)",
+        // Each located fold or branch point is located again on the
+        // refined family (twice the collocation intervals) while the run's
+        // own systems are still held: its discretization error.
+        let refined = match problem.options.method {
+            Method::Collocation { .. } => 2.0 * family.size() as f64 + 1.0,
+            _ => size,
+        };
+        let systems =
+            continuation_system(family, size, n) + continuation_system(family, refined, n);
+        e.add(field, systems, format!(
+            "continuation systems of {size} unknowns (dense up to {}, band beyond, the augmented systems of folds and branch points too), and of {refined} on the refined family that states a located point's discretization error",
             crate::continuation::DENSE_UP_TO
         ));
         let k = opts.stability.eigenvalues() as f64;
