@@ -136,7 +136,7 @@ pub fn lowest_eigenpairs_from(
             .max(1e-6 * spread)
             .max(1e-14 * scale);
         let sigma = ritz.values[0] - margin;
-        let shifted = k.combine(1.0, g, -sigma).ldlt().ok()?;
+        let shifted = k.shifted_ldlt(-sigma, g).ok()?;
         (shifted.negative_pivots() == 0).then_some((sigma, shifted))
     })?;
     for _ in 0..SWEEPS {
