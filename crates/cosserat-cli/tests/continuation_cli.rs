@@ -100,7 +100,9 @@ fn interrupted_run_keeps_its_points() {
 fn killed_run_leaves_its_last_checkpoint() {
     let dir = scratch("continuation", "killed");
     let out = dir.join("slow.h5");
-    let mut child = slow_euler(&out, "0.0005", &[]).spawn().unwrap();
+    // Steps of 0.00025: the straight branch alone (63 600 points) outlasts
+    // the 3.5 s before the kill (at 0.0005 a faster build finished it).
+    let mut child = slow_euler(&out, "0.00025", &[]).spawn().unwrap();
     std::thread::sleep(std::time::Duration::from_millis(3500));
     child.kill().unwrap();
     let _ = child.wait();
@@ -116,7 +118,7 @@ fn killed_run_leaves_its_last_checkpoint() {
     drop(f);
     // The lock of the killed process does not block the resumed run, which
     // goes on from the checkpoint (more points) and cleans up after itself.
-    let mut child = slow_euler(&out, "0.0005", &["--resume"]).spawn().unwrap();
+    let mut child = slow_euler(&out, "0.00025", &["--resume"]).spawn().unwrap();
     let status = interrupt_after(&mut child, 3000);
     assert_eq!(status.code(), Some(130));
     let f = common::h5::open(&out);
@@ -140,7 +142,9 @@ fn killed_run_leaves_its_last_checkpoint() {
 fn interrupted_run_resumes_to_the_same_diagram() {
     let dir = scratch("continuation", "resumed");
     let (partial, full) = (dir.join("partial.h5"), dir.join("full.h5"));
-    let command = |out: &Path, extra: &[&str]| slow_euler(out, "0.004", extra);
+    // Steps of 0.002: the whole diagram takes ≈ 3 s of CPU, so the run is
+    // still going at 1.5 s (at 0.004 a faster build finished it sooner).
+    let command = |out: &Path, extra: &[&str]| slow_euler(out, "0.002", extra);
     let mut child = command(&partial, &[]).spawn().unwrap();
     let status = interrupt_after(&mut child, 1500);
     assert_eq!(

@@ -12,7 +12,7 @@
 //! the first point of a branch, on a constrained pencil, and where the warm
 //! start cannot vouch for its pairs.
 
-use std::cell::RefCell;
+use std::cell::{Ref, RefCell};
 
 use nalgebra::Vector3;
 
@@ -60,6 +60,22 @@ pub struct Spectrum {
 /// K and G of one block.
 type BlockMatrices = (SymmetricBanded, SymmetricBanded, Constraints);
 
+/// The tracker's data on one mesh ([`Tracker::mesh_on`]).
+#[derive(Debug, Clone)]
+struct MeshData {
+    /// The mesh.
+    fe: FiniteElements,
+    /// G of every block: the L² Gram matrix.
+    masses: Vec<SymmetricBanded>,
+    /// The quadrature points and the shape points (the last is the tip),
+    /// merged in increasing order: one integration samples them all.
+    points: Vec<f64>,
+    /// Whether each of `points` is a quadrature point (else a shape point).
+    quadrature: Vec<bool>,
+    /// The quadrature weights.
+    weights: Vec<f64>,
+}
+
 /// Measures spectra and keeps the last eigenvectors for matching.
 #[derive(Debug, Clone)]
 pub struct Tracker {
@@ -72,11 +88,10 @@ pub struct Tracker {
     shape_points: usize,
     previous: Option<Modes>,
     previous_values: Option<Vec<Vec<f64>>>,
-    /// G of every block and the mesh it was assembled on: the L² Gram
-    /// matrix depends on the mesh alone (length, elements, order, base),
-    /// not on the shape, so along a branch that keeps the length it is
-    /// assembled once (the same sums, so bit for bit the same matrices).
-    masses: RefCell<Option<(FiniteElements, Vec<SymmetricBanded>)>>,
+    /// What depends on the mesh alone (length, elements, order, base),
+    /// not on the shape: along a branch that keeps the length it is made
+    /// once (the same sums, so bit for bit the same matrices and points).
+    masses: RefCell<Option<MeshData>>,
     /// The block and eigenvectors (tracked and guard) of the last trial
     /// point of an event's location ([`Tracker::trial_nearest_zero`]),
     /// which start the next trial's eigenpairs; cleared when a location
@@ -176,29 +191,18 @@ impl Tracker {
             .with_breaks(&rod.loads().jumps())
             .with_hinged_base(rod.clamp().hinge);
         // One integration for the quadrature points and the shape points
-        // (the last is the tip).
-        let quadrature = fe.quadrature_points();
-        // L·(i/last), not L·i/last: i/last ≤ 1 rounds to exactly 1 at the
-        // tip, so no shape point lands an ulp beyond the rod (the
-        // sampler serves [0, L] and would leave such a point out).
-        let last = (self.shape_points - 1) as f64;
-        let grid: Vec<f64> = (0..self.shape_points)
-            .map(|i| rod.length() * (i as f64 / last))
-            .collect();
-        let mut all: Vec<(f64, bool)> = quadrature
-            .iter()
-            .map(|&s| (s, true))
-            .chain(grid.iter().map(|&s| (s, false)))
-            .collect();
-        all.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let points: Vec<f64> = all.iter().map(|a| a.0).collect();
-        let (samples, shape): (Vec<_>, Vec<_>) = family
-            .samples(x, p, &points)?
-            .into_iter()
-            .zip(&all)
-            .partition(|(_, tag)| tag.1);
-        let samples: Vec<RodSample> = samples.into_iter().map(|(s, _)| s).collect();
-        let shape: Vec<RodSample> = shape.into_iter().map(|(s, _)| s).collect();
+        // (the last is the tip), merged once per mesh.
+        let mesh = self.mesh_on(&fe, rod.length());
+        let mut samples = Vec::with_capacity(mesh.weights.len());
+        let mut shape = Vec::with_capacity(self.shape_points);
+        let all = family.samples(x, p, &mesh.points)?;
+        for (sample, &at_quadrature) in all.into_iter().zip(&mesh.quadrature) {
+            if at_quadrature {
+                samples.push(sample);
+            } else {
+                shape.push(sample);
+            }
+        }
         let turn = fe.h()
             * samples
                 .iter()
@@ -214,21 +218,20 @@ impl Tracker {
         }
         let norm = samples
             .iter()
-            .zip(fe.quadrature_weights())
+            .zip(&mesh.weights)
             .map(|(s, w)| w * s.curvature.norm_squared())
             .sum::<f64>()
             .sqrt();
         let c = coefficients(&rod, &samples);
         let tip = shape.last().expect("at least two shape points");
-        let masses = self.masses_on(&fe);
         let mats = self
             .blocks
             .iter()
-            .zip(masses)
+            .zip(&mesh.masses)
             .map(|(&b, g)| {
                 let constraints = support_constraints(&rod, &fe, b, &samples, tip)
                     .map_err(|e| PointError::Eigen(e.to_string()))?;
-                Ok((fe.stiffness(&c, b), g, constraints))
+                Ok((fe.stiffness(&c, b), g.clone(), constraints))
             })
             .collect::<Result<_, PointError>>()?;
         Ok((fe, mats, norm, shape))
@@ -417,18 +420,41 @@ impl Tracker {
         Ok(nearest)
     }
 
-    /// G of every block on the mesh `fe`, assembled only when the mesh
-    /// differs from the last one's.
-    fn masses_on(&self, fe: &FiniteElements) -> Vec<SymmetricBanded> {
-        let mut cache = self.masses.borrow_mut();
-        match cache.as_ref() {
-            Some((mesh, masses)) if mesh == fe => masses.clone(),
-            _ => {
-                let masses: Vec<SymmetricBanded> =
-                    self.blocks.iter().map(|&b| fe.mass(b)).collect();
-                *cache = Some((fe.clone(), masses.clone()));
-                masses
+    /// On the mesh `fe` of a rod of length `length`: the sample points
+    /// (quadrature and shape points merged in increasing order), which of
+    /// them are quadrature points, the quadrature weights and G of every
+    /// block — made only when the mesh differs from the last one's.
+    fn mesh_on(&self, fe: &FiniteElements, length: f64) -> Ref<'_, MeshData> {
+        {
+            let mut cache = self.masses.borrow_mut();
+            if cache.as_ref().is_none_or(|data| data.fe != *fe) {
+                *cache = Some(self.mesh_data(fe, length));
             }
+        }
+        Ref::map(self.masses.borrow(), |cache| {
+            cache.as_ref().expect("made just above")
+        })
+    }
+
+    /// [`Tracker::mesh_on`]'s data, made.
+    fn mesh_data(&self, fe: &FiniteElements, length: f64) -> MeshData {
+        // L·(i/last), not L·i/last: i/last ≤ 1 rounds to exactly 1 at the
+        // tip, so no shape point lands an ulp beyond the rod (the
+        // sampler serves [0, L] and would leave such a point out).
+        let last = (self.shape_points - 1) as f64;
+        let mut all: Vec<(f64, bool)> = fe
+            .quadrature_points()
+            .into_iter()
+            .map(|s| (s, true))
+            .chain((0..self.shape_points).map(|i| (length * (i as f64 / last), false)))
+            .collect();
+        all.sort_by(|a, b| a.0.total_cmp(&b.0));
+        MeshData {
+            fe: fe.clone(),
+            masses: self.blocks.iter().map(|&b| fe.mass(b)).collect(),
+            points: all.iter().map(|a| a.0).collect(),
+            quadrature: all.iter().map(|a| a.1).collect(),
+            weights: fe.quadrature_weights(),
         }
     }
 

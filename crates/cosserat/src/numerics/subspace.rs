@@ -29,8 +29,6 @@
 //! pairs whose values lie below σ — the Morse index (σ = 0) without a
 //! Sturm count of its own where the spectrum keeps clear of zero.
 
-use nalgebra::DMatrix;
-
 use super::banded::SymmetricBanded;
 use super::eigen::{count_below, diagonal_ratio, dot, row_sum_norm, Eigenpairs, Inertia};
 
@@ -138,7 +136,7 @@ pub fn lowest_eigenpairs_from(
             .max(1e-6 * spread)
             .max(1e-14 * scale);
         let sigma = ritz.values[0] - margin;
-        let shifted = k.combine(1.0, g, -sigma).ldlt().ok()?;
+        let shifted = k.shifted_ldlt(-sigma, g).ok()?;
         (shifted.negative_pivots() == 0).then_some((sigma, shifted))
     })?;
     for _ in 0..SWEEPS {
@@ -178,6 +176,8 @@ struct Ritz {
     v: Vec<Vec<f64>>,
     kv: Vec<Vec<f64>>,
     gv: Vec<Vec<f64>>,
+    /// The projected pencil and its solution ([`SmallPencil`]).
+    pencil: SmallPencil,
 }
 
 impl Ritz {
@@ -191,6 +191,7 @@ impl Ritz {
             v: block(),
             kv: block(),
             gv: block(),
+            pencil: SmallPencil::new(p),
         }
     }
 
@@ -202,29 +203,23 @@ impl Ritz {
         let p = self.basis.len();
         let (w, kw, gw) = (&self.basis, &self.k_basis, &self.g_basis);
         // One product per pair i ≤ j; the lower triangle mirrors it.
-        let (mut kr, mut gr) = (DMatrix::zeros(p, p), DMatrix::zeros(p, p));
-        for i in 0..p {
+        let pencil = &mut self.pencil;
+        for (i, wi) in w.iter().enumerate() {
             for j in i..p {
-                kr[(i, j)] = dot(&w[i], &kw[j]);
-                kr[(j, i)] = kr[(i, j)];
-                gr[(i, j)] = dot(&w[i], &gw[j]);
-                gr[(j, i)] = gr[(i, j)];
+                let (k, g) = (dot(wi, &kw[j]), dot(wi, &gw[j]));
+                pencil.k[i * p + j] = k;
+                pencil.k[j * p + i] = k;
+                pencil.g[i * p + j] = g;
+                pencil.g[j * p + i] = g;
             }
         }
-        let l_inv = gr.cholesky()?.l().try_inverse()?;
-        let c = &l_inv * kr * l_inv.transpose();
-        let eig = ((&c + c.transpose()) * 0.5).symmetric_eigen();
-        if eig.eigenvalues.iter().any(|v| !v.is_finite()) {
-            return None;
-        }
-        let mut order: Vec<usize> = (0..p).collect();
-        order.sort_by(|&a, &b| eig.eigenvalues[a].total_cmp(&eig.eigenvalues[b]));
-        let s = l_inv.transpose() * &eig.eigenvectors;
-        for (slot, &col) in order.iter().enumerate() {
-            self.values[slot] = eig.eigenvalues[col];
-            combine(w, s.column(col).as_slice(), &mut self.v[slot]);
-            combine(kw, s.column(col).as_slice(), &mut self.kv[slot]);
-            combine(gw, s.column(col).as_slice(), &mut self.gv[slot]);
+        pencil.solve()?;
+        for (slot, &col) in pencil.order.iter().enumerate() {
+            self.values[slot] = pencil.values[col];
+            let s = &pencil.vectors[col * p..(col + 1) * p];
+            combine(w, s, &mut self.v[slot]);
+            combine(kw, s, &mut self.kv[slot]);
+            combine(gw, s, &mut self.gv[slot]);
         }
         Some(())
     }
@@ -251,6 +246,178 @@ impl Ritz {
         Eigenpairs {
             values: self.values,
             vectors: self.v,
+        }
+    }
+}
+
+/// The p × p symmetric-definite pencil (K_r, G_r) of a Rayleigh–Ritz
+/// projection (p = the tracked eigenvalues and their guard, a handful),
+/// solved in buffers kept across sweeps, with no allocation: G_r = L Lᵀ
+/// (Cholesky), C = L⁻¹ K_r L⁻ᵀ symmetrized, C = Q Θ Qᵀ by cyclic Jacobi
+/// rotations (Golub & Van Loan, *Matrix Computations*, 4th ed., Sec. 8.5:
+/// eigenvalues to a few ulps of ‖C‖, as the QR algorithm), S = L⁻ᵀ Q
+/// (G_r-orthonormal columns). At this size Jacobi's O(p³) per sweep is a
+/// few hundred operations, and a general dense eigensolver's setup costs
+/// more than the solve.
+struct SmallPencil {
+    p: usize,
+    /// K_r and G_r, row-major; G_r's lower triangle becomes L.
+    k: Vec<f64>,
+    g: Vec<f64>,
+    /// C, then Θ on its diagonal.
+    c: Vec<f64>,
+    /// The eigenvalues θ (unsorted) and S's columns (column j at
+    /// `vectors[j p..(j + 1) p]`).
+    values: Vec<f64>,
+    vectors: Vec<f64>,
+    /// The columns in increasing θ.
+    order: Vec<usize>,
+}
+
+/// Jacobi sweeps at most; each squares the off-diagonal norm's relative
+/// size once the rotations are small, so 4–6 reach round-off.
+const JACOBI_SWEEPS: usize = 30;
+
+impl SmallPencil {
+    fn new(p: usize) -> Self {
+        SmallPencil {
+            p,
+            k: vec![0.0; p * p],
+            g: vec![0.0; p * p],
+            c: vec![0.0; p * p],
+            values: vec![0.0; p],
+            vectors: vec![0.0; p * p],
+            order: (0..p).collect(),
+        }
+    }
+
+    /// The eigenpairs of the pencil in `k`, `g`; None where G_r is not
+    /// positive definite (a dependent basis) or a value is not finite.
+    fn solve(&mut self) -> Option<()> {
+        let p = self.p;
+        self.cholesky()?;
+        // X = L⁻¹ K_r (column by column), then C = L⁻¹ Xᵀ = L⁻¹ K_r L⁻ᵀ.
+        let (l, c) = (&self.g, &mut self.c);
+        c.copy_from_slice(&self.k);
+        for _ in 0..2 {
+            for col in 0..p {
+                for i in 0..p {
+                    let mut v = c[i * p + col];
+                    for j in 0..i {
+                        v -= l[i * p + j] * c[j * p + col];
+                    }
+                    c[i * p + col] = v / l[i * p + i];
+                }
+            }
+            // Transpose in place: the second pass solves for (L⁻¹ K_r)ᵀ.
+            for i in 0..p {
+                for j in 0..i {
+                    c.swap(i * p + j, j * p + i);
+                }
+            }
+        }
+        for i in 0..p {
+            for j in 0..i {
+                let mean = 0.5 * (c[i * p + j] + c[j * p + i]);
+                c[i * p + j] = mean;
+                c[j * p + i] = mean;
+            }
+        }
+        self.jacobi();
+        // S = L⁻ᵀ Q, column by column (back substitution with Lᵀ).
+        let l = &self.g;
+        for col in 0..p {
+            let s = &mut self.vectors[col * p..(col + 1) * p];
+            for i in (0..p).rev() {
+                let mut v = s[i];
+                for j in i + 1..p {
+                    v -= l[j * p + i] * s[j];
+                }
+                s[i] = v / l[i * p + i];
+            }
+        }
+        if self.values.iter().any(|v| !v.is_finite()) {
+            return None;
+        }
+        let values = &self.values;
+        self.order.sort_by(|&a, &b| values[a].total_cmp(&values[b]));
+        Some(())
+    }
+
+    /// G_r = L Lᵀ in place (L in the lower triangle of `g`); None where a
+    /// pivot is not positive.
+    fn cholesky(&mut self) -> Option<()> {
+        let (p, g) = (self.p, &mut self.g);
+        for j in 0..p {
+            let mut d = g[j * p + j];
+            for k in 0..j {
+                d -= g[j * p + k] * g[j * p + k];
+            }
+            if d.is_nan() || d <= 0.0 {
+                return None;
+            }
+            let d = d.sqrt();
+            g[j * p + j] = d;
+            for i in j + 1..p {
+                let mut v = g[i * p + j];
+                for k in 0..j {
+                    v -= g[i * p + k] * g[j * p + k];
+                }
+                g[i * p + j] = v / d;
+            }
+        }
+        Some(())
+    }
+
+    /// C = Q Θ Qᵀ by cyclic Jacobi: Θ into `values`, Q's columns into
+    /// `vectors`, stopped when every off-diagonal entry is below round-off
+    /// of its diagonal pair (or after [`JACOBI_SWEEPS`]).
+    fn jacobi(&mut self) {
+        let (p, a, q) = (self.p, &mut self.c, &mut self.vectors);
+        q.fill(0.0);
+        for i in 0..p {
+            q[i * p + i] = 1.0;
+        }
+        for _ in 0..JACOBI_SWEEPS {
+            let mut rotated = false;
+            for i in 0..p {
+                for j in i + 1..p {
+                    let aij = a[i * p + j];
+                    let (aii, ajj) = (a[i * p + i], a[j * p + j]);
+                    if aij.abs() <= f64::EPSILON * 0.5 * (aii.abs() + ajj.abs()) || aij == 0.0 {
+                        continue;
+                    }
+                    rotated = true;
+                    // The rotation that zeroes a_ij (Golub & Van Loan,
+                    // Alg. 8.5.1): t = tan of the smaller angle.
+                    let tau = (ajj - aii) / (2.0 * aij);
+                    let t = tau.signum() / (tau.abs() + (1.0 + tau * tau).sqrt());
+                    let cs = 1.0 / (1.0 + t * t).sqrt();
+                    let sn = t * cs;
+                    for k in 0..p {
+                        let (akj, aki) = (a[k * p + j], a[k * p + i]);
+                        a[k * p + i] = cs * aki - sn * akj;
+                        a[k * p + j] = sn * aki + cs * akj;
+                    }
+                    for k in 0..p {
+                        let (ajk, aik) = (a[j * p + k], a[i * p + k]);
+                        a[i * p + k] = cs * aik - sn * ajk;
+                        a[j * p + k] = sn * aik + cs * ajk;
+                    }
+                    // Q's columns i and j (column c at q[c p..]).
+                    for k in 0..p {
+                        let (qi, qj) = (q[i * p + k], q[j * p + k]);
+                        q[i * p + k] = cs * qi - sn * qj;
+                        q[j * p + k] = sn * qi + cs * qj;
+                    }
+                }
+            }
+            if !rotated {
+                break;
+            }
+        }
+        for i in 0..p {
+            self.values[i] = a[i * p + i];
         }
     }
 }
@@ -367,6 +534,77 @@ mod tests {
         assert_eq!(warm.count_below(warm.pairs.values[0]), None);
         // Beyond τ the certificate says nothing.
         assert_eq!(warm.count_below(warm.pairs.values[2]), None);
+    }
+
+    /// The projected pencil's solver: K = tridiag(−1, 2, −1) of size 5
+    /// with G = 2 I has λ_j = (1 − cos(jπ/6)) (the discrete Laplacian's
+    /// 2 − 2cos(jπ/(p + 1)), halved); with a full G (K and G mixed by a
+    /// congruence X, which leaves the eigenvalues) the same values, the
+    /// vectors G-orthonormal with K s = λ G s.
+    #[test]
+    fn the_small_pencil_has_the_laplacians_eigenvalues() {
+        let p = 5;
+        let laplacian = |i: usize, j: usize| match i.abs_diff(j) {
+            0 => 2.0,
+            1 => -1.0,
+            _ => 0.0,
+        };
+        // X = I + 0.1·(i + 2j)/p² off the diagonal: invertible, not orthogonal.
+        let x = |i: usize, j: usize| {
+            if i == j {
+                1.0
+            } else {
+                0.1 * (i + 2 * j) as f64 / (p * p) as f64
+            }
+        };
+        for mixed in [false, true] {
+            let mut pencil = SmallPencil::new(p);
+            for i in 0..p {
+                for j in 0..p {
+                    // Xᵀ K X and Xᵀ (2I) X, or K and 2I.
+                    let (mut k, mut g) = (0.0, 0.0);
+                    for a in 0..p {
+                        for b in 0..p {
+                            let (xa, xb) = if mixed {
+                                (x(a, i), x(b, j))
+                            } else {
+                                (f64::from(u8::from(a == i)), f64::from(u8::from(b == j)))
+                            };
+                            k += xa * laplacian(a, b) * xb;
+                            g += xa * if a == b { 2.0 } else { 0.0 } * xb;
+                        }
+                    }
+                    pencil.k[i * p + j] = k;
+                    pencil.g[i * p + j] = g;
+                }
+            }
+            let (k, g) = (pencil.k.clone(), pencil.g.clone());
+            pencil.solve().expect("a definite pencil");
+            for (rank, &col) in pencil.order.iter().enumerate() {
+                let exact = 1.0 - ((rank + 1) as f64 * std::f64::consts::PI / 6.0).cos();
+                let theta = pencil.values[col];
+                assert!((theta - exact).abs() < 1e-14, "θ{rank} {theta} vs {exact}");
+                let s = &pencil.vectors[col * p..(col + 1) * p];
+                for i in 0..p {
+                    let (ks, gs): (f64, f64) = (0..p)
+                        .map(|j| (k[i * p + j] * s[j], g[i * p + j] * s[j]))
+                        .fold((0.0, 0.0), |a, b| (a.0 + b.0, a.1 + b.1));
+                    assert!(
+                        (ks - theta * gs).abs() < 1e-13,
+                        "residual {}",
+                        ks - theta * gs
+                    );
+                }
+                for &other in &pencil.order {
+                    let t = &pencil.vectors[other * p..(other + 1) * p];
+                    let gst: f64 = (0..p)
+                        .map(|i| s[i] * (0..p).map(|j| g[i * p + j] * t[j]).sum::<f64>())
+                        .sum();
+                    let expected = if other == col { 1.0 } else { 0.0 };
+                    assert!((gst - expected).abs() < 1e-13, "sᵀGt = {gst}");
+                }
+            }
+        }
     }
 
     #[test]

@@ -478,20 +478,68 @@ impl FiniteElements {
     }
 
     /// K for the coefficients at the quadrature points (in the order of
-    /// [`Self::quadrature_points`]).
+    /// [`Self::quadrature_points`]): element by element, ∫ φ_a'φ_b' A +
+    /// φ_a'φ_b B + φ_aφ_b' Bᵀ + φ_aφ_b C over the block's components, by
+    /// Gauss–Legendre with order + 1 points. Each point's block entries of
+    /// A, B, Bᵀ, C and each element's φ' = dφ/dξ / h are read once, not
+    /// once per pair of shape functions (the same products in the same
+    /// order as a term-by-term sum, so the same K bit for bit).
     pub fn stiffness(&self, coeffs: &[FormCoefficients], block: Block) -> SymmetricBanded {
         assert_eq!(
             coeffs.len(),
             self.elements() * (self.order + 1),
             "one set per quadrature point"
         );
-        self.assemble(block, |q, a, da, b, db, ci, cj| {
-            let c = &coeffs[q];
-            da * db * c.a[(ci, cj)]
-                + da * b * c.b[(ci, cj)]
-                + a * db * c.b[(cj, ci)]
-                + a * b * c.c[(ci, cj)]
-        })
+        let comps = block.components();
+        let nc = comps.len();
+        let p = self.order;
+        let mut k = SymmetricBanded::zeros(self.size(block), nc * (p + 1) - 1);
+        let first = self.first_node(block);
+        let (xs, ws) = gauss(p + 1);
+        let shapes: Vec<_> = xs.iter().map(|&x| self.shape(x)).collect();
+        // [A, B, Bᵀ, C]_{c_x c_y} of the block's components x, y (≤ 3 each).
+        let mut local = [[0.0; 4]; 9];
+        let mut slopes = vec![0.0; p + 1];
+        for e in 0..self.elements() {
+            let (_, h) = self.element(e);
+            for (g, ((values, derivatives), w)) in shapes.iter().zip(&ws).enumerate() {
+                let c = &coeffs[e * (p + 1) + g];
+                for (x, &ci) in comps.iter().enumerate() {
+                    for (y, &cj) in comps.iter().enumerate() {
+                        local[x * nc + y] =
+                            [c.a[(ci, cj)], c.b[(ci, cj)], c.b[(cj, ci)], c.c[(ci, cj)]];
+                    }
+                }
+                for (slope, d) in slopes.iter_mut().zip(derivatives) {
+                    *slope = d / h;
+                }
+                let weight = w * h;
+                for a in 0..=p {
+                    let Some(ia) = (e * p + a).checked_sub(first) else {
+                        continue;
+                    };
+                    let (va, da) = (values[a], slopes[a]);
+                    for b in 0..=p {
+                        let Some(ib) = (e * p + b).checked_sub(first) else {
+                            continue;
+                        };
+                        let (vb, db) = (values[b], slopes[b]);
+                        for x in 0..nc {
+                            for y in 0..nc {
+                                let (i, j) = (ia * nc + x, ib * nc + y);
+                                if i < j {
+                                    continue;
+                                }
+                                let [ca, cb, cbt, cc] = local[x * nc + y];
+                                let v = da * db * ca + da * vb * cb + va * db * cbt + va * vb * cc;
+                                k.add(i, j, weight * v);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        k
     }
 
     /// The L² Gram matrix G (ω·ω integrated): each element adds h times
@@ -531,50 +579,6 @@ impl FiniteElements {
             }
         }
         g
-    }
-
-    /// Element-by-element assembly of ∫ term(φ_a, φ_a', φ_b, φ_b') over
-    /// the selected components; `term` gets the quadrature index.
-    #[allow(clippy::type_complexity)]
-    fn assemble(
-        &self,
-        block: Block,
-        term: impl Fn(usize, f64, f64, f64, f64, usize, usize) -> f64,
-    ) -> SymmetricBanded {
-        let comps = block.components();
-        let nc = comps.len();
-        let p = self.order;
-        let mut k = SymmetricBanded::zeros(self.size(block), nc * (p + 1) - 1);
-        let first = self.first_node(block);
-        let (xs, ws) = gauss(p + 1);
-        let shapes: Vec<_> = xs.iter().map(|&x| self.shape(x)).collect();
-        for e in 0..self.elements() {
-            let (_, h) = self.element(e);
-            for (g, ((val, der), w)) in shapes.iter().zip(&ws).enumerate() {
-                let q = e * (p + 1) + g;
-                for a in 0..=p {
-                    let Some(ia) = (e * p + a).checked_sub(first) else {
-                        continue;
-                    };
-                    for b in 0..=p {
-                        let Some(ib) = (e * p + b).checked_sub(first) else {
-                            continue;
-                        };
-                        for (x, &ci) in comps.iter().enumerate() {
-                            for (y, &cj) in comps.iter().enumerate() {
-                                let (i, j) = (ia * nc + x, ib * nc + y);
-                                if i < j {
-                                    continue;
-                                }
-                                let v = term(q, val[a], der[a] / h, val[b], der[b] / h, ci, cj);
-                                k.add(i, j, w * h * v);
-                            }
-                        }
-                    }
-                }
-            }
-        }
-        k
     }
 
     /// The quadrature weights (times the element size), in the order of
