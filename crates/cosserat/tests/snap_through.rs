@@ -187,7 +187,9 @@ fn collocation_folds_are_located_on_the_augmented_system() {
 /// twice the intervals, Richardson-scaled) matches the actual error
 /// against the elastica within 10 % (measured on 16 intervals of order 6:
 /// 4.0e-8 and 4.1e-8 against 4.01e-8 and 4.12e-8), far above the
-/// reference's own error and the location tolerance.
+/// reference's own error and the location tolerance; and the branch is
+/// reported as outgrowing its mesh (on 64 intervals, where the folds are
+/// right to 1e-10, it is not: the test above).
 #[test]
 #[cfg_attr(debug_assertions, ignore = "a collocation diagram: release only")]
 fn collocation_folds_carry_their_discretization_error() {
@@ -201,7 +203,15 @@ fn collocation_folds_carry_their_discretization_error() {
     .map(String::from);
     let problem = Problem::from_str_with(ARCH, &sets).unwrap();
     let d = diagram(&problem);
-    assert!(d.warnings.is_empty(), "{:?}", d.warnings);
+    // The mesh is too coarse for the collocation tolerance 1e-10, and the
+    // diagram says so — once, for its one branch.
+    assert_eq!(d.warnings.len(), 1, "{:?}", d.warnings);
+    assert!(
+        d.warnings[0].starts_with("branch 0: its most deformed point")
+            && d.warnings[0].contains("raise continuation.intervals"),
+        "{:?}",
+        d.warnings
+    );
     let elastica = arch_elastica_folds(THETA).unwrap();
     assert!(elastica.correction < 1e-10);
     let mut folds: Vec<_> = d

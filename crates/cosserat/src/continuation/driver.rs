@@ -103,6 +103,9 @@ pub(super) fn drain(
         }
         let outcome = run.follow(&start, sign, index, diagram, monitor);
         diagram.branches[index].stop_reason = outcome.stop_reason.clone();
+        if !outcome.interrupted {
+            run.check_mesh(diagram, index);
+        }
         if outcome.interrupted {
             diagram.stop_reason = RunState::Interrupted;
             return;

@@ -269,6 +269,16 @@ impl Family {
         Ok((fine, gain))
     }
 
+    /// The segments (shooting) or intervals (collocation) of the mesh.
+    pub fn intervals(&self) -> usize {
+        self.segments
+    }
+
+    /// Gauss points per interval where the family is collocation.
+    pub fn stages(&self) -> Option<usize> {
+        self.stages
+    }
+
     /// The discrete system at a rod's equations.
     fn system<'e>(&self, eq: &'e dyn crate::equations::RodEquations) -> ShootingSystem<'e> {
         match self.stages {

@@ -41,6 +41,7 @@ mod kernel;
 mod landing;
 mod lens;
 mod measure;
+mod mesh_check;
 mod options;
 mod restart;
 mod resume;
