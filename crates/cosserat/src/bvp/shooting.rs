@@ -18,7 +18,8 @@ use super::newton::NonlinearSystem;
 use crate::equations::{PlanarKernel, RodEquations, RodSample};
 use crate::model::RodTangent;
 use crate::numerics::integrator::{
-    DenseRecord, Dop853, FixedDop853, IntegrationError, IntegrationStats, Stops, Tolerances,
+    DenseRecord, Dop853, FixedDop853, FixedRecorder, IntegrationError, IntegrationStats, Stops,
+    Tolerances,
 };
 use crate::numerics::staircase::Staircase;
 
@@ -45,8 +46,8 @@ pub struct ShootingSystem<'a> {
     kernel: Option<PlanarKernel>,
     fixed: FixedDop853<8>,
     /// The planar kernel's state alone, for the recorded sampling
-    /// ([`ShootingSystem::sample_recorded`]).
-    fixed_state: FixedDop853<4>,
+    /// ([`ShootingSystem::sample_recorded`]); built on first use.
+    recorder: Option<FixedRecorder<4>>,
     /// The buffers of one evaluation, kept for the next.
     work: Workspace,
     /// Integration work so far.
@@ -103,7 +104,7 @@ impl<'a> ShootingSystem<'a> {
             jumps: eq.jumps(),
             kernel: eq.planar_kernel(),
             fixed: FixedDop853::default(),
-            fixed_state: FixedDop853::default(),
+            recorder: None,
             work: Workspace {
                 seed: eq.initial_sensitivity(),
                 ..Workspace::default()
@@ -695,7 +696,8 @@ impl<'a> ShootingSystem<'a> {
                     // is this kernel's, its projection nothing).
                     let mut state = [0.0; 4];
                     state.copy_from_slice(&y);
-                    let stats = self.fixed_state.integrate_recorded(
+                    let recorder = self.recorder.get_or_insert_with(FixedRecorder::default);
+                    let stats = recorder.integrate_recorded(
                         |s, y, d| kernel.state_rates_fixed(s, y, d),
                         (piece.from, piece.to),
                         &mut state,

@@ -17,7 +17,7 @@ mod dense;
 mod fixed;
 
 pub use dense::DenseRecord;
-pub use fixed::FixedDop853;
+pub use fixed::{FixedDop853, FixedRecorder};
 
 /// Tolerances and limits of one integration.
 #[derive(Debug, Clone, Copy, PartialEq)]

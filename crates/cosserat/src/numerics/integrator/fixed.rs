@@ -6,7 +6,7 @@
 //! shooting's Newton iterations integrate (the planar state with its
 //! sensitivity column, N = 8, no stops) and what its sampling integrates
 //! (the planar state, N = 4, every step's continuous extension recorded:
-//! [`FixedDop853::integrate_recorded`]).
+//! [`FixedRecorder::integrate_recorded`]).
 
 use super::dense::{extension, interpolate, DenseRecord};
 use super::{
@@ -20,13 +20,6 @@ pub struct FixedDop853<const N: usize> {
     k: [[f64; N]; 12],
     stage: [f64; N],
     next: [f64; N],
-    /// The continuous extension of the last step: its start, the stages
-    /// 13..16 and the coefficients F₀ … F₆ (`integrator/dense.rs`), and a
-    /// state read from it.
-    y_old: [f64; N],
-    late: [[f64; N]; 4],
-    coefficients: [[f64; N]; 7],
-    value: [f64; N],
 }
 
 impl<const N: usize> Default for FixedDop853<N> {
@@ -35,6 +28,29 @@ impl<const N: usize> Default for FixedDop853<N> {
             k: [[0.0; N]; 12],
             stage: [0.0; N],
             next: [0.0; N],
+        }
+    }
+}
+
+/// A [`FixedDop853`] with room for DOP853's continuous extension
+/// (`integrator/dense.rs`): what a recorded integration needs, kept apart
+/// so that the Newton iterations' integrator does not carry (and zero)
+/// it.
+#[derive(Debug, Clone)]
+pub struct FixedRecorder<const N: usize> {
+    dop: FixedDop853<N>,
+    /// The last step's start, stages 13..16, coefficients F₀ … F₆, and a
+    /// state read from them.
+    y_old: [f64; N],
+    late: [[f64; N]; 4],
+    coefficients: [[f64; N]; 7],
+    value: [f64; N],
+}
+
+impl<const N: usize> Default for FixedRecorder<N> {
+    fn default() -> Self {
+        FixedRecorder {
+            dop: FixedDop853::default(),
             y_old: [0.0; N],
             late: [[0.0; N]; 4],
             coefficients: [[0.0; N]; 7],
@@ -88,7 +104,9 @@ impl<const N: usize> FixedDop853<N> {
         }
         Ok(control.stats)
     }
+}
 
+impl<const N: usize> FixedRecorder<N> {
     /// Integrates y' = f(s, y) over `span` = (s0, s1) in place as
     /// [`Dop853::integrate_serving`](super::Dop853::integrate_serving)
     /// with [`Stops::Recorded`](super::Stops::Recorded), all N components
@@ -117,21 +135,30 @@ impl<const N: usize> FixedDop853<N> {
             observe(s0, y);
             next_stop += 1;
         }
-        f(s, y, &mut self.k[0]);
-        let h = initial_step(&mut self.k, &mut self.stage, &mut f, s, s1, y, N, tol);
+        f(s, y, &mut self.dop.k[0]);
+        let h = initial_step(
+            &mut self.dop.k,
+            &mut self.dop.stage,
+            &mut f,
+            s,
+            s1,
+            y,
+            N,
+            tol,
+        );
         let mut control = StepControl::new(h);
         while s < s1 {
             let (step, lands) = control.propose(s, s1, tol)?;
             stages(
-                &mut self.k,
-                &mut self.stage,
-                &mut self.next,
+                &mut self.dop.k,
+                &mut self.dop.stage,
+                &mut self.dop.next,
                 &mut f,
                 s,
                 step,
                 y,
             );
-            let err = error_norm(&self.k, &self.next, step, y, N, tol);
+            let err = error_norm(&self.dop.k, &self.dop.next, step, y, N, tol);
             if !control.judge(err, step, lands, s, (s0, s1))? {
                 continue;
             }
@@ -139,7 +166,7 @@ impl<const N: usize> FixedDop853<N> {
             s = if lands { s1 } else { s + step };
             let inside = stops[next_stop..].partition_point(|&t| t <= s);
             self.y_old = *y;
-            *y = self.next;
+            *y = self.dop.next;
             if y.iter().any(|v| !v.is_finite()) {
                 return Err(IntegrationError::NotFinite { s });
             }
@@ -157,7 +184,7 @@ impl<const N: usize> FixedDop853<N> {
                 }
             }
             // f(s, y) is the extension's first extra stage.
-            self.k[0] = self.late[0];
+            self.dop.k[0] = self.late[0];
             next_stop += inside;
             if lands && next_stop < stops.len() && s1 == stops[next_stop] {
                 observe(s, y);
@@ -176,8 +203,8 @@ impl<const N: usize> FixedDop853<N> {
     {
         f(s + h, y_new, &mut self.late[0]);
         extension(
-            &self.k,
-            &mut self.stage,
+            &self.dop.k,
+            &mut self.dop.stage,
             &mut self.late,
             &mut self.coefficients,
             f,
@@ -261,7 +288,7 @@ mod tests {
                 .unwrap();
             let (mut fixed, mut fast_seen) = (start, vec![]);
             let mut record = DenseRecord::new(4);
-            let fast = FixedDop853::<4>::default()
+            let fast = FixedRecorder::<4>::default()
                 .integrate_recorded(
                     |s, y, d| rhs(s, y, d),
                     (0.0, 7.3),
