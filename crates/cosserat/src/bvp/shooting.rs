@@ -18,7 +18,8 @@ use super::newton::NonlinearSystem;
 use crate::equations::{PlanarKernel, RodEquations, RodSample};
 use crate::model::RodTangent;
 use crate::numerics::integrator::{
-    DenseRecord, Dop853, FixedDop853, IntegrationError, IntegrationStats, Stops, Tolerances,
+    DenseRecord, Dop853, FixedDop853, FixedRecorder, IntegrationError, IntegrationStats, Stops,
+    Tolerances,
 };
 use crate::numerics::staircase::Staircase;
 
@@ -44,8 +45,49 @@ pub struct ShootingSystem<'a> {
     /// (`fixed`), the same steps and result as `dop`'s.
     kernel: Option<PlanarKernel>,
     fixed: FixedDop853<8>,
+    /// The planar kernel's state alone, for the recorded sampling
+    /// ([`ShootingSystem::sample_recorded`]); built on first use.
+    recorder: Option<FixedRecorder<4>>,
+    /// The buffers of one evaluation, kept for the next.
+    work: Workspace,
     /// Integration work so far.
     pub stats: IntegrationStats,
+}
+
+/// The end of an integrated segment: the state and its sensitivity
+/// columns Φ (dim × cols).
+struct SegmentEnd {
+    state: Vec<f64>,
+    phi: DMatrix<f64>,
+}
+
+impl Default for SegmentEnd {
+    fn default() -> Self {
+        SegmentEnd {
+            state: Vec::new(),
+            phi: DMatrix::zeros(0, 0),
+        }
+    }
+}
+
+/// What [`ShootingSystem::evaluate_staircase_forced`] and
+/// [`NonlinearSystem::evaluate`] reuse from one evaluation to the next, so
+/// that a Newton iteration of single shooting allocates only inside the
+/// equations' tip Jacobian and the LU: the constant seeds of Φ, the
+/// segment's start and end, the tip residual g and g' Φ, and the
+/// staircase.
+#[derive(Default)]
+struct Workspace {
+    /// ∂y(0)/∂u ([`RodEquations::initial_sensitivity`], a constant of
+    /// the equations): the first segment's Φ(0).
+    seed: DMatrix<f64>,
+    /// The identity, the interior segments' Φ(0); built on first use.
+    identity: Option<DMatrix<f64>>,
+    start: Vec<f64>,
+    end: SegmentEnd,
+    g: Vec<f64>,
+    g_phi: DMatrix<f64>,
+    staircase: Option<Staircase>,
 }
 
 impl<'a> ShootingSystem<'a> {
@@ -62,6 +104,11 @@ impl<'a> ShootingSystem<'a> {
             jumps: eq.jumps(),
             kernel: eq.planar_kernel(),
             fixed: FixedDop853::default(),
+            recorder: None,
+            work: Workspace {
+                seed: eq.initial_sensitivity(),
+                ..Workspace::default()
+            },
             stats: IntegrationStats::default(),
         }
     }
@@ -105,14 +152,27 @@ impl<'a> ShootingSystem<'a> {
 
     /// The state at node j (j = 0 from u) taken from the unknown vector.
     fn node_state(&self, x: &[f64], j: usize) -> Vec<f64> {
+        let mut y = Vec::new();
+        self.node_state_into(x, j, &mut y);
+        y
+    }
+
+    /// [`ShootingSystem::node_state`] into `y`, reusing its storage.
+    fn node_state_into(&self, x: &[f64], j: usize, y: &mut Vec<f64>) {
         let (n, p) = (self.eq.dim(), self.eq.unknowns());
+        y.clear();
         if j == 0 {
-            let mut y0 = vec![0.0; n];
-            self.eq.initial_state(&x[..p], &mut y0);
-            y0
+            y.resize(n, 0.0);
+            self.eq.initial_state(&x[..p], y);
         } else {
-            x[p + n * (j - 1)..p + n * j].to_vec()
+            y.extend_from_slice(self.interior_node(x, j));
         }
+    }
+
+    /// The state at interior node j ≥ 1: a slice of the unknowns.
+    fn interior_node<'x>(&self, x: &'x [f64], j: usize) -> &'x [f64] {
+        let (n, p) = (self.eq.dim(), self.eq.unknowns());
+        &x[p + n * (j - 1)..p + n * j]
     }
 
     /// Integrates segment j from `start` with `cols` sensitivity columns
@@ -123,21 +183,33 @@ impl<'a> ShootingSystem<'a> {
         start: &[f64],
         phi0: &DMatrix<f64>,
     ) -> Result<(Vec<f64>, DMatrix<f64>), IntegrationError> {
-        self.forced_segment(j, start, phi0, None)
+        let mut end = SegmentEnd::default();
+        self.forced_segment(j, start, phi0, None, &mut end)?;
+        Ok((end.state, end.phi))
     }
 
-    /// [`ShootingSystem::segment`], with `forcing` the last column the
-    /// parameter sensitivity z' = f_y z + ∂f/∂p
-    /// ([`RodEquations::rhs_parameter`]).
+    /// [`ShootingSystem::segment`] into `out` (its storage reused), with
+    /// `forcing` the last column the parameter sensitivity
+    /// z' = f_y z + ∂f/∂p ([`RodEquations::rhs_parameter`]).
     fn forced_segment(
         &mut self,
         j: usize,
         start: &[f64],
         phi0: &DMatrix<f64>,
         forcing: Option<&RodTangent>,
-    ) -> Result<(Vec<f64>, DMatrix<f64>), IntegrationError> {
+        out: &mut SegmentEnd,
+    ) -> Result<(), IntegrationError> {
         let n = self.eq.dim();
-        let span = pieces(&self.jumps, self.node(j), self.node(j + 1));
+        let (a, b) = (self.node(j), self.node(j + 1));
+        let cols = phi0.ncols();
+        if let (None, Some(kernel), None, 1) = (&self.gauss, self.kernel, forcing, cols) {
+            // One piece without a jump ([`pieces`]), found without
+            // building the list.
+            if !self.jumps.iter().any(|&s| s > a && s <= b) {
+                return self.planar_segment(kernel, (a, b), start, phi0, out);
+            }
+        }
+        let span = pieces(&self.jumps, a, b);
         if let Some(stepper) = &mut self.gauss {
             // A jump inside the interval splits the Gauss step there: the
             // pieces chain through the state's jump (the identity at a
@@ -160,15 +232,11 @@ impl<'a> ShootingSystem<'a> {
                     self.eq.jump(s, &mut y.0, cols, y.1.as_mut_slice())?;
                 }
             }
-            return Ok(y);
+            (out.state, out.phi) = y;
+            return Ok(());
         }
-        let cols = phi0.ncols();
-        if let (Some(kernel), None, 1, [piece]) = (self.kernel, forcing, cols, span.as_slice()) {
-            if piece.jump.is_none() {
-                return self.planar_segment(kernel, piece, start, phi0);
-            }
-        }
-        let mut y = Vec::with_capacity(n * (cols + 1));
+        let y = &mut out.state;
+        y.clear();
         y.extend_from_slice(start);
         y.extend_from_slice(phi0.as_slice());
         let eq = self.eq;
@@ -191,14 +259,14 @@ impl<'a> ShootingSystem<'a> {
         // each jump with Φ (continuous at a point force).
         for piece in span {
             if piece.to <= piece.from {
-                jump_with_sensitivities(eq, piece.jump, &mut y, n, cols)?;
+                jump_with_sensitivities(eq, piece.jump, y, n, cols)?;
                 continue;
             }
             let stats = Self::dop(&mut self.dop, self.eq, self.segments).integrate(
                 &mut rhs,
                 piece.from,
                 piece.to,
-                &mut y,
+                y,
                 controlled,
                 &self.tol,
                 &[],
@@ -214,11 +282,14 @@ impl<'a> ShootingSystem<'a> {
                 },
             )?;
             self.stats += stats;
-            jump_with_sensitivities(eq, piece.jump, &mut y, n, cols)?;
+            jump_with_sensitivities(eq, piece.jump, y, n, cols)?;
         }
-        let phi = DMatrix::from_column_slice(n, cols, &y[n..]);
+        if out.phi.shape() != (n, cols) {
+            out.phi = DMatrix::zeros(n, cols);
+        }
+        out.phi.as_mut_slice().copy_from_slice(&y[n..]);
         y.truncate(n);
-        Ok((y, phi))
+        Ok(())
     }
 
     /// A segment of the planar kernel's equations with one sensitivity
@@ -230,22 +301,29 @@ impl<'a> ShootingSystem<'a> {
     fn planar_segment(
         &mut self,
         kernel: PlanarKernel,
-        piece: &Piece,
+        (from, to): (f64, f64),
         start: &[f64],
         phi0: &DMatrix<f64>,
-    ) -> Result<(Vec<f64>, DMatrix<f64>), IntegrationError> {
+        out: &mut SegmentEnd,
+    ) -> Result<(), IntegrationError> {
         let mut y = [0.0; 8];
         y[..4].copy_from_slice(start);
         y[4..].copy_from_slice(phi0.as_slice());
         let stats = self.fixed.integrate(
             |s, y, d| kernel.rates_with_column(s, y, d),
-            piece.from,
-            piece.to,
+            from,
+            to,
             &mut y,
             &self.tol,
         )?;
         self.stats += stats;
-        Ok((y[..4].to_vec(), DMatrix::from_column_slice(4, 1, &y[4..])))
+        out.state.clear();
+        out.state.extend_from_slice(&y[..4]);
+        if out.phi.shape() != (4, 1) {
+            out.phi = DMatrix::zeros(4, 1);
+        }
+        out.phi.as_mut_slice().copy_from_slice(&y[4..]);
+        Ok(())
     }
 
     /// A starting vector of unknowns from free values u: the interior nodes
@@ -396,6 +474,22 @@ impl<'a> ShootingSystem<'a> {
         x: &[f64],
         r: &mut DVector<f64>,
         a: &mut Staircase,
+        forcing: Option<(&RodTangent, &mut DVector<f64>)>,
+    ) -> Result<(), IntegrationError> {
+        let mut work = std::mem::take(&mut self.work);
+        let outcome = self.evaluate_in(&mut work, x, r, a, forcing);
+        self.work = work;
+        outcome
+    }
+
+    /// [`ShootingSystem::evaluate_staircase_forced`] on the buffers of
+    /// `work`.
+    fn evaluate_in(
+        &mut self,
+        work: &mut Workspace,
+        x: &[f64],
+        r: &mut DVector<f64>,
+        a: &mut Staircase,
         mut forcing: Option<(&RodTangent, &mut DVector<f64>)>,
     ) -> Result<(), IntegrationError> {
         let (n, p, k) = (self.eq.dim(), self.eq.unknowns(), self.segments);
@@ -404,29 +498,32 @@ impl<'a> ShootingSystem<'a> {
             None => Vec::new(),
         };
         for j in 0..k {
-            let start = self.node_state(x, j);
+            self.node_state_into(x, j, &mut work.start);
             let seed = if j == 0 {
-                self.eq.initial_sensitivity()
+                &work.seed
             } else {
-                DMatrix::identity(n, n)
+                work.identity.get_or_insert_with(|| DMatrix::identity(n, n))
             };
             let cols = seed.ncols();
+            let forced;
             let phi0 = match &forcing {
                 None => seed,
                 Some((t, _)) => {
-                    let mut phi0 = seed.insert_column(cols, 0.0);
+                    let mut phi0 = seed.clone().insert_column(cols, 0.0);
                     if j == 0 {
                         let mut z0 = vec![0.0; n];
                         self.eq.initial_state_parameter(&x[..p], t, &mut z0);
                         phi0.column_mut(cols).copy_from_slice(&z0);
                     }
-                    phi0
+                    forced = phi0;
+                    &forced
                 }
             };
             let tangent = forcing.as_ref().map(|(t, _)| *t);
-            let (end, phi) = self.forced_segment(j, &start, &phi0, tangent)?;
+            self.forced_segment(j, &work.start, phi0, tangent, &mut work.end)?;
+            let (end, phi) = (&work.end.state, &work.end.phi);
             if j + 1 < k {
-                let next = self.node_state(x, j + 1);
+                let next = self.interior_node(x, j + 1);
                 let block = a.block_mut(j);
                 for i in 0..n {
                     let w = 1.0 / self.scales[i];
@@ -442,16 +539,21 @@ impl<'a> ShootingSystem<'a> {
                     *d = -1.0 / s;
                 }
             } else {
-                let mut g = vec![0.0; p];
-                self.eq.tip_residual(&end, &mut g);
-                let gj = self.eq.tip_residual_jacobian(&end) * &phi;
+                work.g.resize(p, 0.0);
+                self.eq.tip_residual(end, &mut work.g);
+                let g_y = self.eq.tip_residual_jacobian(end);
+                if work.g_phi.shape() != (p, phi.ncols()) {
+                    work.g_phi = DMatrix::zeros(p, phi.ncols());
+                }
+                g_y.mul_to(phi, &mut work.g_phi);
+                let gj = &work.g_phi;
                 for i in 0..p {
-                    r[n * (k - 1) + i] = g[i];
+                    r[n * (k - 1) + i] = work.g[i];
                 }
                 a.block_mut(j).copy_from(&gj.columns(0, cols));
                 if let Some((t, fp)) = forcing.as_mut() {
                     let mut gp = vec![0.0; p];
-                    self.eq.tip_residual_parameter(&end, t, &mut gp);
+                    self.eq.tip_residual_parameter(end, t, &mut gp);
                     for i in 0..p {
                         fp[n * (k - 1) + i] = gj[(i, cols)] + gp[i];
                     }
@@ -490,7 +592,9 @@ impl<'a> ShootingSystem<'a> {
                 self.eq
                     .initial_state_parameter(&x[..p], t, z0.as_mut_slice());
             }
-            let (end, z) = self.forced_segment(j, &start, &z0, Some(t))?;
+            let mut out = SegmentEnd::default();
+            self.forced_segment(j, &start, &z0, Some(t), &mut out)?;
+            let (end, z) = (out.state, out.phi);
             if j + 1 < k {
                 let next = self.node_state(x, j + 1);
                 for i in 0..n {
@@ -582,7 +686,29 @@ impl<'a> ShootingSystem<'a> {
             let mut y = self.node_state(x, j);
             let eq = self.eq;
             for (piece, stops) in served_pieces(&self.jumps, a, b, &stops, last) {
-                if piece.to > piece.from {
+                let fixed = match (self.kernel, serve) {
+                    (Some(kernel), Stops::Recorded) if n == 4 => Some(kernel),
+                    _ => None,
+                };
+                if let (Some(kernel), true) = (fixed, piece.to > piece.from) {
+                    // The planar state on a 4-array: the generic path's
+                    // steps, samples and record, bit for bit (its `rhs`
+                    // is this kernel's, its projection nothing).
+                    let mut state = [0.0; 4];
+                    state.copy_from_slice(&y);
+                    let recorder = self.recorder.get_or_insert_with(FixedRecorder::default);
+                    let stats = recorder.integrate_recorded(
+                        |s, y, d| kernel.state_rates_fixed(s, y, d),
+                        (piece.from, piece.to),
+                        &mut state,
+                        &self.tol,
+                        stops,
+                        |s, y| samples.push(eq.sample(s, y)),
+                        &mut record,
+                    )?;
+                    y.copy_from_slice(&state);
+                    self.stats += stats;
+                } else if piece.to > piece.from {
                     let stats = Self::dop(&mut self.dop, eq, self.segments).integrate_serving(
                         |s, y: &[f64], d: &mut [f64]| eq.rhs(s, y, d),
                         (piece.from, piece.to, n),
@@ -740,10 +866,19 @@ impl NonlinearSystem for ShootingSystem<'_> {
         r: &mut DVector<f64>,
         jac: &mut DMatrix<f64>,
     ) -> Result<(), IntegrationError> {
-        let mut a = self.staircase();
-        self.evaluate_staircase(x, r, &mut a)?;
-        a.write_dense(jac);
-        Ok(())
+        // Every entry of the staircase is written by each evaluation: the
+        // last one's is reused.
+        let mut a = self
+            .work
+            .staircase
+            .take()
+            .unwrap_or_else(|| self.staircase());
+        let outcome = self.evaluate_staircase(x, r, &mut a);
+        if outcome.is_ok() {
+            a.write_dense(jac);
+        }
+        self.work.staircase = Some(a);
+        outcome
     }
 }
 
@@ -788,6 +923,40 @@ mod tests {
             };
             let (a, b) = (run(&mut fast), run(&mut slow));
             assert_eq!(a, b, "{segments} segments, rtol {rtol}");
+        }
+    }
+
+    /// The recorded sampling of the planar kernel on the fixed-size
+    /// integrator against the generic path: the same samples, drift,
+    /// record and work, bit for bit, on one and three segments.
+    #[test]
+    fn the_planar_recorded_sampling_is_the_generic_integration() {
+        let energy = LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3]).unwrap();
+        let loads = DeadLoads {
+            tip_force: Vector3::new(3.0, 0.0, 0.0),
+            distributed_force: Vector3::new(0.5, 0.0, -0.2),
+            ..Default::default()
+        };
+        let rod = Rod::new(1.0, Arc::new(energy), Clamp::paper(), loads, None).unwrap();
+        let eq = PlanarEquations::new(rod);
+        let points: Vec<f64> = (0..=7).map(|i| f64::from(i) / 7.0).collect();
+        for (segments, rtol) in [(1, 1e-4), (1, 1e-12), (3, 1e-8)] {
+            let tol = Tolerances {
+                rtol,
+                atol: rtol,
+                ..Tolerances::default()
+            };
+            let mut fast = ShootingSystem::new(&eq, segments, tol);
+            let mut slow = ShootingSystem::new(&eq, segments, tol);
+            slow.kernel = None;
+            let x = fast.initial_unknowns(&[1.3]);
+            let (a, b) = (
+                fast.sample_recorded(&x, &points).unwrap(),
+                slow.sample_recorded(&x, &points).unwrap(),
+            );
+            assert_eq!(a.0.len(), points.len());
+            assert_eq!(format!("{a:?}"), format!("{b:?}"), "{segments} segments");
+            assert_eq!(fast.stats, slow.stats, "{segments} segments, rtol {rtol}");
         }
     }
 

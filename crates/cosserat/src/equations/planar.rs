@@ -125,6 +125,14 @@ impl PlanarKernel {
         let (dy, dphi) = d.split_at_mut(4);
         self.rates(s, state, 1, column, dy, dphi);
     }
+
+    /// The state's rates alone on a 4-array (x, z, φ, κ2): what
+    /// [`RodEquations::rhs`] of the planar equations computes with this
+    /// kernel, for the fixed-size sampling integration.
+    #[inline]
+    pub fn state_rates_fixed(&self, s: f64, y: &[f64; 4], d: &mut [f64; 4]) {
+        self.state_rates(s, y, d);
+    }
 }
 
 impl PlanarEquations {

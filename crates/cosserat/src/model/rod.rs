@@ -5,7 +5,7 @@
 //! positive finite length, finite loads and positions, unit support axes
 //! and director frames that are rotations ([`Frame`]).
 
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use nalgebra::Vector3;
 
@@ -91,6 +91,12 @@ pub struct Rod {
     clamp: Clamp,
     loads: DeadLoads,
     support: Option<TipSupport>,
+    /// [`Rod::intrinsic_moment`] once computed: it reads only the energy
+    /// and the length, so the rod's clones (a load ramp's scaled rods,
+    /// another clamp or support) share it, and [`Rod::with_length`] and
+    /// [`Rod::with_energy`] start a new one. Without it every set of
+    /// equations made 65 energy calls for its residual units.
+    intrinsic: Arc<OnceLock<Vector3<f64>>>,
 }
 
 /// Refuses a vector with a non-finite component.
@@ -187,6 +193,7 @@ impl Rod {
             clamp,
             loads,
             support,
+            intrinsic: Arc::default(),
         })
     }
 
@@ -220,6 +227,7 @@ impl Rod {
         check_length(length)?;
         check_point_loads(&self.loads, length)?;
         self.length = length;
+        self.intrinsic = Arc::default();
         Ok(self)
     }
 
@@ -228,6 +236,7 @@ impl Rod {
     #[must_use]
     pub fn with_energy(mut self, energy: Arc<dyn StoredEnergy>) -> Rod {
         self.energy = energy;
+        self.intrinsic = Arc::default();
         self
     }
 
@@ -296,12 +305,19 @@ impl Rod {
 
     /// max over s of |M_i(s, κ = 0)|: the moment an intrinsically curved rod
     /// carries when straightened (B_i |κ⁰_i| for the linear energy), on 65
-    /// points along the rod.
+    /// points along the rod; computed once per energy and length.
     fn intrinsic_moment(&self) -> Vector3<f64> {
+        *self
+            .intrinsic
+            .get_or_init(|| Self::sampled_intrinsic_moment(&*self.energy, self.length))
+    }
+
+    /// [`Rod::intrinsic_moment`] sampled from the energy.
+    fn sampled_intrinsic_moment(energy: &dyn StoredEnergy, length: f64) -> Vector3<f64> {
         (0..=64)
             .map(|j| {
-                let s = self.length * f64::from(j) / 64.0;
-                self.energy.moment(s, &Vector3::zeros()).abs()
+                let s = length * f64::from(j) / 64.0;
+                energy.moment(s, &Vector3::zeros()).abs()
             })
             .fold(Vector3::zeros(), |a, m| a.sup(&m))
     }
@@ -371,6 +387,35 @@ mod tests {
             .with_support(Some(support.clone()))
             .unwrap();
         assert_eq!((rod.clamp(), rod.support()), (&turned, Some(&support)));
+    }
+
+    /// The residual units of a rod whose energy or length changed are
+    /// those of the same rod built afresh: the intrinsic moment shared by
+    /// clones is not carried across [`Rod::with_energy`] or
+    /// [`Rod::with_length`], and a clone under other loads keeps it.
+    #[test]
+    fn residual_units_follow_the_energy_and_the_length() {
+        let curved = |k: f64| -> Arc<dyn StoredEnergy> {
+            Arc::new(LinearElastic::uniform([1.0, 2.0, 3.0], [0.0, k, 0.0]).unwrap())
+        };
+        let fresh = |l: f64, e: Arc<dyn StoredEnergy>| {
+            Rod::new(l, e, Clamp::paper(), loads(), None)
+                .unwrap()
+                .residual_scales()
+        };
+        let rod = Rod::new(1.0, curved(5.0), Clamp::paper(), loads(), None).unwrap();
+        assert_eq!(rod.residual_scales(), fresh(1.0, curved(5.0)));
+        assert_eq!(rod.residual_scales().moment[1], 10.0);
+        let other = rod.clone().with_energy(curved(7.0));
+        assert_eq!(other.residual_scales(), fresh(1.0, curved(7.0)));
+        let longer = rod.clone().with_length(0.1).unwrap();
+        assert_eq!(longer.residual_scales(), fresh(0.1, curved(5.0)));
+        assert_eq!(rod.residual_scales(), fresh(1.0, curved(5.0)));
+        let scaled = rod.with_load_factor(40.0).unwrap();
+        let expected = Rod::new(1.0, curved(5.0), Clamp::paper(), loads().scaled(40.0), None)
+            .unwrap()
+            .residual_scales();
+        assert_eq!(scaled.residual_scales(), expected);
     }
 
     #[test]

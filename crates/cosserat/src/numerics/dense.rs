@@ -2,12 +2,15 @@
 //! Newton linearization to its solves: the linear solve of the small dense
 //! systems (single shooting, Newton at a fixed continuation parameter).
 
-use nalgebra::{DMatrix, DVector, Dyn, LU};
+use nalgebra::{DMatrix, DVectorViewMut, Dyn, LU};
 
 /// The LU factors of the last matrix factored, if any.
 #[derive(Debug, Clone, Default)]
 pub struct DenseLu {
     lu: Option<LU<f64, Dyn, Dyn>>,
+    /// The right-hand side solved in place, kept between solves: a
+    /// Newton iteration's corrections allocate nothing.
+    rhs: Vec<f64>,
 }
 
 impl DenseLu {
@@ -18,14 +21,17 @@ impl DenseLu {
 
     /// The Newton correction δ = −A⁻¹ f of the last factored A; false
     /// (δ untouched) where A is singular or nothing was factored.
-    pub fn newton_step(&self, f: &[f64], delta: &mut [f64]) -> bool {
-        let rhs = -DVector::from_column_slice(f);
-        match self.lu.as_ref().and_then(|lu| lu.solve(&rhs)) {
-            Some(d) => {
-                delta.copy_from_slice(d.as_slice());
-                true
-            }
-            None => false,
+    pub fn newton_step(&mut self, f: &[f64], delta: &mut [f64]) -> bool {
+        let Some(lu) = self.lu.as_ref() else {
+            return false;
+        };
+        self.rhs.clear();
+        self.rhs.extend(f.iter().map(|v| -v));
+        let n = self.rhs.len();
+        if !lu.solve_mut(&mut DVectorViewMut::from_slice(&mut self.rhs, n)) {
+            return false;
         }
+        delta.copy_from_slice(&self.rhs);
+        true
     }
 }

@@ -17,7 +17,7 @@ mod dense;
 mod fixed;
 
 pub use dense::DenseRecord;
-pub use fixed::FixedDop853;
+pub use fixed::{FixedDop853, FixedRecorder};
 
 /// Tolerances and limits of one integration.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -320,7 +320,8 @@ impl Dop853 {
                 control.stats.evaluations += self.extend(&mut f, start, step, y);
                 let mut dense = self.dense.take().expect("built by interpolant");
                 if serve == Stops::Recorded {
-                    self.record.push(start, step, &dense);
+                    self.record
+                        .push(start, step, &dense.y_old, &dense.coefficients);
                 }
                 for &t in &stops[next_stop..next_stop + inside] {
                     // The step's end is the state itself, as when landed.

@@ -11,7 +11,7 @@
 
 #![allow(clippy::excessive_precision)]
 
-use super::{axpy, Dop853};
+use super::{axpy, Dop853, StageVector};
 
 /// Nodes of the extra stages 14, 15, 16.
 const C_EXTRA: [f64; 3] = [0.1, 0.2, 0.777777777777777777777777777778];
@@ -84,10 +84,10 @@ const D: [[f64; 12]; 4] = [
 /// The continuous extension of the last accepted step, with its buffers.
 #[derive(Debug, Clone)]
 pub(super) struct Interpolant {
-    y_old: Vec<f64>,
+    pub(super) y_old: Vec<f64>,
     /// Stages 13..16: f(s + h, y₁) and the three extra ones.
     late: [Vec<f64>; 4],
-    coefficients: [Vec<f64>; 7],
+    pub(super) coefficients: [Vec<f64>; 7],
     value: Vec<f64>,
 }
 
@@ -114,17 +114,79 @@ impl Interpolant {
 
     /// The state at θ ∈ [0, 1] of the step, passed through `project`.
     pub(super) fn at(&mut self, theta: f64, project: &mut impl FnMut(&mut [f64])) -> &[f64] {
-        self.value.fill(0.0);
-        for (i, f) in self.coefficients.iter().rev().enumerate() {
-            let w = if i % 2 == 0 { theta } else { 1.0 - theta };
-            self.value
-                .iter_mut()
-                .zip(f)
-                .for_each(|(v, c)| *v = (*v + c) * w);
-        }
-        axpy(&mut self.value, 1.0, &self.y_old);
+        interpolate(&self.coefficients, &self.y_old, theta, &mut self.value);
         project(&mut self.value);
         &self.value
+    }
+}
+
+/// The extension y₀ + θ(F₀ + (1−θ)(F₁ + …)) of a step at θ into `value`,
+/// from its start y₀ and coefficients F₀ … F₆ (heap vectors or arrays).
+pub(super) fn interpolate<K: StageVector>(
+    coefficients: &[K; 7],
+    y_old: &[f64],
+    theta: f64,
+    value: &mut [f64],
+) {
+    value.fill(0.0);
+    for (i, f) in coefficients.iter().rev().enumerate() {
+        let w = if i % 2 == 0 { theta } else { 1.0 - theta };
+        value
+            .iter_mut()
+            .zip(f.as_ref())
+            .for_each(|(v, c)| *v = (*v + c) * w);
+    }
+    axpy(value, 1.0, y_old);
+}
+
+/// The extension's three extra stages (`late[1..]`, with `late[0]` =
+/// f(s + h, y_new) already evaluated) and its coefficients F₀ … F₆, of
+/// the step of size h from (s, y_old) to `y_new` whose 12 stages are in
+/// `k`; shared by [`Dop853`] and [`super::FixedDop853`] as the stages
+/// are.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn extension<K: StageVector, F: FnMut(f64, &K, &mut K)>(
+    k: &[K; 12],
+    stage: &mut K,
+    late: &mut [K; 4],
+    coefficients: &mut [K; 7],
+    f: &mut F,
+    (s, h): (f64, f64),
+    y_old: &[f64],
+    y_new: &[f64],
+) {
+    for (i, (&c, row)) in C_EXTRA.iter().zip(A_EXTRA).enumerate() {
+        stage.as_mut().copy_from_slice(y_old);
+        for &(j, a) in row {
+            let kj = if j < 12 {
+                k[j].as_ref()
+            } else {
+                late[j - 12].as_ref()
+            };
+            axpy(stage.as_mut(), h * a, kj);
+        }
+        f(s + c * h, stage, &mut late[i + 1]);
+    }
+    let [f0, f1, f2, rest @ ..] = coefficients;
+    let (f0, f1, f2) = (f0.as_mut(), f1.as_mut(), f2.as_mut());
+    let (k0, end_slope) = (k[0].as_ref(), late[0].as_ref());
+    for i in 0..y_new.len() {
+        let dy = y_new[i] - y_old[i];
+        f0[i] = dy;
+        f1[i] = h * k0[i] - dy;
+        f2[i] = 2.0 * dy - h * (end_slope[i] + k0[i]);
+    }
+    for (fm, d) in rest.iter_mut().zip(&D) {
+        let fm = fm.as_mut();
+        fm.fill(0.0);
+        for (&j, &dj) in D_STAGES.iter().zip(d) {
+            let kj = if j < 12 {
+                k[j].as_ref()
+            } else {
+                late[j - 12].as_ref()
+            };
+            axpy(fm, h * dj, kj);
+        }
     }
 }
 
@@ -174,12 +236,20 @@ impl DenseRecord {
         self.data.append(&mut other.data);
     }
 
-    pub(super) fn push(&mut self, start: f64, step: f64, step_extension: &Interpolant) {
+    /// Appends the step of `step` from `start` whose extension starts at
+    /// `y_old` with `coefficients` F₀ … F₆.
+    pub(super) fn push<K: StageVector>(
+        &mut self,
+        start: f64,
+        step: f64,
+        y_old: &[f64],
+        coefficients: &[K; 7],
+    ) {
         self.starts.push(start);
         self.steps.push(step);
-        self.data.extend_from_slice(&step_extension.y_old);
-        for c in &step_extension.coefficients {
-            self.data.extend_from_slice(c);
+        self.data.extend_from_slice(y_old);
+        for c in coefficients {
+            self.data.extend_from_slice(c.as_ref());
         }
     }
 
@@ -229,36 +299,16 @@ impl Dop853 {
     ) -> usize {
         let mut dense = self.dense.take().expect("Interpolant::start came first");
         f(s + h, y_new, &mut dense.late[0]);
-        for (i, (&c, row)) in C_EXTRA.iter().zip(A_EXTRA).enumerate() {
-            self.stage.copy_from_slice(&dense.y_old);
-            for &(j, a) in row {
-                let kj = if j < 12 {
-                    &self.k[j]
-                } else {
-                    &dense.late[j - 12]
-                };
-                axpy(&mut self.stage, h * a, kj);
-            }
-            f(s + c * h, &self.stage, &mut dense.late[i + 1]);
-        }
-        let [f0, f1, f2, rest @ ..] = &mut dense.coefficients;
-        for i in 0..y_new.len() {
-            let dy = y_new[i] - dense.y_old[i];
-            f0[i] = dy;
-            f1[i] = h * self.k[0][i] - dy;
-            f2[i] = 2.0 * dy - h * (dense.late[0][i] + self.k[0][i]);
-        }
-        for (fm, d) in rest.iter_mut().zip(&D) {
-            fm.fill(0.0);
-            for (&j, &dj) in D_STAGES.iter().zip(d) {
-                let kj = if j < 12 {
-                    &self.k[j]
-                } else {
-                    &dense.late[j - 12]
-                };
-                axpy(fm, h * dj, kj);
-            }
-        }
+        extension(
+            &self.k,
+            &mut self.stage,
+            &mut dense.late,
+            &mut dense.coefficients,
+            &mut |t, a: &Vec<f64>, b: &mut Vec<f64>| f(t, a, b),
+            (s, h),
+            &dense.y_old,
+            y_new,
+        );
         self.dense = Some(dense);
         4
     }
