@@ -14,6 +14,14 @@
 //! the point until an entry of G changes sign, then closed by Illinois to
 //! the event tolerance.
 //!
+//! Newton at fixed p is near-singular close to the branch point along the
+//! crossing directions only. A branch point that persists on every
+//! discretization is one of symmetry (the straight rod's: every mesh keeps
+//! it), and then the branch lies in the symmetric subspace, where F_x is
+//! regular, and so do the carried point and its residual: Newton's
+//! corrections have no part along the crossing modes, and the trials stay
+//! on the branch.
+//!
 //! Used by `discretization.rs` on [`super::Family::refined`]. It locates
 //! one root and nothing else — no events are detected and no error is
 //! estimated here — so a location on the refined family never estimates
