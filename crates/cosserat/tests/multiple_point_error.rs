@@ -138,3 +138,33 @@ fn the_refined_relocation_recovers_the_finer_meshs_point() {
         "estimate {estimate:e}, actual {actual:e}"
     );
 }
+
+/// Where no refined family exists (an integration tolerance within a
+/// factor 10 of the integrator's floor 1e-14) the error is not estimated:
+/// None, and a warning that says why — never a guessed bound.
+#[test]
+#[cfg_attr(debug_assertions, ignore = "a continuation: milliseconds in release")]
+fn an_estimate_that_cannot_be_made_is_none_with_a_warning() {
+    let set: Vec<String> = [
+        "solver.model=\"kirchhoff\"",
+        "solver.integration_tolerance=5e-14",
+        "continuation.switch_depth=0",
+        "continuation.bounds=[0.0, 3.0]",
+    ]
+    .iter()
+    .map(ToString::to_string)
+    .collect();
+    let p = Problem::from_str_with(EULER, &set).unwrap();
+    let (family, opts) = p.continuation.clone().unwrap();
+    let d = continuation(&family, &opts, &mut |_, _| true).unwrap();
+    assert_eq!(d.special_points.len(), 1, "{:?}", d.special_points);
+    let sp = &d.special_points[0];
+    assert_eq!((sp.multiplicity, sp.location), (2, Location::Bracketed));
+    assert_eq!(sp.parameter_error, None);
+    assert_eq!(d.warnings.len(), 1, "{:?}", d.warnings);
+    assert!(
+        d.warnings[0].contains("unknown discretization error") && d.warnings[0].contains("floor"),
+        "{}",
+        d.warnings[0]
+    );
+}
