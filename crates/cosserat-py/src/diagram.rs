@@ -361,9 +361,11 @@ impl SpecialPoint {
     /// The estimated error of the parameter: the discretization's for an
     /// "augmented" location (located again on a refined discretization),
     /// the extrapolations' for an "extrapolated" one, the bracket's spread
-    /// for a "bracketed" one not closed; None where not estimated (an
-    /// augmented point whose refined location failed, which the diagram's
-    /// warnings say, and a closed bracket).
+    /// for a "bracketed" one not closed, and the discretization's for a
+    /// multiple branch point whose bracket closed (its root located again
+    /// on a refined discretization); None where not estimated (a refined
+    /// location that failed, which the diagram's warnings say, and a fold
+    /// or simple branch point kept at its closed bracket).
     #[getter]
     fn parameter_error(&self) -> Option<f64> {
         self.point.parameter_error

@@ -125,11 +125,14 @@ pub struct SpecialPoint {
     /// by Richardson's G/(G − 1) (`continuation/discretization.rs`); for
     /// [`Location::Extrapolated`] the difference of the extrapolations
     /// from two pairs of element meshes; for [`Location::Bracketed`] the
-    /// bracket's spread where it could not be closed. None where it is
-    /// not estimated: an augmented point whose refined location failed
-    /// (the diagram's warnings say why), and a bracket closed to the event
-    /// tolerance (a multiple branch point; its discretization error is not
-    /// estimated).
+    /// bracket's spread where it could not be closed, and where it closed
+    /// on a multiple branch point the discretization's (the root of the
+    /// same entry of Govaerts' G located again on the refined family,
+    /// `continuation/bordered_root.rs`, Richardson-scaled alike). None
+    /// where it is not estimated: a refined location that failed (the
+    /// diagram's warnings say why), and a fold or simple branch point kept
+    /// at its closed bracket (its augmented Newton failed, which the
+    /// warnings say, or it lies on a branch of symmetric copies).
     pub parameter_error: Option<f64>,
 }
 

@@ -345,7 +345,7 @@ impl Run<'_> {
     /// Govaerts' G (m × m) at (x, p): [F_x Ψ; Φᵀ 0] [V; G] = [0; I_m].
     /// None where the bordered matrix is singular (borders that do not
     /// complement F_x's kernel and range).
-    fn bordered(
+    pub(super) fn bordered(
         &self,
         x: &[f64],
         p: f64,
@@ -388,11 +388,46 @@ impl Run<'_> {
         g.iter().all(|v| v.is_finite()).then_some(g)
     }
 
-    /// The borders of the bordered test at one end in O(N): the m
+    /// The borders of the bordered test at (x, p): Φ and Ψ (n × m), the
+    /// right and left singular vectors of the m smallest singular values
+    /// of F_x there, and σ_m/σ_{m+1} (how well they stand apart: small
+    /// near a singularity of multiplicity m). Dense SVD up to
+    /// [`DENSE_UP_TO`] unknowns, above by inverse iteration on the band
+    /// copy of the staircase ([`Self::banded_borders`]). None where m is
+    /// not below n or F_x cannot be evaluated.
+    pub(super) fn borders_at(
+        &self,
+        x: &[f64],
+        p: f64,
+        m: usize,
+    ) -> Option<(f64, DMatrix<f64>, DMatrix<f64>)> {
+        let n = x.len();
+        if m == 0 || m >= n {
+            return None;
+        }
+        if self.is_large(n) {
+            return self.banded_borders(x, p, m);
+        }
+        let svd = self.jacobian(x, p)?.svd(true, true);
+        let (u, v_t) = (svd.u.as_ref()?, svd.v_t.as_ref()?);
+        let mut idx: Vec<usize> = (0..n).collect();
+        idx.sort_by(|&i, &j| svd.singular_values[i].total_cmp(&svd.singular_values[j]));
+        let ratio = svd.singular_values[idx[m - 1]] / svd.singular_values[idx[m]];
+        let right = DMatrix::from_fn(n, m, |r, c| v_t[(idx[c], r)]);
+        let left = DMatrix::from_fn(n, m, |r, c| u[(r, idx[c])]);
+        Some((ratio, right, left))
+    }
+
+    /// The borders of the bordered test at (x, p) in O(N): the m
     /// smallest singular triplets of the staircase F_x by inverse
     /// iteration ([`BandedJacobian::smallest`]) and σ_m/σ_{m+1}.
-    fn banded_borders(&self, end: &Point, m: usize) -> Option<(f64, DMatrix<f64>, DMatrix<f64>)> {
-        let a = self.large_jacobian(&end.unknowns, end.parameter)?;
+    fn banded_borders(
+        &self,
+        x: &[f64],
+        p: f64,
+        m: usize,
+    ) -> Option<(f64, DMatrix<f64>, DMatrix<f64>)> {
+        let a = self.large_jacobian(x, p)?;
         let s = BandedJacobian::of(&a)?.smallest(m + 1)?;
         let ratio = s.values[m - 1] / s.values[m];
         Some((
@@ -420,31 +455,15 @@ impl Run<'_> {
         }
         let mut best: Option<(f64, DMatrix<f64>, DMatrix<f64>)> = None;
         for end in [a, b] {
-            if self.is_large(n) {
-                let here = self.banded_borders(end, m)?;
-                if best.as_ref().is_none_or(|b| here.0 < b.0) {
-                    best = Some(here);
-                }
-                continue;
-            }
-            let svd = self.jacobian(&end.unknowns, end.parameter)?.svd(true, true);
-            let (u, v_t) = (svd.u.as_ref()?, svd.v_t.as_ref()?);
-            let mut idx: Vec<usize> = (0..n).collect();
-            idx.sort_by(|&i, &j| svd.singular_values[i].total_cmp(&svd.singular_values[j]));
-            let ratio = svd.singular_values[idx[m - 1]] / svd.singular_values[idx[m]];
-            if best.as_ref().is_none_or(|b| ratio < b.0) {
-                let right = DMatrix::from_fn(n, m, |r, c| v_t[(idx[c], r)]);
-                let left = DMatrix::from_fn(n, m, |r, c| u[(r, idx[c])]);
-                best = Some((ratio, right, left));
+            let here = self.borders_at(&end.unknowns, end.parameter, m)?;
+            if best.as_ref().is_none_or(|b| here.0 < b.0) {
+                best = Some(here);
             }
         }
         let (_, right, left) = best?;
         let ga = self.bordered(&a.unknowns, a.parameter, &right, &left)?;
         let gb = self.bordered(&b.unknowns, b.parameter, &right, &left)?;
-        let entry = (0..m)
-            .flat_map(|i| (0..m).map(move |j| (i, j)))
-            .filter(|&e| ga[e] * gb[e] < 0.0)
-            .max_by(|&e, &f| (gb[e] - ga[e]).abs().total_cmp(&(gb[f] - ga[f]).abs()))?;
+        let entry = sign_changing_entry(&ga, &gb)?;
         Some(Test::Bordered { right, left, entry })
     }
 
@@ -514,6 +533,16 @@ impl Run<'_> {
             return (point.into_iter().collect(), note.into_iter().collect());
         }
         let (point, note) = self.bracketed(a, b, sign, root, (branch, index), wanted, kind.name());
+        // A multiple branch point (G wholly zero at the closed root) carries
+        // its discretization error, located again on the refined family.
+        if resolved && matches!(test, Test::Bordered { .. }) {
+            let reach = (b.parameter - a.parameter).abs();
+            let (point, error_note) = self.with_multiple_discretization_error(point, reach);
+            return (
+                point.into_iter().collect(),
+                note.into_iter().chain(error_note).collect(),
+            );
+        }
         (point.into_iter().collect(), note.into_iter().collect())
     }
 
@@ -1361,6 +1390,17 @@ fn collinear(points: &[nalgebra::Vector3<f64>]) -> bool {
         && points
             .iter()
             .all(|q| (q - first).cross(&chord).norm() <= 1e-8 * length * length)
+}
+
+/// The entry of G that changes sign from `ga` to `gb` with the largest
+/// change (the test function of a multiple branch point: a simple root
+/// there); None where no entry changes sign.
+pub(super) fn sign_changing_entry(ga: &DMatrix<f64>, gb: &DMatrix<f64>) -> Option<(usize, usize)> {
+    let m = ga.nrows();
+    (0..m)
+        .flat_map(|i| (0..m).map(move |j| (i, j)))
+        .filter(|&e| ga[e] * gb[e] < 0.0)
+        .max_by(|&e, &f| (gb[e] - ga[e]).abs().total_cmp(&(gb[f] - ga[f]).abs()))
 }
 
 /// Govaerts' G in O(N) where F_x is a large staircase: with F_x

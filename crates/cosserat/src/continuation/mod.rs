@@ -26,6 +26,7 @@
 //! saved diagram, `restart` a run started from given unknowns, `stage` the
 //! chained stages of one run joined into one diagram.
 
+mod bordered_root;
 mod bordering;
 mod branch_point;
 mod codim2;
