@@ -20,8 +20,9 @@
 //! system —, `bracketed` — the root of a test function by regula falsi —,
 //! `extrapolated` — a finite-element crossing on three meshes, Richardson;
 //! absent in older files, read as `bracketed`), `parameter_error` (s: the
-//! estimated error of an extrapolated parameter, NaN elsewhere; absent in
-//! older files); `/warnings` (events
+//! parameter's estimated error — the discretization's for a located
+//! point, the extrapolations' for an extrapolated crossing, an unclosed
+//! bracket's spread —, NaN where not estimated; absent in older files); `/warnings` (events
 //! detected but not located, as text); the problem text as the
 //! root attribute `problem`, the run's `stop_reason` and the parameter name
 //! as root attributes (the first stage's parameter for a chained run, whose
