@@ -52,3 +52,26 @@ pub fn interrupt_after(child: &mut Child, ms: u64) -> ExitStatus {
     signal(child, "-INT");
     child.wait().unwrap()
 }
+
+/// A `special N …` line of `continue`'s output: how the point was located
+/// (the word after "located"), its printed parameter and its printed
+/// error "(error of the parameter ±E)", if any.
+pub fn special_line(line: &str) -> (String, f64, Option<f64>) {
+    let parameter = line
+        .split("at parameter ")
+        .nth(1)
+        .and_then(|r| r.split(',').next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no parameter in {line}"));
+    let located = line
+        .split("located ")
+        .nth(1)
+        .and_then(|r| r.split_whitespace().next())
+        .unwrap_or_else(|| panic!("no location in {line}"))
+        .to_string();
+    let error = line
+        .split("(error of the parameter ±")
+        .nth(1)
+        .map(|r| r.trim_end_matches(')').parse().expect("a printed error"));
+    (located, parameter, error)
+}
