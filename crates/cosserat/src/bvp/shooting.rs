@@ -890,12 +890,9 @@ mod tests {
     use nalgebra::Vector3;
     use std::sync::Arc;
 
-    /// The planar kernel's fixed-size segments against the generic path
-    /// (the same system with the kernel taken away): the residual, the
-    /// Jacobian and the integration work agree bit for bit, single and
-    /// multiple shooting, loose and tight tolerances.
-    #[test]
-    fn the_planar_fast_path_is_the_generic_integration() {
+    /// A planar cantilever under a tip force and a distributed load, whose
+    /// right-hand side is a [`PlanarKernel`].
+    fn loaded_planar() -> PlanarEquations {
         let energy = LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3]).unwrap();
         let loads = DeadLoads {
             tip_force: Vector3::new(3.0, 0.0, 0.0),
@@ -903,7 +900,16 @@ mod tests {
             ..Default::default()
         };
         let rod = Rod::new(1.0, Arc::new(energy), Clamp::paper(), loads, None).unwrap();
-        let eq = PlanarEquations::new(rod);
+        PlanarEquations::new(rod)
+    }
+
+    /// The planar kernel's fixed-size segments against the generic path
+    /// (the same system with the kernel taken away): the residual, the
+    /// Jacobian and the integration work agree bit for bit, single and
+    /// multiple shooting, loose and tight tolerances.
+    #[test]
+    fn the_planar_fast_path_is_the_generic_integration() {
+        let eq = loaded_planar();
         assert!(eq.planar_kernel().is_some());
         for (segments, rtol) in [(1, 1e-4), (1, 1e-12), (3, 1e-8)] {
             let tol = Tolerances {
@@ -931,14 +937,7 @@ mod tests {
     /// record and work, bit for bit, on one and three segments.
     #[test]
     fn the_planar_recorded_sampling_is_the_generic_integration() {
-        let energy = LinearElastic::uniform([10.0, 1.0, 10.0], [0.0; 3]).unwrap();
-        let loads = DeadLoads {
-            tip_force: Vector3::new(3.0, 0.0, 0.0),
-            distributed_force: Vector3::new(0.5, 0.0, -0.2),
-            ..Default::default()
-        };
-        let rod = Rod::new(1.0, Arc::new(energy), Clamp::paper(), loads, None).unwrap();
-        let eq = PlanarEquations::new(rod);
+        let eq = loaded_planar();
         let points: Vec<f64> = (0..=7).map(|i| f64::from(i) / 7.0).collect();
         for (segments, rtol) in [(1, 1e-4), (1, 1e-12), (3, 1e-8)] {
             let tol = Tolerances {

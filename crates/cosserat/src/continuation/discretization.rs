@@ -48,22 +48,14 @@ impl Run<'_> {
         sp: Option<SpecialPoint>,
         radius: f64,
     ) -> (Option<SpecialPoint>, Option<String>) {
-        let Some(mut sp) = sp else {
+        let Some(sp) = sp else {
             return (None, None);
         };
         if sp.location != Location::Augmented {
             return (Some(sp), None);
         }
-        match self.relocated(&sp, radius) {
-            Ok(error) => {
-                sp.parameter_error = Some(error);
-                (Some(sp), None)
-            }
-            Err(why) => {
-                let note = unknown_error(&sp, &why);
-                (Some(sp), Some(note))
-            }
-        }
+        let error = self.relocated(&sp, radius);
+        stated(sp, error)
     }
 
     /// `sp`, a multiple branch point located on an entry of Govaerts'
@@ -77,19 +69,11 @@ impl Run<'_> {
         sp: Option<SpecialPoint>,
         reach: f64,
     ) -> (Option<SpecialPoint>, Option<String>) {
-        let Some(mut sp) = sp else {
+        let Some(sp) = sp else {
             return (None, None);
         };
-        match self.relocated_multiple(&sp, reach) {
-            Ok(error) => {
-                sp.parameter_error = Some(error);
-                (Some(sp), None)
-            }
-            Err(why) => {
-                let note = unknown_error(&sp, &why);
-                (Some(sp), Some(note))
-            }
-        }
+        let error = self.relocated_multiple(&sp, reach);
+        stated(sp, error)
     }
 
     /// |p − p_fine| · G/(G − 1), p_fine the root in p of an entry of G on
@@ -131,6 +115,23 @@ impl Run<'_> {
         }
         .map_err(|why| format!("on the refined discretization {why}"))?;
         Ok((p - located.1).abs() * gain / (gain - 1.0))
+    }
+}
+
+/// `sp` with its estimated error, or without one and the note saying why.
+fn stated(
+    mut sp: SpecialPoint,
+    error: Result<f64, String>,
+) -> (Option<SpecialPoint>, Option<String>) {
+    match error {
+        Ok(e) => {
+            sp.parameter_error = Some(e);
+            (Some(sp), None)
+        }
+        Err(why) => {
+            let note = unknown_error(&sp, &why);
+            (Some(sp), Some(note))
+        }
     }
 }
 

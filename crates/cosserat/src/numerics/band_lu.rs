@@ -361,14 +361,21 @@ mod tests {
         );
     }
 
-    #[test]
-    fn names_a_zero_pivot() {
+    /// [[1, 2, 0], [2, 4, 0], [0, 0, 1]]: singular, its second pivot
+    /// exactly zero, its null vector (2, −1, 0).
+    fn singular_band() -> BandLu {
         let mut lu = BandLu::zeros(3, 1, 1);
         lu.add(0, 0, 1.0);
         lu.add(0, 1, 2.0);
         lu.add(1, 0, 2.0);
         lu.add(1, 1, 4.0);
         lu.add(2, 2, 1.0);
+        lu
+    }
+
+    #[test]
+    fn names_a_zero_pivot() {
+        let mut lu = singular_band();
         assert_eq!(lu.factor(), Err(SingularBand { column: 1 }));
     }
 
@@ -377,12 +384,7 @@ mod tests {
     /// the null vector (2, −1, 0)/√5 to round-off.
     #[test]
     fn inverse_iteration_on_an_exactly_singular_band() {
-        let mut lu = BandLu::zeros(3, 1, 1);
-        lu.add(0, 0, 1.0);
-        lu.add(0, 1, 2.0);
-        lu.add(1, 0, 2.0);
-        lu.add(1, 1, 4.0);
-        lu.add(2, 2, 1.0);
+        let mut lu = singular_band();
         lu.factor_for_inverse_iteration(f64::EPSILON).unwrap();
         let mut v = [0.3, 0.5, 0.7];
         lu.solve(&mut v);
