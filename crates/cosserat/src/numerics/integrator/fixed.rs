@@ -220,18 +220,21 @@ mod tests {
     use super::super::Dop853;
     use super::*;
 
+    /// θ'' = −sin θ as (θ, ω) with its variational equation (δθ, δω).
+    fn pendulum(_: f64, y: &[f64], d: &mut [f64]) {
+        let (sin, cos) = y[0].sin_cos();
+        d[0] = y[1];
+        d[1] = -sin;
+        d[2] = y[3];
+        d[3] = -cos * y[2];
+    }
+
     /// The pendulum with its variational equation (4 components): the
     /// fixed-size integrator takes the generic one's steps and lands on
     /// its result bit for bit, at a loose and a tight tolerance.
     #[test]
     fn the_same_steps_and_result_as_the_generic_integrator() {
-        let rhs = |_: f64, y: &[f64], d: &mut [f64]| {
-            let (sin, cos) = y[0].sin_cos();
-            d[0] = y[1];
-            d[1] = -sin;
-            d[2] = y[3];
-            d[3] = -cos * y[2];
-        };
+        let rhs = pendulum;
         for rtol in [1e-4, 1e-12] {
             let tol = Tolerances {
                 rtol,
@@ -257,13 +260,7 @@ mod tests {
     /// states and records its extensions bit for bit, with the same work.
     #[test]
     fn the_same_record_and_samples_as_the_generic_integrator() {
-        let rhs = |_: f64, y: &[f64], d: &mut [f64]| {
-            let (sin, cos) = y[0].sin_cos();
-            d[0] = y[1];
-            d[1] = -sin;
-            d[2] = y[3];
-            d[3] = -cos * y[2];
-        };
+        let rhs = pendulum;
         let stops: Vec<f64> = (0..=40).map(|i| 7.3 * f64::from(i) / 40.0).collect();
         for rtol in [1e-4, 1e-12] {
             let tol = Tolerances {
