@@ -21,6 +21,8 @@
 //! (p₁, p₂) plane turns back; it is reported between the two points whose
 //! projected tangents point against each other.
 
+mod error;
+
 use std::sync::Arc;
 
 use nalgebra::DVector;
@@ -99,6 +101,11 @@ pub struct CurvePoint {
     pub null_vector: Vec<f64>,
     /// |g| at the point (zero to the tolerance).
     pub singularity: f64,
+    /// The estimated discretization errors of (p₁ at this p₂, p₂ at this
+    /// p₁): the point located again on the refined family (`error.rs`);
+    /// None where that failed (the curve's warnings say why). Infinite
+    /// for the parameter whose axis the curve runs parallel to.
+    pub parameter_error: Option<[f64; 2]>,
 }
 
 /// A cusp of the curve: where its projection on (p₁, p₂) turns back,
@@ -110,6 +117,9 @@ pub struct Cusp {
     /// The located point, where the projected tangent vanishes (to the
     /// bisection's 2⁻⁴⁰ of the step).
     pub point: CurvePoint,
+    /// The estimated discretization errors of its (p₁, p₂): the cusp
+    /// located again on the refined family; None where that failed.
+    pub parameter_error: Option<[f64; 2]>,
 }
 
 /// A followed curve of singular points.
@@ -123,6 +133,8 @@ pub struct SingularCurve {
     pub cusps: Vec<Cusp>,
     /// Why each end stopped (the first end, then the second).
     pub ends: [String; 2],
+    /// Why a point's or a cusp's discretization error is unknown.
+    pub warnings: Vec<String>,
 }
 
 /// The minimally augmented system of one family.
@@ -473,18 +485,29 @@ pub fn follow_singular(
     let mut points: Vec<CurvePoint> = halves[1].iter().rev().cloned().collect();
     points.push(first);
     points.extend(halves[0].iter().cloned());
-    let cusps = (0..points.len().saturating_sub(1))
+    let mut cusps = (0..points.len().saturating_sub(1))
         .filter(|&i| projected(&points[i], n).dot(&projected(&points[i + 1], n)) < 0.0)
         .map(|i| {
-            locate_cusp(&aug, &points[i], &points[i + 1], opts)
-                .map(|point| Cusp { after: i, point })
+            locate_cusp(&aug, &points[i], &points[i + 1], opts).map(|point| Cusp {
+                after: i,
+                point,
+                parameter_error: None,
+            })
         })
         .collect::<Result<Vec<_>, _>>()?;
+    let errors = error::estimate(&aug, &points, &cusps, opts);
+    for (point, e) in points.iter_mut().zip(errors.points) {
+        point.parameter_error = e;
+    }
+    for (cusp, e) in cusps.iter_mut().zip(errors.cusps) {
+        cusp.parameter_error = e;
+    }
     Ok(SingularCurve {
         keys: pair.keys(),
         points,
         cusps,
         ends: [ends[1].clone(), ends[0].clone()],
+        warnings: errors.notes,
     })
 }
 
@@ -570,6 +593,7 @@ fn curve_point(
         tangent,
         null_vector: v.normalize().as_slice().to_vec(),
         singularity: g.abs(),
+        parameter_error: None,
     })
 }
 

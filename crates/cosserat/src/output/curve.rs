@@ -2,8 +2,11 @@
 //!
 //! Layout: `/curve/parameters` (m×2: p₁, p₂), `unknowns` (m×n), `tangent`
 //! (m×(n+2) or m×(n+3) with the branch point's ψ), `null_vector` (m×n),
-//! `singularity` (m: |g|), `cusps` (the index of the point before each
-//! cusp), `cusp_parameters` (c×2: the located cusps); root attributes `problem` (the problem text), `parameter_names`
+//! `singularity` (m: |g|), `parameter_error` (m×2: the estimated
+//! discretization errors of p₁ at the point's p₂ and of p₂ at its p₁, NaN
+//! where unknown), `cusps` (the index of the point before each cusp),
+//! `cusp_parameters` (c×2: the located cusps), `cusp_parameter_error`
+//! (c×2), `warnings` (why an error is unknown); root attributes `problem` (the problem text), `parameter_names`
 //! (the two keys, comma separated), `kind` (`fold` or `branch_point`),
 //! `ends` (why each end stopped, `;` separated).
 
@@ -47,6 +50,16 @@ pub fn write_curve(
         g.floats("null_vector", &[m, nv], &v)?;
         let s: Vec<f64> = curve.points.iter().map(|c| c.singularity).collect();
         g.floats("singularity", &[m], &s)?;
+        let unknown = [f64::NAN; 2];
+        let (_, e) = rows(curve, |c| c.parameter_error.unwrap_or(unknown).to_vec());
+        g.floats("parameter_error", &[m, 2], &e)?;
+        let ce: Vec<f64> = curve
+            .cusps
+            .iter()
+            .flat_map(|c| c.parameter_error.unwrap_or(unknown))
+            .collect();
+        g.floats("cusp_parameter_error", &[curve.cusps.len(), 2], &ce)?;
+        g.texts("warnings", &curve.warnings)?;
         let after: Vec<u64> = curve.cusps.iter().map(|c| c.after as u64).collect();
         g.counts("cusps", &after)?;
         let at: Vec<f64> = curve

@@ -17,6 +17,9 @@ pub const UNDESCRIBED: &str = "undescribed";
 /// (units, description) of the dataset `name` in the group `parent` (its
 /// last path component, "" for the root).
 fn entry(parent: &str, name: &str) -> (&'static str, &'static str) {
+    if let Some(e) = (parent == "curve").then(|| curve_entry(name)).flatten() {
+        return e;
+    }
     match (parent, name) {
         // Equilibria (solve, stability).
         ("solution", "s") => ("m", "arc length of each sample"),
@@ -63,11 +66,6 @@ fn entry(parent: &str, name: &str) -> (&'static str, &'static str) {
         ("special_points", "location") => ("", "augmented (minimally augmented system), bracketed (regula falsi) or extrapolated (finite-element crossings on three meshes, Richardson)"),
         ("special_points", "parameter_error") => ("as the continued key", "estimated error of the parameter: augmented, the discretization's (the point located again on twice the collocation intervals or integration tolerances up to 100× tighter, Richardson-scaled; NaN with a warning where that failed); extrapolated, the difference of two extrapolations; bracketed, the bracket's spread where it was not closed; where it closed on a multiple branch point the discretization's (the root of the same entry of G located again on the refined discretization, Richardson-scaled); NaN where not estimated: that relocation failed (a warning says why), or a fold or simple branch point kept bracketed (its augmented Newton failed, with a warning, or it lies on a branch of symmetric copies)"),
         (_, "warnings") => ("", "events detected but not located, and other warnings"),
-        // Curves of singular points.
-        ("curve", "parameters") => ("as the two keys", "the two parameters along the curve"),
-        ("curve", "singularity") => ("1", "the test function along the curve"),
-        ("curve", "cusps") => ("", "point indices of the cusps"),
-        ("curve", "cusp_parameters") => ("as the two keys", "the two parameters at each cusp"),
         // Spatial arms (`/spatial`).
         ("spatial", "intrinsic_curvature") => ("1/m", "intrinsic curvature κ⁰(s) of the design, body components"),
         ("spatial", "design") => ("1", "the searched design vector: c2..cM, κ̄1 and κ̄3 coefficients, roll"),
@@ -123,6 +121,22 @@ fn entry(parent: &str, name: &str) -> (&'static str, &'static str) {
         (_, "start") => ("", "how the point started: warm from its predecessor, or cold"),
         (_, "limit") => ("", "what limits the straight arm"),
         _ => ("", UNDESCRIBED),
+    }
+}
+
+/// (units, description) of a dataset of `/curve` (curves of singular
+/// points), None for one the other groups share (`unknowns`, `tangent`,
+/// `warnings`, …).
+#[rustfmt::skip]
+fn curve_entry(name: &str) -> Option<(&'static str, &'static str)> {
+    match name {
+        "parameters" => Some(("as the two keys", "the two parameters along the curve")),
+        "singularity" => Some(("1", "the test function along the curve")),
+        "cusps" => Some(("", "point indices of the cusps")),
+        "cusp_parameters" => Some(("as the two keys", "the two parameters at each cusp")),
+        "parameter_error" => Some(("as the two keys", "estimated discretization errors of (p₁ at the point's p₂, p₂ at its p₁): the point located again on twice the collocation intervals or integration tolerances up to 100× tighter, with the parameter the curve moves along most held, the other's shift Richardson-scaled, the held one's through the curve's slope (inf where the curve runs parallel to its axis); NaN where that failed (a warning says why)")),
+        "cusp_parameter_error" => Some(("as the two keys", "estimated discretization errors of each cusp's two parameters: the cusp located again between the refined curve's points around it, Richardson-scaled; NaN where that failed (a warning says why)")),
+        _ => None,
     }
 }
 
