@@ -600,7 +600,15 @@ impl Run<'_> {
             (point, note.or(unresolved))
         };
         if self.sliced {
-            return bracketed(root, None);
+            let (point, unresolved) = bracketed(root, None);
+            if unresolved.is_some() {
+                return (point, unresolved);
+            }
+            return Self::without_discretization_error(
+                point,
+                "it lies on a branch of symmetric copies, where its bracket is not closed again \
+                 on the refined family",
+            );
         }
         let best = root.located.clone();
         let radius = span_of(a, b, sign).abs().max(distance(a, b));
@@ -679,7 +687,8 @@ impl Run<'_> {
                 (branch, index),
                 (wanted, Location::Bracketed),
             );
-            return (point.into_iter().collect(), None);
+            let (point, note) = self.with_sliced_fold_error(point, a, (sign, b.parameter, span));
+            return (point.into_iter().collect(), note);
         }
         let refined = self
             .refine_fold(&best.1, best.2, radius)
@@ -867,6 +876,10 @@ impl Run<'_> {
         } else {
             (s4, (p4 - p2).abs() + resolution)
         };
+        // The crossings are of the family's discretized branch: add the
+        // BVP discretization's part of the error, or leave the whole
+        // unknown where it cannot be estimated.
+        let bvp = self.crossing_bvp_error(a, (sign, b.parameter, span), block, p1);
         let near = &finer[1];
         let Some((x, p, tangent, _)) = self.point_at(a, sign, sigma, Some(near)) else {
             let point = self
@@ -882,7 +895,7 @@ impl Run<'_> {
                     sp.parameter_error = Some((p4 - p2).abs() + resolution);
                     sp
                 });
-            return (point, None);
+            return Self::with_bvp_part(point, bvp);
         };
         let point = self
             .special_point(
@@ -897,7 +910,7 @@ impl Run<'_> {
                 sp.parameter_error = Some(error);
                 sp
             });
-        (point, None)
+        Self::with_bvp_part(point, bvp)
     }
 
     /// Whether the whole of G vanishes at the located point (relative to
@@ -1069,6 +1082,61 @@ impl Run<'_> {
 
     /// Whether a root's parameter bracket closed to the event tolerance;
     /// else a note naming the bracket it reached.
+    /// The parameter at the root of τ_p in the step from `a` (`sign`,
+    /// towards `p_b`, arclength `span`), its bracket closed to the event
+    /// tolerance; Err says why not.
+    pub(super) fn fold_root(
+        &self,
+        a: &Point,
+        (sign, p_b): (f64, f64),
+        span: f64,
+    ) -> Result<f64, String> {
+        self.closed_root(a, (sign, p_b), span, &Test::Fold, "τ_p")
+    }
+
+    /// The parameter where `block`'s eigenvalue nearest zero on `factor`
+    /// times the run's finite elements crosses zero in the step from `a`
+    /// (`sign`, towards `p_b`, arclength `span`), its bracket closed to the
+    /// event tolerance; Err says why not.
+    pub(super) fn crossing_root(
+        &self,
+        a: &Point,
+        (sign, p_b): (f64, f64),
+        span: f64,
+        (block, factor): (Block, usize),
+    ) -> Result<f64, String> {
+        let tracker = self
+            .tracker
+            .refined(factor)
+            .ok_or("the finer finite-element mesh cannot be made")?;
+        let test = Test::EigenvalueOn(block, Box::new(tracker));
+        self.closed_root(a, (sign, p_b), span, &test, "the eigenvalue")
+    }
+
+    /// The parameter at the root of `test` in the step from `a`, its
+    /// bracket closed to the event tolerance; Err says why not.
+    fn closed_root(
+        &self,
+        a: &Point,
+        (sign, p_b): (f64, f64),
+        span: f64,
+        test: &Test,
+        what: &str,
+    ) -> Result<f64, String> {
+        let root = self
+            .root(a, (sign, p_b), (0.0, span), test)
+            .ok_or_else(|| {
+                format!("{what} does not change sign within the step, or a corrector failed")
+            })?;
+        match self.unresolved(&root, "root", (0, 0)) {
+            None => Ok(root.located.2),
+            Some(_) => Err(format!(
+                "the bracket of {what}'s root closed only to ±{:.1e}",
+                root.spread
+            )),
+        }
+    }
+
     fn unresolved(
         &self,
         root: &Root,
