@@ -64,6 +64,51 @@ fn turning_and_energy_follow_the_elastica() {
     assert!((last.abs() - 170f64.to_radians()).abs() < 1e-8, "{last}");
 }
 
+/// `continuation.stop_at`: each buckled branch ends exactly where its tip
+/// has turned by one radian, α = 2 asin k = ±1, i.e. at the load
+/// p = K(sin ½)² of the elastica (B = L = 1) — the step that passes it
+/// shortened onto it (measured 4.2e-13 from the closed form). A stop on a
+/// measure that `measures` does not list is refused, naming the key.
+#[test]
+fn a_branch_stops_where_its_measure_reaches_the_value() {
+    let set = [
+        "continuation.measures=[\"turning\"]".to_string(),
+        "continuation.stop_at=[{measure=\"turning\", value=1.0}, {measure=\"turning\", \
+         value=-1.0}]"
+            .to_string(),
+    ];
+    let problem = Problem::from_str_with(EULER, &set).unwrap();
+    let (family, opts) = problem.continuation.clone().unwrap();
+    let d = continuation(&family, &opts, &mut |_, _| true).unwrap();
+    let k = 0.5f64.sin();
+    let exact = ellip_f(FRAC_PI_2, k).powi(2);
+    let buckled: Vec<_> = d.branches.iter().skip(1).collect();
+    assert_eq!(buckled.len(), 2, "{:?}", d.warnings);
+    for branch in buckled {
+        let last = branch.points.last().unwrap();
+        assert!(
+            (last.measures[0].abs() - 1.0).abs() <= 1e-10,
+            "turning {}",
+            last.measures[0]
+        );
+        assert!(
+            (last.parameter - exact).abs() <= 1e-9 * exact,
+            "p = {} against K(sin ½)² = {exact}",
+            last.parameter
+        );
+        let end = branch.stop_reason.to_string();
+        assert!(end.starts_with("reached turning = "), "{end}");
+    }
+    let unlisted = ["continuation.stop_at=[{measure=\"turning\", value=1.0}]".to_string()];
+    let e = Problem::from_str_with(EULER, &unlisted)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("continuation.stop_at[0]") && e.contains("continuation.measures"),
+        "{e}"
+    );
+}
+
 /// The total potential energy Π = ∫W ds − P·r(L) along the buckled
 /// column (load P = λP₀, P₀ = −e3, B = L = 1). The elastica gives it in
 /// closed form, Π = 2K(E − k'²K) + λ z(L) with λ = K² and the tip height

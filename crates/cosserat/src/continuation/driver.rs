@@ -41,6 +41,17 @@ pub(super) fn check_start(
     family: &Family,
     opts: &ContinuationOptions,
 ) -> Result<(), ContinuationError> {
+    if let Some(stop) = opts.stops.iter().find(|s| s.measure >= opts.measures.len()) {
+        return Err(ContinuationError::Start {
+            p: opts.start,
+            message: format!(
+                "a stop value names measure {} of {}: a stop's measure must be one of the \
+                 run's measures",
+                stop.measure,
+                opts.measures.len()
+            ),
+        });
+    }
     let start = family.rod_at(opts.start).map_err(PointError::from)?;
     crate::stability::check_conservative(&start).map_err(|e| ContinuationError::Start {
         p: opts.start,
@@ -483,8 +494,12 @@ impl<'a> Run<'a> {
                 diagram.special_points.push(sp);
             }
             diagram.warnings.extend(missed);
+            let stopped = self.passed_stop(&last, &next);
             diagram.branches[branch].points.push(next);
             self.total_points += 1;
+            if let Some(reason) = stopped {
+                return end(specials, reason, false);
+            }
             if closes(&diagram.branches[branch].points)
                 || passes_again(&diagram.special_points, &specials)
             {

@@ -62,7 +62,7 @@ pub use driver::continuation;
 pub use family::{tip_angle, CarryError, DerivativeMethod, Family, FamilyError, PointError};
 pub use lens::{Lens, Parameter, RodLens};
 pub use measure::{Measure, Quantity};
-pub use options::ContinuationOptions;
+pub use options::{ContinuationOptions, StopAt};
 pub use restart::{continuation_from, switch_from, StartPoint};
 pub use resume::{resume, SavedBranch, SavedDiagram, SavedSpecial};
 pub use stage::{stage_of, Stage};

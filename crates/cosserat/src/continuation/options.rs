@@ -43,6 +43,9 @@ pub struct ContinuationOptions {
     pub start_solver: Option<SolverOptions>,
     /// The measures computed at every point ([`super::Measure`]).
     pub measures: Vec<super::Measure>,
+    /// Stop values: a branch ends where one of these measures reaches its
+    /// value, its last step shortened onto it (`landing.rs`).
+    pub stops: Vec<StopAt>,
     /// Equally spaced points of the shape stored with every point (the
     /// clamp and the tip included).
     pub shape_points: usize,
@@ -65,7 +68,34 @@ impl Default for ContinuationOptions {
             event_tolerance: 1e-11,
             start_solver: None,
             measures: vec![],
+            stops: vec![],
             shape_points: 21,
         }
+    }
+}
+
+/// A stop value of a branch (`continuation.stop_at`): the branch ends where
+/// the measure `measures[measure]` reaches `value`, the step that passes it
+/// shortened so that the measure lands on it to
+/// [`StopAt::tolerance`]. The index must name one of the run's measures
+/// (checked when the run starts).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StopAt {
+    /// The index of the measure in [`ContinuationOptions::measures`].
+    pub measure: usize,
+    /// The value it stops at.
+    pub value: f64,
+}
+
+impl StopAt {
+    /// How close the landed measure comes to the value: 1e-10 max(1, |value|).
+    pub fn tolerance(&self) -> f64 {
+        1e-10 * self.value.abs().max(1.0)
+    }
+
+    /// The measure minus the value at a point with the run's `measures`
+    /// values, or None where the point has no such measure.
+    pub fn gap(&self, measures: &[f64]) -> Option<f64> {
+        measures.get(self.measure).map(|m| m - self.value)
     }
 }

@@ -81,6 +81,17 @@ pub enum BranchEnd {
     MaxPoints(usize),
     /// The tip turned by the angle limit (degrees).
     TipAngle(f64),
+    /// A measure reached a stop value (`continuation.stop_at`): landed on
+    /// it, or passed it where the shortened step failed.
+    ReachedValue {
+        /// The measure's name.
+        measure: String,
+        /// The stop value.
+        value: f64,
+        /// Whether the last point lies on the value (to the stop's
+        /// tolerance) rather than past it.
+        landed: bool,
+    },
     /// The step fell below the smallest step: the corrector does not
     /// converge there.
     StepTooSmall(f64),
@@ -133,6 +144,19 @@ impl fmt::Display for BranchEnd {
             BranchEnd::ReachedBound(b) => write!(f, "reached the bound {b}"),
             BranchEnd::MaxPoints(n) => write!(f, "{n} points"),
             BranchEnd::TipAngle(deg) => write!(f, "tip angle {deg:.2}° reached"),
+            BranchEnd::ReachedValue {
+                measure,
+                value,
+                landed: true,
+            } => write!(f, "reached {measure} = {value}"),
+            BranchEnd::ReachedValue {
+                measure,
+                value,
+                landed: false,
+            } => write!(
+                f,
+                "passed {measure} = {value} in its last step, which could not be shortened onto it"
+            ),
             BranchEnd::StepTooSmall(min) => write!(
                 f,
                 "step size below {min:.1e}: the corrector does not converge"

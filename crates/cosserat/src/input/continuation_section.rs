@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use super::mesh::MeshKeys;
 use super::problem::{invalid, within, ProblemError, NEWTON_TOLERANCE};
-use crate::continuation::{ContinuationOptions, Measure};
+use crate::continuation::{ContinuationOptions, Measure, StopAt};
 
 /// One entry of `continuation.link`: a numeric key of the rod's tables
 /// set to `factor`·p + `offset` whenever the parameter is p.
@@ -24,6 +24,17 @@ pub struct LinkSection {
 
 fn unit_factor() -> f64 {
     1.0
+}
+
+/// One entry of `continuation.stop_at`: a branch ends where the measure
+/// `measure` (one of `continuation.measures`) reaches `value`.
+#[derive(Debug, Clone, Deserialize, Serialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct StopAtSection {
+    /// The measure's name, as listed in `continuation.measures`.
+    pub measure: String,
+    /// The value the branch stops at.
+    pub value: f64,
 }
 
 /// `[continuation]`.
@@ -91,6 +102,10 @@ pub struct ContinuationSection {
     /// ([`crate::continuation::Measure`]): `force[2]@0`, `turning`, …
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub measures: Vec<String>,
+    /// Stop values: a branch ends where one of `measures` reaches its
+    /// value, landed on it.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub stop_at: Vec<StopAtSection>,
     /// `[continuation.curve]`: a stored fold or branch point followed in
     /// a second parameter (`cosserat continue --from … --point special/K
     /// --curve`).
@@ -143,6 +158,9 @@ pub struct StageSection {
     /// Stop a branch when the tip tangent has turned this far (degrees).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tip_angle_limit: Option<f64>,
+    /// The stage's own stop values (the first stage's are not inherited).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub stop_at: Vec<StopAtSection>,
     /// Corrector tolerance.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tolerance: Option<f64>,
@@ -275,6 +293,38 @@ fn positive(field: &str, v: f64) -> Result<f64, ProblemError> {
 }
 
 impl ContinuationSection {
+    /// `stop_at` as the run's stops: each measure one of `measures` (named
+    /// as there), each value finite, no measure and value twice.
+    fn checked_stops(&self, measures: &[Measure]) -> Result<Vec<StopAt>, ProblemError> {
+        let mut stops: Vec<StopAt> = vec![];
+        for (i, entry) in self.stop_at.iter().enumerate() {
+            let field = format!("continuation.stop_at[{i}]");
+            let named = Measure::parse(&entry.measure).map_err(|e| invalid(&field, e))?;
+            let measure = measures.iter().position(|m| *m == named).ok_or_else(|| {
+                invalid(
+                    &field,
+                    format!(
+                        "stops on `{}`, which continuation.measures does not list: add it there \
+                         (the stop reads the measure every point computes)",
+                        entry.measure
+                    ),
+                )
+            })?;
+            if !entry.value.is_finite() {
+                return Err(invalid(&field, "the value must be a finite number"));
+            }
+            let stop = StopAt {
+                measure,
+                value: entry.value,
+            };
+            if stops.contains(&stop) {
+                return Err(invalid(&field, "repeats an earlier stop"));
+            }
+            stops.push(stop);
+        }
+        Ok(stops)
+    }
+
     fn checked_shape_points(&self) -> Result<usize, ProblemError> {
         if (2..=MAX_SHAPE_POINTS).contains(&self.shape_points) {
             Ok(self.shape_points)
@@ -341,6 +391,7 @@ impl ContinuationSection {
         if names.windows(2).any(|w| w[0] == w[1]) {
             return Err(invalid("continuation.measures", "names a measure twice"));
         }
+        let stops = self.checked_stops(&measures)?;
         if !MEASURES.contains(&self.measure.as_str())
             && !measures.iter().any(|m| m.name() == self.measure)
         {
@@ -370,6 +421,7 @@ impl ContinuationSection {
                 event_tolerance: 1e-11,
                 start_solver: None,
                 measures,
+                stops,
                 shape_points: self.checked_shape_points()?,
             },
         ))

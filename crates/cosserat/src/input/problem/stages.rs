@@ -34,8 +34,10 @@ fn stage_text(text: &str, number: usize, held: &[(String, f64)]) -> Result<Strin
     let stages = table.remove("stage").ok_or_else(missing)?;
     table.remove("curve");
     // The first stage's links belong to its parameter; a stage links its
-    // own keys or none.
+    // own keys or none. Its stop values likewise: a stage stops where it
+    // says, on the diagram's shared measures.
     table.remove("link");
+    table.remove("stop_at");
     let stage = stages
         .as_array()
         .and_then(|a| a.get(number.checked_sub(2)?))
