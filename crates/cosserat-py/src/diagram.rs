@@ -352,7 +352,8 @@ impl SpecialPoint {
         self.point.block.name()
     }
 
-    /// How it was located: "augmented", "bracketed" or "extrapolated".
+    /// How it was located: "augmented", "bracketed", "interpolated" or
+    /// "extrapolated".
     #[getter]
     fn location(&self) -> &'static str {
         self.point.location.name()

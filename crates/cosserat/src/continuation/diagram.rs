@@ -74,6 +74,11 @@ pub enum Location {
     /// extrapolated at the elements' order (Richardson); its estimated
     /// error is [`SpecialPoint::parameter_error`].
     Extrapolated,
+    /// The root of the test function interpolated from its samples on both
+    /// sides where the corrector fails closer to it (the bracket could not
+    /// be closed; `interpolated_root.rs`): its estimated error is the
+    /// difference from the interpolant of one degree less.
+    Interpolated,
 }
 
 impl Location {
@@ -83,6 +88,7 @@ impl Location {
             Location::Augmented => "augmented",
             Location::Bracketed => "bracketed",
             Location::Extrapolated => "extrapolated",
+            Location::Interpolated => "interpolated",
         }
     }
 }

@@ -86,7 +86,9 @@ impl Run<'_> {
         let Some(sp) = sp else {
             return (None, None);
         };
-        let error = self.relocated_multiple(&sp, reach);
+        // An interpolated root's own error adds to the discretization's.
+        let location = sp.parameter_error.unwrap_or(0.0);
+        let error = self.relocated_multiple(&sp, reach).map(|e| e + location);
         stated(sp, error)
     }
 
@@ -197,10 +199,37 @@ impl Run<'_> {
         a: &Point,
         (sign, p_b, span): (f64, f64, f64),
     ) -> Result<f64, String> {
+        self.relocated_on_slice(sp, a, &|run, start| run.fold_root(start, (sign, p_b), span))
+    }
+
+    /// |p − p_fine| · G/(G − 1) of `sp`, located on a branch of symmetric
+    /// copies in the step from `a`: p_fine the `root` of the same test
+    /// along the same step on the refined family's slice, from `a` carried
+    /// onto it and put back on its slice at its own parameter.
+    pub(super) fn relocated_on_slice(
+        &self,
+        sp: &SpecialPoint,
+        a: &Point,
+        root: &dyn Fn(&Run, &Point) -> Result<f64, String>,
+    ) -> Result<f64, String> {
         let (fine, gain) = self.family.refined()?;
         let mut run = Run::new(&fine, self.opts);
         run.sliced = true;
-        let (x, forward) = self.carried_onto(&fine, a)?;
+        let start = self.start_on_refined_slice(&run, &fine, a)?;
+        let fine_p =
+            root(&run, &start).map_err(|why| format!("on the refined discretization {why}"))?;
+        Ok((sp.point.parameter - fine_p).abs() * gain / (gain - 1.0))
+    }
+
+    /// `a` carried onto the refined family `fine` of `run` and put back on
+    /// its slice at its own parameter, with its tangent there.
+    fn start_on_refined_slice(
+        &self,
+        run: &Run,
+        fine: &super::Family,
+        a: &Point,
+    ) -> Result<Point, String> {
+        let (x, forward) = self.carried_onto(fine, a)?;
         // The carried point is off the refined branch by the coarse
         // discretization's error, so F_x's copies' singular value there is
         // small but not yet persistent: its smallest pair sets the slice
@@ -225,11 +254,7 @@ impl Run<'_> {
         let tangent = run
             .sliced_tangent(&z[..n], z[n], &kernel, &forward)
             .map_err(|e| refined(&e))?;
-        let start = restarted(a, z[..n].to_vec(), z[n], tangent);
-        let fine_p = run
-            .fold_root(&start, (sign, p_b), span)
-            .map_err(|why| format!("on the refined discretization {why}"))?;
-        Ok((sp.point.parameter - fine_p).abs() * gain / (gain - 1.0))
+        Ok(restarted(a, z[..n].to_vec(), z[n], tangent))
     }
 
     /// |p − p_fine| · G/(G − 1), p_fine the root in p of an entry of G on
@@ -291,7 +316,7 @@ fn refined(e: &super::PointError) -> String {
 }
 
 /// `sp` with its estimated error, or without one and the note saying why.
-fn stated(
+pub(super) fn stated(
     mut sp: SpecialPoint,
     error: Result<f64, String>,
 ) -> (Option<SpecialPoint>, Option<String>) {

@@ -40,7 +40,7 @@ use crate::numerics::staircase::{Staircase, StaircaseLu};
 use crate::stability::Block;
 
 /// A test function along the step from a point: f(σ) and the point there.
-type Located = (f64, Vec<f64>, f64, Vec<f64>);
+pub(super) type Located = (f64, Vec<f64>, f64, Vec<f64>);
 
 /// A point of [`Run::point_at`]: unknowns, parameter, tangent, and F_x
 /// there where its corrector evaluated it.
@@ -55,6 +55,10 @@ struct Root {
     sigma: f64,
     located: Located,
     spread: f64,
+    /// Where the bracket could not be closed and the root was interpolated
+    /// from the samples on both sides (`interpolated_root.rs`): its
+    /// estimated error in p.
+    interpolated: Option<f64>,
 }
 
 /// The function whose sign change locates an event.
@@ -532,18 +536,51 @@ impl Run<'_> {
                 self.refined_branch_point(a, b, sign, root, (branch, index), wanted);
             return (point.into_iter().collect(), note.into_iter().collect());
         }
+        let interpolated = root.interpolated.is_some();
         let (point, note) = self.bracketed(a, b, sign, root, (branch, index), wanted, kind.name());
         // A multiple branch point (G wholly zero at the closed root) carries
         // its discretization error, located again on the refined family.
-        if resolved && matches!(test, Test::Bordered { .. }) {
+        if (resolved || interpolated) && matches!(test, Test::Bordered { .. }) {
             let reach = (b.parameter - a.parameter).abs();
-            let (point, error_note) = self.with_multiple_discretization_error(point, reach);
+            let (point, error_note) = if self.sliced {
+                self.with_sliced_multiple_error(point, a, (sign, b.parameter, span), &test)
+            } else {
+                self.with_multiple_discretization_error(point, reach)
+            };
             return (
                 point.into_iter().collect(),
                 note.into_iter().chain(error_note).collect(),
             );
         }
         (point.into_iter().collect(), note.into_iter().collect())
+    }
+
+    /// `sp`, a multiple branch point on a branch of symmetric copies (the
+    /// root of an entry of G, `test`, in the step from `a`), with its
+    /// discretization error: the root of the same entry with the same
+    /// borders along the same step on the refined family's slice
+    /// (`discretization.rs`). Where that fails — another number of
+    /// unknowns, whose borders would differ — the error stays unknown and
+    /// the note says why.
+    fn with_sliced_multiple_error(
+        &self,
+        sp: Option<SpecialPoint>,
+        a: &Point,
+        (sign, p_b, span): (f64, f64, f64),
+        test: &Test,
+    ) -> (Option<SpecialPoint>, Option<String>) {
+        let Some(sp) = sp else {
+            return (None, None);
+        };
+        let error = self.relocated_on_slice(&sp, a, &|run, start| match test {
+            Test::Bordered { right, .. } if right.nrows() == start.unknowns.len() => {
+                run.closed_root(start, (sign, p_b), span, test, "the entry of G")
+            }
+            _ => Err("has another number of unknowns, for which G's borders do not hold".into()),
+        });
+        // An interpolated root's own error adds to the discretization's.
+        let location = sp.parameter_error.unwrap_or(0.0);
+        super::discretization::stated(sp, error.map(|e| e + location))
     }
 
     /// The special point kept at the bracketed root, recorded as
@@ -561,6 +598,16 @@ impl Run<'_> {
         wanted: Wanted,
         what: &str,
     ) -> (Option<SpecialPoint>, Option<String>) {
+        if let Some(error) = root.interpolated {
+            let location = (wanted, Location::Interpolated);
+            let point = self
+                .special_point(a, b, sign, root.located, (branch, index), location)
+                .map(|mut sp| {
+                    sp.parameter_error = Some(error);
+                    sp
+                });
+            return (point, None);
+        }
         let unresolved = self.unresolved(&root, what, (branch, index));
         let spread = root.spread;
         let point = self
@@ -1007,6 +1054,7 @@ impl Run<'_> {
         let upper = self.test_at(a, sign, hi, None, test)?;
         let mut bracket = Illinois::new(lo, hi, lower.0, upper.0)?;
         let (mut p_lo, mut p_hi) = (a.parameter, p_b);
+        let mut samples: Vec<Anchor> = vec![(start, lower.clone()), (hi, upper.clone())];
         let mut ends: [Anchor; 2] = [(start, lower), (hi, upper)];
         let mut best: Option<Anchor> = None;
         for _ in 0..80 {
@@ -1025,6 +1073,7 @@ impl Run<'_> {
                 }
             };
             ends[end] = (sigma, here.clone());
+            samples.push((sigma, here.clone()));
             let tol = self.opts.event_tolerance * here.2.abs().max(1.0);
             let done = (p_hi - p_lo).abs() <= tol && bracket.width() <= 1e3 * tol
                 || here.0 == 0.0
@@ -1043,10 +1092,27 @@ impl Run<'_> {
                 u
             }
         });
+        let spread = (p_hi - p_lo).abs();
+        let tol = self.opts.event_tolerance * located.2.abs().max(1.0);
+        if spread > tol {
+            // Each sample's p is itself resolved to the event tolerance.
+            if let Some((sigma, located, error)) = super::interpolated_root::interpolated(&samples)
+                .map(|(sigma, located, error)| (sigma, located, error + tol))
+                .filter(|(_, _, error)| *error < spread)
+            {
+                return Some(Root {
+                    sigma,
+                    located,
+                    spread,
+                    interpolated: Some(error),
+                });
+            }
+        }
         Some(Root {
             sigma,
             located,
-            spread: (p_hi - p_lo).abs(),
+            spread,
+            interpolated: None,
         })
     }
 
@@ -1129,6 +1195,7 @@ impl Run<'_> {
                 format!("{what} does not change sign within the step, or a corrector failed")
             })?;
         match self.unresolved(&root, "root", (0, 0)) {
+            _ if root.interpolated.is_some() => Ok(root.located.2),
             None => Ok(root.located.2),
             Some(_) => Err(format!(
                 "the bracket of {what}'s root closed only to ±{:.1e}",

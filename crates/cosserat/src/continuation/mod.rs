@@ -38,6 +38,7 @@ pub mod engine;
 mod events;
 mod family;
 mod fold;
+mod interpolated_root;
 mod kernel;
 mod landing;
 mod lens;

@@ -318,6 +318,7 @@ fn locations(g: &Group, count: usize) -> StoreResult<Vec<Location>> {
             "augmented" => Ok(Location::Augmented),
             "bracketed" => Ok(Location::Bracketed),
             "extrapolated" => Ok(Location::Extrapolated),
+            "interpolated" => Ok(Location::Interpolated),
             other => Err(format!("unknown location `{other}`").into()),
         })
         .collect()
