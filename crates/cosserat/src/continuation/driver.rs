@@ -256,6 +256,7 @@ impl<'a> Run<'a> {
             tip_angle,
             tip,
             morse_index: spectrum.morse_index,
+            block_morse: spectrum.block_morse,
             stable: spectrum.morse_index == 0,
             eigenvalues: spectrum.values,
             norm: spectrum.curvature_norm,

@@ -140,13 +140,17 @@ impl Run<'_> {
     ) -> (Vec<Wanted>, Vec<String>) {
         let n = a.unknowns.len();
         let fold = a.tangent[n] * b.tangent[n] < 0.0;
-        let spectra_a = self.block_morse(a);
-        let spectra_b = self.block_morse(b);
+        // Each block's Morse index as the tracker counted it, exact
+        // whatever the number of tracked eigenvalues (counting the tracked
+        // values below zero saturated at `eigenvalues`: the twisted rod's
+        // second double crossing, Morse index 2 → 4 with three tracked,
+        // was reported as a simple branch point).
+        let (spectra_a, spectra_b) = (&a.block_morse, &b.block_morse);
         let changed: Vec<(Block, usize)> = self
             .tracker
             .blocks()
             .iter()
-            .zip(spectra_a.iter().zip(&spectra_b))
+            .zip(spectra_a.iter().zip(spectra_b))
             .filter(|(_, (x, y))| x != y)
             .map(|(blk, (x, y))| (*blk, x.abs_diff(*y)))
             .collect();
@@ -173,17 +177,6 @@ impl Run<'_> {
             ));
         }
         (vec![(SpecialKind::Fold, block, 1)], notes)
-    }
-
-    fn block_morse(&mut self, p: &Point) -> Vec<usize> {
-        // The per-block Morse indices are recomputed from the stored
-        // eigenvalues: tracked values below zero, plus any beyond the
-        // computed ones is impossible (they are the lowest).
-        let k = self.opts.stability.eigenvalues();
-        p.eigenvalues
-            .chunks(k)
-            .map(|c| c.iter().filter(|v| **v < 0.0).count())
-            .collect()
     }
 
     /// Whether the model's BVP Jacobian sees the block's mode.
