@@ -1,0 +1,206 @@
+//! Classical problems posed only through the documented keys (issue 16's
+//! acceptance), each run by `cosserat continue` and compared with a
+//! reference computed here from its closed form: the pinned–pinned column
+//! and its elastica (problems/pinned_column.toml: Euler's loads, the
+//! elliptic-integral branch, the end slope stopped at 170°), the same
+//! elastica under displacement control
+//! (problems/pinned_elastica_displacement.toml), and Greenhill's twisted
+//! rod with clamped ends under a thrust, through more than two turns
+//! (problems/twisted_rod_thrust.toml: two double branch points).
+mod common;
+
+use std::f64::consts::PI;
+use std::path::Path;
+
+use common::problems::shipped;
+use common::run::{scratch, special_line, BIN};
+use cosserat::references::{ellip_e, ellip_f, greenhill_clamped};
+
+/// `cosserat continue NAME -o OUT` with `overrides`: its stdout, the run
+/// having succeeded without a warning.
+fn continued(name: &str, out: &Path, overrides: &[&str]) -> String {
+    let mut args = vec![
+        "continue".to_string(),
+        shipped(name),
+        "-o".into(),
+        out.to_str().unwrap().into(),
+    ];
+    for o in overrides {
+        args.extend(["--set".to_string(), (*o).to_string()]);
+    }
+    let o = std::process::Command::new(BIN)
+        .args(&args)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        o.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// The `special K` lines of a run's output, in order.
+fn specials(stdout: &str) -> Vec<&str> {
+    stdout
+        .lines()
+        .filter(|l| l.starts_with("special "))
+        .collect()
+}
+
+/// The printed parameter of a special line within twice its stated error
+/// (plus the 12 printed decimals) of `reference`, the error itself below
+/// `bound` relative.
+fn assert_located(line: &str, reference: f64, bound: f64) {
+    let (_, printed, error) = special_line(line);
+    let error = error.unwrap_or_else(|| panic!("no error stated: {line}"));
+    assert!(error <= bound * reference, "{line}");
+    assert!(
+        (printed - reference).abs() <= 2.0 * error + 1e-12,
+        "{line}: against {reference} off by {:e}",
+        printed - reference
+    );
+}
+
+/// K(k) and E(k), the complete elliptic integrals of modulus k.
+fn complete(k: f64) -> (f64, f64) {
+    (ellip_f(PI / 2.0, k), ellip_e(PI / 2.0, k))
+}
+
+/// The root of `f` (increasing) in (lo, hi) by bisection to round-off.
+fn bisect(f: impl Fn(f64) -> f64, mut lo: f64, mut hi: f64) -> f64 {
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if mid <= lo || mid >= hi {
+            break;
+        }
+        if f(mid) < 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+/// The pinned–pinned elastica of modulus k (B = L = 1): the thrust 4K²,
+/// the tip's height over the base 2E/K − 1 and the midspan's sway 2k/√P.
+struct Elastica {
+    load: f64,
+    height: f64,
+    sway: f64,
+}
+
+impl Elastica {
+    fn of_modulus(k: f64) -> Self {
+        let (kk, e) = complete(k);
+        let load = 4.0 * kk * kk;
+        Self {
+            load,
+            height: 2.0 * e / kk - 1.0,
+            sway: 2.0 * k / load.sqrt(),
+        }
+    }
+
+    /// The elastica under the thrust `load` (> π²).
+    fn at_load(load: f64) -> Self {
+        Self::of_modulus(bisect(|k| Self::of_modulus(k).load - load, 0.0, 1.0))
+    }
+
+    /// The elastica whose tip stands at `height` over the base.
+    fn at_height(height: f64) -> Self {
+        Self::of_modulus(bisect(|k| height - Self::of_modulus(k).height, 0.0, 1.0))
+    }
+}
+
+/// The first positive root of tan β = β (the clamped–pinned column's
+/// β²): β − tan β changes sign once in (π, 3π/2).
+fn clamped_pinned() -> f64 {
+    let beta = bisect(|b| b.tan() - b, PI + 1e-9, 1.5 * PI - 1e-9);
+    beta * beta
+}
+
+#[test]
+fn pinned_column_buckles_at_eulers_loads_onto_its_elastica() {
+    let dir = scratch("classical", "pinned-column");
+    let out = dir.join("column.h5");
+    let stdout = continued("pinned_column", &out, &[]);
+    let lines = specials(&stdout);
+    // The straight column: π², 4π², 9π² in the plane; out of it the hinge
+    // holds the base (a clamped–pinned column, B1 = 2). The buckled
+    // branches (modes 1 and 2) meet the rotated loops where the tip passes
+    // the base: E/K = 1/2, P = 4K² and 16K².
+    let through = Elastica::at_height(0.0).load;
+    let expected = [
+        (0, "in_plane", PI * PI),
+        (1, "in_plane", 4.0 * PI * PI),
+        (2, "out_of_plane", 2.0 * clamped_pinned()),
+        (3, "in_plane", 9.0 * PI * PI),
+        (4, "in_plane", through),
+        (6, "in_plane", through),
+        (8, "in_plane", 4.0 * through),
+        (10, "in_plane", 4.0 * through),
+    ];
+    for (k, block, reference) in expected {
+        let line = lines[k];
+        assert!(
+            line.contains("branch_point") && line.contains(block),
+            "{line}"
+        );
+        assert!(line.contains("multiplicity 1"), "{line}");
+        assert_located(line, reference, 1e-10);
+    }
+    let f = common::h5::open(&out);
+    // The first mode's two buckled branches on the elastica at every point,
+    // each stopped where the end slope reaches 170°.
+    for branch in [1, 2] {
+        let group = format!("branches/{branch}");
+        let p = common::h5::read_f64(&f, &format!("{group}/parameter"));
+        let m = common::h5::read_f64(&f, &format!("{group}/measures"));
+        for (i, &load) in p.iter().enumerate() {
+            let reference = Elastica::at_load(load);
+            let (height, sway) = (m[3 * i], m[3 * i + 1]);
+            assert!((height - reference.height).abs() < 1e-9, "{load}: {height}");
+            assert!((sway.abs() - reference.sway).abs() < 1e-9, "{load}: {sway}");
+        }
+        let slope = common::h5::read_f64(&f, &format!("{group}/tip_angle"));
+        let last = *slope.last().unwrap();
+        assert!((last - 170f64.to_radians()).abs() < 1e-10, "{last}");
+        let at_stop = Elastica::of_modulus(85f64.to_radians().sin()).load;
+        assert!(
+            (p.last().unwrap() - at_stop).abs() < 1e-8 * at_stop,
+            "{p:?}"
+        );
+    }
+}
+
+#[test]
+fn twisted_rod_under_thrust_loses_stability_at_greenhills_double_points() {
+    let dir = scratch("classical", "twisted-thrust");
+    let out = dir.join("twisted.h5");
+    let stdout = continued("twisted_rod_thrust", &out, &[]);
+    let lines = specials(&stdout);
+    assert_eq!(lines.len(), 2, "{stdout}");
+    // Both crossings are pairs (B1 = B2): multiplicity 2, the Morse index
+    // 0 → 2 → 4, though three eigenvalues are tracked.
+    for (line, morse) in lines.iter().zip([0, 2]) {
+        assert!(line.contains("branch_point"), "{line}");
+        assert!(
+            line.contains(&format!("Morse index {morse}, multiplicity 2")),
+            "{line}"
+        );
+        // The thrust at which Greenhill's determinant vanishes for the
+        // printed twisting moment M L/B = θ C/B (C = B) is the problem's,
+        // 10: the moment's error is the thrust's over dP/dM.
+        let (_, theta, error) = special_line(line);
+        let error = error.unwrap_or_else(|| panic!("no error stated: {line}"));
+        let h = 1e-5;
+        let slope = (greenhill_clamped(theta + h) - greenhill_clamped(theta - h)) / (2.0 * h);
+        let off = (greenhill_clamped(theta) - 10.0) / slope;
+        assert!(error <= 1e-10 * theta, "{line}");
+        assert!(off.abs() <= 2.0 * error + 1e-12, "{line}: off by {off:e}");
+    }
+    // More than two full turns at the second point.
+    assert!(special_line(lines[1]).1 > 4.0 * PI);
+}
