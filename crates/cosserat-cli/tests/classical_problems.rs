@@ -204,3 +204,49 @@ fn twisted_rod_under_thrust_loses_stability_at_greenhills_double_points() {
     // More than two full turns at the second point.
     assert!(special_line(lines[1]).1 > 4.0 * PI);
 }
+
+#[test]
+fn pinned_elastica_under_displacement_control_follows_loves_force() {
+    let dir = scratch("classical", "pinned-displacement");
+    let out = dir.join("elastica.h5");
+    let stdout = continued("pinned_elastica_displacement", &out, &[]);
+    // Towards the full length the branch ends on its bound 0.9999: the
+    // step that passed the fold at 1.0 (the straight rod) and came back
+    // used to go on past it, the fold reported beyond the bounds.
+    assert!(specials(&stdout).is_empty(), "{stdout}");
+    let f = common::h5::open(&out);
+    for (branch, bound) in [(0, 0.9999), (1, 0.2)] {
+        let group = format!("branches/{branch}");
+        let p = common::h5::read_f64(&f, &format!("{group}/parameter"));
+        let m = common::h5::read_f64(&f, &format!("{group}/measures"));
+        assert_eq!(*p.last().unwrap(), bound, "{p:?}");
+        for (i, &height) in p.iter().enumerate() {
+            let reference = Elastica::at_height(height);
+            let k = (reference.sway * reference.load.sqrt()) / 2.0;
+            let (force, sway, slope) = (m[3 * i], m[3 * i + 1], m[3 * i + 2]);
+            // The support pushes the tip towards the base.
+            assert!(
+                (-force - reference.load).abs() < 1e-9 * reference.load,
+                "{height}: {force} against {}",
+                reference.load
+            );
+            assert!(
+                (sway.abs() - reference.sway).abs() < 1e-9,
+                "{height}: {sway}"
+            );
+            let sin_alpha = 2.0 * k * (1.0 - k * k).sqrt();
+            assert!((slope.abs() - sin_alpha).abs() < 1e-9, "{height}: {slope}");
+        }
+    }
+}
+
+/// A guess of κ(0) beside a hinge is refused by its key: the planar
+/// solver read its κ2 as the hinge's angle (3 rad from [0, 3, 0], and
+/// Newton diverged); the angle's guess is `clamp.angle`.
+#[test]
+fn a_curvature_guess_beside_a_hinge_is_refused_by_name() {
+    let text = common::problems::shipped_text("pinned_elastica_displacement");
+    let message = common::problems::refusal(&text, &["solver.initial_curvature=[0,3,0]"]);
+    assert!(message.contains("solver.initial_curvature"), "{message}");
+    assert!(message.contains("clamp.angle"), "{message}");
+}

@@ -123,6 +123,18 @@ impl Problem {
                  scene has none ([support] translation = \"fixed\" or \"axial\")",
             ));
         }
+        if options.initial_guess.is_some() && rod.clamp().hinge {
+            // The planar solver took κ2 of the guess as the hinge's angle
+            // (its unknown): [0, 3, 0] started Newton from a base turned
+            // by 3 rad, which diverged.
+            return Err(invalid(
+                "solver.initial_curvature",
+                "guesses κ(0), which a hinged base (clamp.hinge) does not have as an unknown \
+                 (M2(0) = 0 fixes it): the unknown is the base's angle, measured from the clamp \
+                 frame, so guess it by clamp.angle (rad), which turns that frame about the \
+                 hinge's axis",
+            ));
+        }
         point_couples_carried(&rod, &model, &options)?;
         let shape = build_shape(&file)?;
         if shape.is_some() && !rod.loads().point_loads.is_empty() {
