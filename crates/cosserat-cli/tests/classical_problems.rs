@@ -250,3 +250,35 @@ fn a_curvature_guess_beside_a_hinge_is_refused_by_name() {
     assert!(message.contains("solver.initial_curvature"), "{message}");
     assert!(message.contains("clamp.angle"), "{message}");
 }
+
+/// A rod bent by turning its end (tip free, its frame held and turned about
+/// d2) is an arc of curvature θ/L at every θ: through π, where the planar
+/// model's held angle (atan2 of the frame) jumped by 2π and the branch
+/// jumped with it onto the rod unwound by a turn (θ = 6.29 with the
+/// turning 0.005), through the closed ring at 2π and beyond.
+#[test]
+fn ring_bent_by_its_end_follows_the_arc_through_a_full_turn() {
+    let dir = scratch("classical", "ring");
+    let out = dir.join("ring.h5");
+    continued("ring_end_rotation", &out, &[]);
+    let f = common::h5::open(&out);
+    let p = common::h5::read_f64(&f, "branches/0/parameter");
+    let m = common::h5::read_f64(&f, "branches/0/measures");
+    assert_eq!(*p.last().unwrap(), 8.0, "{p:?}");
+    // No step longer than the largest arclength step moves θ (one unit
+    // of the scaled unknowns per radian of the turn, at least).
+    assert!(
+        p.windows(2).all(|w| w[1] > w[0] && w[1] - w[0] <= 0.5),
+        "{p:?}"
+    );
+    for (i, &theta) in p.iter().enumerate().skip(1) {
+        let (turning, x, z, moment) = (m[4 * i], m[4 * i + 1], m[4 * i + 2], m[4 * i + 3]);
+        assert!((turning - theta).abs() < 1e-9, "{theta}: turning {turning}");
+        assert!(
+            (x - (1.0 - theta.cos()) / theta).abs() < 1e-9,
+            "{theta}: x {x}"
+        );
+        assert!((z - theta.sin() / theta).abs() < 1e-9, "{theta}: z {z}");
+        assert!((moment.abs() - theta).abs() < 1e-9, "{theta}: M {moment}");
+    }
+}
