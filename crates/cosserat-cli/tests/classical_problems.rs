@@ -282,3 +282,30 @@ fn ring_bent_by_its_end_follows_the_arc_through_a_full_turn() {
         assert!((moment.abs() - theta).abs() < 1e-9, "{theta}: M {moment}");
     }
 }
+
+/// Every branch stays within its bounds: the second mode's branches,
+/// switched at 4π² = 39.48 below the bound 40, began at 40.74 ("left the
+/// bounds"); now they are landed on the bound, one point each.
+#[test]
+fn switched_branches_begin_within_the_bounds() {
+    let dir = scratch("classical", "switch-bounds");
+    let out = dir.join("column.h5");
+    let stdout = continued("pinned_column", &out, &["continuation.bounds=[0,40]"]);
+    let f = common::h5::open(&out);
+    let branches = stdout.lines().filter(|l| l.starts_with("branch ")).count();
+    assert_eq!(branches, 5, "{stdout}");
+    for b in 0..branches {
+        let p = common::h5::read_f64(&f, &format!("branches/{b}/parameter"));
+        assert!(p.iter().all(|v| (0.0..=40.0).contains(v)), "{b}: {p:?}");
+    }
+    for line in stdout
+        .lines()
+        .filter(|l| l.contains("from special point 1"))
+    {
+        assert!(
+            line.contains("1 points, parameter 40.000000 → 40.000000"),
+            "{line}"
+        );
+        assert!(line.ends_with("reached the bound 40"), "{line}");
+    }
+}

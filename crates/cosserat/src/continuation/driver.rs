@@ -475,6 +475,19 @@ impl<'a> Run<'a> {
             if let Some(reason) = self.stop_reason(&last, points.len()) {
                 return end(specials, reason, false);
             }
+            // A switched branch whose first point was landed on a bound
+            // (`switched_within_bounds`) and heads out of the bounds ends
+            // there, one point long.
+            let n = last.unknowns.len();
+            let outward = sign * last.tangent[n];
+            let (lo, hi) = self.opts.bounds;
+            if points.len() == 1
+                && diagram.branches[branch].parent.is_some()
+                && ((last.parameter == hi && outward > 0.0)
+                    || (last.parameter == lo && outward < 0.0))
+            {
+                return end(specials, BranchEnd::ReachedBound(last.parameter), false);
+            }
             // Newton from the parabola through the last two points only
             // where the step control is saturated (the next step is the
             // maximum whatever the corrector's iterations): elsewhere fewer

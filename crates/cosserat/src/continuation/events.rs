@@ -1156,7 +1156,6 @@ impl Run<'_> {
             return vec![];
         };
         let (x, p) = (&sp.point.unknowns, sp.point.parameter);
-        let n = x.len();
         let eps = 0.5 * self.opts.step;
         let mut z = x.clone();
         z.push(p);
@@ -1168,8 +1167,9 @@ impl Run<'_> {
                 let Some((zn, tangent)) = self.switch_step(&pred, &t, directions.len()) else {
                     continue;
                 };
+                let (xn, pn, tangent) = self.switched_within_bounds(sp, &zn, tangent);
                 self.tracker.reset();
-                if let Ok(pt) = self.point(zn[..n].to_vec(), zn[n], tangent) {
+                if let Ok(pt) = self.point(xn, pn, tangent) {
                     starts.push((pt, 1.0));
                 }
             }
@@ -1184,6 +1184,30 @@ impl Run<'_> {
             ));
         }
         starts
+    }
+
+    /// A switched branch's first point `zn` = (x, p), pulled back onto the
+    /// bound it crossed when it lies beyond the bounds (the pinned
+    /// column's second-mode branch, switched at 4π² = 39.48 with the
+    /// bound 40, began at 40.74 and ended there, "left the bounds"): by
+    /// Newton at the bound from the interpolant between the branch point
+    /// and `zn`, as a step that ends beyond a bound ([`Run::land_on_bound`];
+    /// by the plain corrector — a switch through the slice keeps its point).
+    fn switched_within_bounds(
+        &mut self,
+        sp: &SpecialPoint,
+        zn: &[f64],
+        tangent: Vec<f64>,
+    ) -> (Vec<f64>, f64, Vec<f64>) {
+        let n = zn.len() - 1;
+        let (lo, hi) = self.opts.bounds;
+        if (lo..=hi).contains(&zn[n]) {
+            return (zn[..n].to_vec(), zn[n], tangent);
+        }
+        let sliced = std::mem::replace(&mut self.sliced, false);
+        let landed = self.land_on_bound(&sp.point, zn[..n].to_vec(), zn[n], tangent);
+        self.sliced = sliced;
+        landed
     }
 
     /// The first point off a branch point along `t` from the predictor: the
