@@ -309,3 +309,35 @@ fn switched_branches_begin_within_the_bounds() {
         assert!(line.ends_with("reached the bound 40"), "{line}");
     }
 }
+
+/// The pinned–pinned arch (Θ = 0.5) loses stability at its asymmetric
+/// branch point before its symmetric fold, both at the values of an
+/// independent scipy shooting of the elastica (problems/pinned_arch_full.toml:
+/// 5.92062588 ± 3e-9 and 6.8214789791 ± 1e-10, the reference's accuracy).
+#[test]
+fn pinned_arch_bifurcates_before_its_fold() {
+    // scipy's DOP853 shooting of the elastica (problems/pinned_arch_full.toml).
+    const BIFURCATION: f64 = 5.920_625_881_5;
+    const FOLD: f64 = 6.821_478_979_130_86;
+    let dir = scratch("classical", "pinned-arch");
+    let out = dir.join("arch.h5");
+    let stdout = continued("pinned_arch_full", &out, &[]);
+    let lines = specials(&stdout);
+    assert_eq!(lines.len(), 2, "{stdout}");
+    let (located, bifurcation, error) = special_line(lines[0]);
+    assert!(lines[0].contains("branch_point") && lines[0].contains("Morse index 0"));
+    assert_eq!(located, "augmented");
+    assert!((bifurcation - BIFURCATION).abs() < 3e-9, "{}", lines[0]);
+    assert!(error.unwrap() < 1e-10, "{}", lines[0]);
+    let (located, fold, _) = special_line(lines[1]);
+    assert!(lines[1].contains("fold") && lines[1].contains("Morse index 1"));
+    assert_eq!(located, "augmented");
+    assert!((fold - FOLD).abs() < 1e-10, "{}", lines[1]);
+    // Both ways off the branch point the load falls.
+    for line in stdout
+        .lines()
+        .filter(|l| l.contains("from special point 0"))
+    {
+        assert!(line.ends_with("reached the bound -1"), "{line}");
+    }
+}
