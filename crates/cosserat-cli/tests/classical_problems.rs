@@ -6,7 +6,11 @@
 //! elastica under displacement control
 //! (problems/pinned_elastica_displacement.toml), and Greenhill's twisted
 //! rod with clamped ends under a thrust, through more than two turns
-//! (problems/twisted_rod_thrust.toml: two double branch points).
+//! (problems/twisted_rod_thrust.toml: two double branch points), a ring
+//! bent shut by turning its end (problems/ring_end_rotation.toml: the arc
+//! through 2π), and the pinned arch's asymmetric branch point before its
+//! fold (problems/pinned_arch_full.toml, against an independent scipy
+//! shooting, scripts/pinned_arch_reference.py).
 mod common;
 
 use std::f64::consts::PI;
@@ -339,5 +343,41 @@ fn pinned_arch_bifurcates_before_its_fold() {
         .filter(|l| l.contains("from special point 0"))
     {
         assert!(line.ends_with("reached the bound -1"), "{line}");
+    }
+}
+
+/// Switched again from the stored diagram at the point where the tip
+/// passes the base (`--point special/4`): the loop of E/K = 1/2 turned by
+/// ψ about the common end point, carried by the force F* = 4K² along the
+/// turned chord's normal, so that the thrust is P = F* cos ψ: the tip
+/// stays at the base and the midspan's sway is s₀ cos ψ = s₀ P/F*
+/// (s₀ = 2k/√F*, the loop's own).
+#[test]
+fn loops_turned_about_their_closed_ends_carry_the_projected_force() {
+    let dir = scratch("classical", "turned-loops");
+    let (first, out) = (dir.join("column.h5"), dir.join("loops.h5"));
+    continued("pinned_column", &first, &[]);
+    let o = std::process::Command::new(BIN)
+        .args(["continue", &shipped("pinned_column"), "--from"])
+        .args([first.to_str().unwrap(), "--point", "special/4", "-o"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let loop_ = Elastica::at_height(0.0);
+    let f = common::h5::open(&out);
+    for branch in [1, 2] {
+        let p = common::h5::read_f64(&f, &format!("branches/{branch}/parameter"));
+        let m = common::h5::read_f64(&f, &format!("branches/{branch}/measures"));
+        assert!(p.len() > 5 && p.iter().all(|&v| v < loop_.load), "{p:?}");
+        for (i, &load) in p.iter().enumerate() {
+            let (height, sway) = (m[3 * i], m[3 * i + 1]);
+            assert!(height.abs() < 1e-9, "{load}: {height}");
+            let projected = loop_.sway * load / loop_.load;
+            assert!(
+                (sway.abs() - projected.abs()).abs() < 1e-9,
+                "{load}: {sway}"
+            );
+        }
     }
 }
