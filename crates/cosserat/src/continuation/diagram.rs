@@ -24,6 +24,12 @@ pub struct Point {
     pub eigenvalues: Vec<f64>,
     /// Morse index.
     pub morse_index: usize,
+    /// The Morse index of each block (in the order of the eigenvalues'
+    /// blocks), counted exactly — by the warm pairs' certificate or
+    /// Sylvester's inertia —, not read from the tracked eigenvalues: a
+    /// block may have more negative eigenvalues than it tracks (the
+    /// twisted rod's second pair crosses zero while three are tracked).
+    pub block_morse: Vec<usize>,
     /// Stable (Morse index 0).
     pub stable: bool,
     /// The L² norm of the curvature, √∫|κ|².

@@ -267,6 +267,7 @@ impl<'a> Run<'a> {
             tip_angle,
             tip,
             morse_index: spectrum.morse_index,
+            block_morse: spectrum.block_morse,
             stable: spectrum.morse_index == 0,
             eigenvalues: spectrum.values,
             norm: spectrum.curvature_norm,
@@ -351,6 +352,40 @@ impl<'a> Run<'a> {
             },
             Err(_) => (x, p, tangent),
         }
+    }
+
+    /// The point on the bound a step passed, where a fold it located lies
+    /// beyond the bounds while both ends of the step lie inside: the
+    /// branch left [min, max] and came back within one step (the pinned
+    /// elastica under displacement control went from 0.99957 over the
+    /// fold at the full length 1.0 back to 0.99912 with the bound 0.9999,
+    /// and went on). Landed by Newton at the bound from the interpolant
+    /// between `last` and the fold ([`Run::land_on_bound`]); None where no
+    /// such fold was found, or the landing failed (the step's own
+    /// points and events are then kept).
+    fn beyond_bound_fold(
+        &mut self,
+        last: &Point,
+        sign: f64,
+        ds: f64,
+        found: &[super::SpecialPoint],
+    ) -> Option<Point> {
+        let (lo, hi) = self.opts.bounds;
+        let fold = found.iter().find(|sp| {
+            sp.kind == super::SpecialKind::Fold
+                && (sp.point.parameter > hi || sp.point.parameter < lo)
+        })?;
+        let beyond = &fold.point;
+        let (x, p, tangent) = self.land_on_bound(
+            last,
+            beyond.unknowns.clone(),
+            beyond.parameter,
+            beyond.tangent.clone(),
+        );
+        if p != lo && p != hi {
+            return None;
+        }
+        self.next_point(last, sign, ds, x, p, tangent).ok()
     }
 
     /// The engine's step control with the run's limits.
@@ -451,6 +486,19 @@ impl<'a> Run<'a> {
             if let Some(reason) = self.stop_reason(&last, points.len()) {
                 return end(specials, reason, false);
             }
+            // A switched branch whose first point was landed on a bound
+            // (`switched_within_bounds`) and heads out of the bounds ends
+            // there, one point long.
+            let n = last.unknowns.len();
+            let outward = sign * last.tangent[n];
+            let (lo, hi) = self.opts.bounds;
+            if points.len() == 1
+                && diagram.branches[branch].parent.is_some()
+                && ((last.parameter == hi && outward > 0.0)
+                    || (last.parameter == lo && outward < 0.0))
+            {
+                return end(specials, BranchEnd::ReachedBound(last.parameter), false);
+            }
             // Newton from the parabola through the last two points only
             // where the step control is saturated (the next step is the
             // maximum whatever the corrector's iterations): elsewhere fewer
@@ -489,6 +537,16 @@ impl<'a> Run<'a> {
             };
             let index = diagram.branches[branch].points.len() - 1;
             let (found, missed) = self.events(&last, &next, sign, branch, index);
+            if let Some(landed) = self.beyond_bound_fold(&last, sign, ds, &found) {
+                // The step went out of the bounds and back in through a
+                // fold beyond them: the branch ends on the bound it passed
+                // (the events of the step lie beyond it, or are not known
+                // to lie before it, and are dropped).
+                let reason = BranchEnd::ReachedBound(landed.parameter);
+                diagram.branches[branch].points.push(landed);
+                self.total_points += 1;
+                return end(specials, reason, false);
+            }
             for sp in found {
                 specials.push(diagram.special_points.len());
                 diagram.special_points.push(sp);

@@ -144,13 +144,17 @@ impl Run<'_> {
     ) -> (Vec<Wanted>, Vec<String>) {
         let n = a.unknowns.len();
         let fold = a.tangent[n] * b.tangent[n] < 0.0;
-        let spectra_a = self.block_morse(a);
-        let spectra_b = self.block_morse(b);
+        // Each block's Morse index as the tracker counted it, exact
+        // whatever the number of tracked eigenvalues (counting the tracked
+        // values below zero saturated at `eigenvalues`: the twisted rod's
+        // second double crossing, Morse index 2 → 4 with three tracked,
+        // was reported as a simple branch point).
+        let (spectra_a, spectra_b) = (&a.block_morse, &b.block_morse);
         let changed: Vec<(Block, usize)> = self
             .tracker
             .blocks()
             .iter()
-            .zip(spectra_a.iter().zip(&spectra_b))
+            .zip(spectra_a.iter().zip(spectra_b))
             .filter(|(_, (x, y))| x != y)
             .map(|(blk, (x, y))| (*blk, x.abs_diff(*y)))
             .collect();
@@ -177,17 +181,6 @@ impl Run<'_> {
             ));
         }
         (vec![(SpecialKind::Fold, block, 1)], notes)
-    }
-
-    fn block_morse(&mut self, p: &Point) -> Vec<usize> {
-        // The per-block Morse indices are recomputed from the stored
-        // eigenvalues: tracked values below zero, plus any beyond the
-        // computed ones is impossible (they are the lowest).
-        let k = self.opts.stability.eigenvalues();
-        p.eigenvalues
-            .chunks(k)
-            .map(|c| c.iter().filter(|v| **v < 0.0).count())
-            .collect()
     }
 
     /// Whether the model's BVP Jacobian sees the block's mode.
@@ -1298,7 +1291,6 @@ impl Run<'_> {
             return vec![];
         };
         let (x, p) = (&sp.point.unknowns, sp.point.parameter);
-        let n = x.len();
         let eps = 0.5 * self.opts.step;
         let mut z = x.clone();
         z.push(p);
@@ -1310,8 +1302,9 @@ impl Run<'_> {
                 let Some((zn, tangent)) = self.switch_step(&pred, &t, directions.len()) else {
                     continue;
                 };
+                let (xn, pn, tangent) = self.switched_within_bounds(sp, &zn, tangent);
                 self.tracker.reset();
-                if let Ok(pt) = self.point(zn[..n].to_vec(), zn[n], tangent) {
+                if let Ok(pt) = self.point(xn, pn, tangent) {
                     starts.push((pt, 1.0));
                 }
             }
@@ -1326,6 +1319,30 @@ impl Run<'_> {
             ));
         }
         starts
+    }
+
+    /// A switched branch's first point `zn` = (x, p), pulled back onto the
+    /// bound it crossed when it lies beyond the bounds (the pinned
+    /// column's second-mode branch, switched at 4π² = 39.48 with the
+    /// bound 40, began at 40.74 and ended there, "left the bounds"): by
+    /// Newton at the bound from the interpolant between the branch point
+    /// and `zn`, as a step that ends beyond a bound ([`Run::land_on_bound`];
+    /// by the plain corrector — a switch through the slice keeps its point).
+    fn switched_within_bounds(
+        &mut self,
+        sp: &SpecialPoint,
+        zn: &[f64],
+        tangent: Vec<f64>,
+    ) -> (Vec<f64>, f64, Vec<f64>) {
+        let n = zn.len() - 1;
+        let (lo, hi) = self.opts.bounds;
+        if (lo..=hi).contains(&zn[n]) {
+            return (zn[..n].to_vec(), zn[n], tangent);
+        }
+        let sliced = std::mem::replace(&mut self.sliced, false);
+        let landed = self.land_on_bound(&sp.point, zn[..n].to_vec(), zn[n], tangent);
+        self.sliced = sliced;
+        landed
     }
 
     /// The first point off a branch point along `t` from the predictor: the

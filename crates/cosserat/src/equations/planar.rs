@@ -301,8 +301,14 @@ impl PlanarEquations {
         match support.rotation {
             Freedom::Fixed => {
                 let d3 = support.frame.column(2);
+                // The held angle on the 2π-branch nearest φ(L): a frame
+                // fixes the angle only modulo 2π, and atan2's cut at ±π
+                // made the residual jump by 2π there — continued in
+                // `support.turn.angle` the rod bent by its end unwound
+                // from φ(L) = 2.79 to 0.005 in one step at θ = 6.29.
                 let target = d3.dot(&ex).atan2(d3.dot(&ez));
-                r.push(y[2] - target);
+                let turns = ((y[2] - target) / std::f64::consts::TAU).round();
+                r.push(y[2] - target - std::f64::consts::TAU * turns);
                 g[(row, 2)] = 1.0;
             }
             Freedom::Free | Freedom::Axial(_) => {

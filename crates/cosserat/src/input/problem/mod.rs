@@ -114,15 +114,7 @@ impl Problem {
         let rod = build_rod(&file, catalog)?;
         let mut model = choose_model(&rod, &file.solver.model, file.energy.shear.is_some())?;
         let options = build_options(&file.solver)?;
-        if options.initial_reaction.is_some()
-            && !rod.support().as_ref().is_some_and(|s| s.holds_position())
-        {
-            return Err(invalid(
-                "solver.initial_reaction",
-                "guesses the reaction of a tip support that holds the tip's position; this \
-                 scene has none ([support] translation = \"fixed\" or \"axial\")",
-            ));
-        }
+        guesses_fit(&rod, &options)?;
         point_couples_carried(&rod, &model, &options)?;
         let shape = build_shape(&file)?;
         if shape.is_some() && !rod.loads().point_loads.is_empty() {
@@ -339,6 +331,34 @@ fn point_couples_carried(
             "a point couple is not carried on the general W(s, κ, ν) Cosserat path (the moment \
              there depends on the strain too); use an energy with shear stiffnesses \
              (energy.shear) or the Kirchhoff model",
+        ));
+    }
+    Ok(())
+}
+
+/// The solver's guesses name unknowns the scene has: a reaction needs a
+/// support that holds the tip's position, and κ(0) is no unknown beside
+/// a hinge.
+fn guesses_fit(rod: &Rod, options: &SolverOptions) -> Result<(), ProblemError> {
+    if options.initial_reaction.is_some()
+        && !rod.support().as_ref().is_some_and(|s| s.holds_position())
+    {
+        return Err(invalid(
+            "solver.initial_reaction",
+            "guesses the reaction of a tip support that holds the tip's position; this \
+             scene has none ([support] translation = \"fixed\" or \"axial\")",
+        ));
+    }
+    if options.initial_guess.is_some() && rod.clamp().hinge {
+        // The planar solver took κ2 of the guess as the hinge's angle
+        // (its unknown): [0, 3, 0] started Newton from a base turned
+        // by 3 rad, which diverged.
+        return Err(invalid(
+            "solver.initial_curvature",
+            "guesses κ(0), which a hinged base (clamp.hinge) does not have as an unknown \
+             (M2(0) = 0 fixes it): the unknown is the base's angle, measured from the clamp \
+             frame, so guess it by clamp.angle (rad), which turns that frame about the \
+             hinge's axis",
         ));
     }
     Ok(())
