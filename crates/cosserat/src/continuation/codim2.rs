@@ -381,6 +381,13 @@ impl Augmented<'_> {
             for (zi, d) in z.iter_mut().zip(&dz) {
                 *zi -= d;
             }
+            // A corrector that moves a parameter by half its size (or by
+            // 1/2 near zero) from the predictor has diverged: stop before
+            // it evaluates a rod hundreds of lengths long.
+            let n = self.n;
+            if (n..n + 2).any(|k| (z[k] - pred[k]).abs() > 0.5 * pred[k].abs().max(1.0)) {
+                return Ok(None);
+            }
             let size = z.iter().fold(1.0f64, |m, v| m.max(v.abs()));
             if Self::converged(&at, tolerance) && dy.amax() <= 100.0 * tolerance * size {
                 let at = self.system(&z, borders.0, borders.1, anchor)?;
@@ -609,6 +616,7 @@ fn walk(
     let n = aug.n;
     let mut points: Vec<CurvePoint> = vec![];
     let mut ds = opts.step;
+    let mut failure: Option<String> = None;
     loop {
         let last = points.last().unwrap_or(first);
         let [p1, p2] = last.parameters;
@@ -628,21 +636,32 @@ fn walk(
         // Borders: the last point's null vectors (right v; left from Fᵀ).
         let (_, fx) = aug.evaluate(&z)?;
         let (b, c) = Augmented::null_vectors(&fx, p1)?;
-        if let Some((z, mut at, iterations)) =
-            aug.correct(&pred, &tau, (&b, &c), &last.unknowns, opts.tolerance)?
-        {
-            let t = aug
-                .tangent(&mut at, &tau)
-                .ok_or(PointError::SingularTangent(z[n]))?;
-            let stored: Vec<f64> = t.iter().map(|v| v * sign).collect();
-            points.push(curve_point(aug, &z, stored, &b, &c)?);
-            if iterations <= 3 {
-                ds = (ds * 1.5).min(opts.max_step);
+        // A corrector whose iterate leaves the rods that can be evaluated
+        // (a Newton step that diverged: a length of hundreds, an
+        // integration that cannot finish) failed as one that did not
+        // converge: the step is halved, and the last such failure named
+        // where the curve ends for it.
+        match aug.correct(&pred, &tau, (&b, &c), &last.unknowns, opts.tolerance) {
+            Ok(Some((z, mut at, iterations))) => {
+                let t = aug
+                    .tangent(&mut at, &tau)
+                    .ok_or(PointError::SingularTangent(z[n]))?;
+                let stored: Vec<f64> = t.iter().map(|v| v * sign).collect();
+                points.push(curve_point(aug, &z, stored, &b, &c)?);
+                if iterations <= 3 {
+                    ds = (ds * 1.5).min(opts.max_step);
+                }
+                failure = None;
             }
-        } else {
-            ds *= 0.5;
-            if ds < opts.min_step {
-                return Ok((points, format!("step size below {:e}", opts.min_step)));
+            outcome => {
+                if let Err(e) = outcome {
+                    failure = Some(e.to_string());
+                }
+                ds *= 0.5;
+                if ds < opts.min_step {
+                    let why = failure.map_or(String::new(), |e| format!(" (last: {e})"));
+                    return Ok((points, format!("step size below {:e}{why}", opts.min_step)));
+                }
             }
         }
     }
