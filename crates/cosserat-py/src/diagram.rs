@@ -361,12 +361,15 @@ impl SpecialPoint {
 
     /// The estimated error of the parameter: the discretization's for an
     /// "augmented" location (located again on a refined discretization),
-    /// the extrapolations' for an "extrapolated" one, the bracket's spread
-    /// for a "bracketed" one not closed, and the discretization's for a
-    /// multiple branch point whose bracket closed (its root located again
-    /// on a refined discretization); None where not estimated (a refined
-    /// location that failed, which the diagram's warnings say, and a fold
-    /// or simple branch point kept at its closed bracket).
+    /// the extrapolations' plus the BVP discretization's for an
+    /// "extrapolated" one, the interpolants' difference (plus the
+    /// discretization's where known) for an "interpolated" one, the
+    /// bracket's spread for a "bracketed" one not closed, and the
+    /// discretization's for a multiple branch point whose bracket closed and
+    /// for a fold on a branch of symmetric copies (located again on a
+    /// refined discretization); None where not estimated (a refined
+    /// location that failed, and a simple branch point on a branch of
+    /// symmetric copies, which the diagram's warnings say).
     #[getter]
     fn parameter_error(&self) -> Option<f64> {
         self.point.parameter_error

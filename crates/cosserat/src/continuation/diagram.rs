@@ -136,15 +136,19 @@ pub struct SpecialPoint {
     /// integration tolerances up to 100× tighter), the difference scaled
     /// by Richardson's G/(G − 1) (`continuation/discretization.rs`); for
     /// [`Location::Extrapolated`] the difference of the extrapolations
-    /// from two pairs of element meshes; for [`Location::Bracketed`] the
-    /// bracket's spread where it could not be closed, and where it closed
-    /// on a multiple branch point the discretization's (the root of the
-    /// same entry of Govaerts' G located again on the refined family,
-    /// `continuation/bordered_root.rs`, Richardson-scaled alike). None
-    /// where it is not estimated: a refined location that failed (the
-    /// diagram's warnings say why), and a fold or simple branch point kept
-    /// at its closed bracket (its augmented Newton failed, which the
-    /// warnings say, or it lies on a branch of symmetric copies).
+    /// from two pairs of element meshes plus the BVP discretization's part
+    /// (the crossing located again on the refined family); for
+    /// [`Location::Interpolated`] the interpolants' difference plus the
+    /// event tolerance (plus the discretization's where it is known); for
+    /// [`Location::Bracketed`] the bracket's spread where it could not be
+    /// closed, and where it closed on a multiple branch point, or on a
+    /// fold of a branch of symmetric copies, the discretization's (the
+    /// root of the same test located again on the refined family,
+    /// `continuation/bordered_root.rs`, `discretization.rs`,
+    /// Richardson-scaled alike). None where it is not estimated: a refined
+    /// location that failed, a fold kept at its closed bracket because its
+    /// augmented Newton failed, and a simple branch point on a branch of
+    /// symmetric copies (the diagram's warnings say which and why).
     pub parameter_error: Option<f64>,
 }
 
