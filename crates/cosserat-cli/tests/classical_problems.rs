@@ -17,7 +17,7 @@ use std::f64::consts::PI;
 use std::path::Path;
 
 use common::problems::shipped;
-use common::run::{scratch, special_line, BIN};
+use common::run::{run, scratch, special_line, stderr};
 use cosserat::references::{ellip_e, ellip_f, greenhill_clamped};
 
 /// `cosserat continue NAME -o OUT` with `overrides`: its stdout, the run
@@ -32,16 +32,8 @@ fn continued(name: &str, out: &Path, overrides: &[&str]) -> String {
     for o in overrides {
         args.extend(["--set".to_string(), (*o).to_string()]);
     }
-    let o = std::process::Command::new(BIN)
-        .args(&args)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    assert!(
-        o.stderr.is_empty(),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    let o = run(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(o.status.success() && o.stderr.is_empty(), "{}", stderr(&o));
     String::from_utf8_lossy(&o.stdout).into_owned()
 }
 
@@ -357,13 +349,17 @@ fn loops_turned_about_their_closed_ends_carry_the_projected_force() {
     let dir = scratch("classical", "turned-loops");
     let (first, out) = (dir.join("column.h5"), dir.join("loops.h5"));
     continued("pinned_column", &first, &[]);
-    let o = std::process::Command::new(BIN)
-        .args(["continue", &shipped("pinned_column"), "--from"])
-        .args([first.to_str().unwrap(), "--point", "special/4", "-o"])
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = run(&[
+        "continue",
+        &shipped("pinned_column"),
+        "--from",
+        first.to_str().unwrap(),
+        "--point",
+        "special/4",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
     let loop_ = Elastica::at_height(0.0);
     let f = common::h5::open(&out);
     for branch in [1, 2] {
@@ -393,23 +389,20 @@ fn the_pinned_columns_branch_point_follows_eulers_load_in_the_length() {
     let dir = scratch("classical", "pinned_curve");
     let (diagram, curve) = (dir.join("d.h5"), dir.join("c.h5"));
     continued("pinned_column", &diagram, &["continuation.switch_depth=0"]);
-    let o = std::process::Command::new(BIN)
-        .args([
-            "continue",
-            &shipped("pinned_column"),
-            "-o",
-            curve.to_str().unwrap(),
-            "--from",
-            diagram.to_str().unwrap(),
-            "--point",
-            "special/0",
-            "--curve",
-            "--set",
-            "continuation.curve={parameter=\"rod.length\", start=1.0, bounds=[0.5, 2.0]}",
-        ])
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = run(&[
+        "continue",
+        &shipped("pinned_column"),
+        "-o",
+        curve.to_str().unwrap(),
+        "--from",
+        diagram.to_str().unwrap(),
+        "--point",
+        "special/0",
+        "--curve",
+        "--set",
+        "continuation.curve={parameter=\"rod.length\", start=1.0, bounds=[0.5, 2.0]}",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
     let file = common::h5::open(&curve);
     let floats = |name: &str| file.dataset(name).unwrap().floats().unwrap().to_vec();
     let (p, e) = (floats("curve/parameters"), floats("curve/parameter_error"));
