@@ -62,14 +62,12 @@ impl Run<'_> {
         sp: Option<SpecialPoint>,
         radius: f64,
     ) -> (Option<SpecialPoint>, Option<String>) {
-        let Some(sp) = sp else {
-            return (None, None);
-        };
-        if sp.location != Location::Augmented {
-            return (Some(sp), None);
+        match sp {
+            Some(sp) if sp.location == Location::Augmented => {
+                with_estimate(Some(sp), |sp| self.relocated(sp, radius))
+            }
+            other => (other, None),
         }
-        let error = self.relocated(&sp, radius);
-        stated(sp, error)
     }
 
     /// `sp`, a multiple branch point located on an entry of Govaerts'
@@ -83,13 +81,7 @@ impl Run<'_> {
         sp: Option<SpecialPoint>,
         reach: f64,
     ) -> (Option<SpecialPoint>, Option<String>) {
-        let Some(sp) = sp else {
-            return (None, None);
-        };
-        // An interpolated root's own error adds to the discretization's.
-        let location = sp.parameter_error.unwrap_or(0.0);
-        let error = self.relocated_multiple(&sp, reach).map(|e| e + location);
-        stated(sp, error)
+        with_estimate(sp, |sp| self.relocated_multiple(sp, reach))
     }
 
     /// An extrapolated crossing `sp` (its error the finite elements')
@@ -166,10 +158,7 @@ impl Run<'_> {
         sp: Option<SpecialPoint>,
         why: &str,
     ) -> (Option<SpecialPoint>, Option<String>) {
-        match sp {
-            Some(sp) => stated(sp, Err(why.to_string())),
-            None => (None, None),
-        }
+        with_estimate(sp, |_| Err(why.to_string()))
     }
 
     /// `sp`, a fold bracketed on a branch of symmetric copies in the step
@@ -184,11 +173,7 @@ impl Run<'_> {
         a: &Point,
         step: (f64, f64, f64),
     ) -> (Option<SpecialPoint>, Option<String>) {
-        let Some(sp) = sp else {
-            return (None, None);
-        };
-        let error = self.relocated_sliced_fold(&sp, a, step);
-        stated(sp, error)
+        with_estimate(sp, |sp| self.relocated_sliced_fold(sp, a, step))
     }
 
     /// The refined family's p at the root of τ_p in the step from `a`
@@ -315,8 +300,24 @@ fn refined(e: &super::PointError) -> String {
     format!("on the refined discretization {e}")
 }
 
+/// `sp` (where there is one) with the discretization error `estimate`
+/// gives it, added to the error it already carries (an interpolated
+/// root's own; none for a closed bracket or an augmented point), or with
+/// that error unknown and the note saying why.
+pub(super) fn with_estimate(
+    sp: Option<SpecialPoint>,
+    estimate: impl FnOnce(&SpecialPoint) -> Result<f64, String>,
+) -> (Option<SpecialPoint>, Option<String>) {
+    let Some(sp) = sp else {
+        return (None, None);
+    };
+    let located = sp.parameter_error.unwrap_or(0.0);
+    let error = estimate(&sp).map(|e| e + located);
+    stated(sp, error)
+}
+
 /// `sp` with its estimated error, or without one and the note saying why.
-pub(super) fn stated(
+fn stated(
     mut sp: SpecialPoint,
     error: Result<f64, String>,
 ) -> (Option<SpecialPoint>, Option<String>) {

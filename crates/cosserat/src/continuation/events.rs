@@ -562,18 +562,16 @@ impl Run<'_> {
         (sign, p_b, span): (f64, f64, f64),
         test: &Test,
     ) -> (Option<SpecialPoint>, Option<String>) {
-        let Some(sp) = sp else {
-            return (None, None);
-        };
-        let error = self.relocated_on_slice(&sp, a, &|run, start| match test {
-            Test::Bordered { right, .. } if right.nrows() == start.unknowns.len() => {
-                run.closed_root(start, (sign, p_b), span, test, "the entry of G")
-            }
-            _ => Err("has another number of unknowns, for which G's borders do not hold".into()),
-        });
-        // An interpolated root's own error adds to the discretization's.
-        let location = sp.parameter_error.unwrap_or(0.0);
-        super::discretization::stated(sp, error.map(|e| e + location))
+        super::discretization::with_estimate(sp, |sp| {
+            self.relocated_on_slice(sp, a, &|run, start| match test {
+                Test::Bordered { right, .. } if right.nrows() == start.unknowns.len() => {
+                    run.closed_root(start, (sign, p_b), span, test, "the entry of G")
+                }
+                _ => {
+                    Err("has another number of unknowns, for which G's borders do not hold".into())
+                }
+            })
+        })
     }
 
     /// The special point kept at the bracketed root, recorded as
